@@ -1,0 +1,56 @@
+"""Error types. User errors (bad input) derive from :class:`ExucableError`; the CLI
+prints their message without a traceback and exits with status 2."""
+
+__all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError"]
+
+
+class ExucableError(Exception):
+    """Base class of every error caused by the user's input or a failed run."""
+
+
+class ScenarioError(ExucableError):
+    """A scenario file is malformed or non-physical.
+
+    Parameters
+    ----------
+    key : str
+        Dotted key of the offending field, e.g. ``"conduit.path[2].radius"``.
+    message : str
+        What is wrong and what is allowed.
+    """
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        self.message = message
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+class GeometryError(ExucableError):
+    """A conduit route cannot be built (e.g. a fillet that does not fit).
+
+    ``key`` names the offending input relative to the conduit table, e.g.
+    ``"points[3]"`` or ``"path[1].radius"``, so the scenario layer can prefix it.
+    """
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        self.message = message
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+class ModelError(ExucableError):
+    """The scenario is valid on its own but cannot be modelled (e.g. a cable longer
+    than its conduit, elements too long to resolve the bends)."""
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        self.message = message
+        super().__init__(f"{key}: {message}" if key else message)
+
+
+class SolverError(ExucableError):
+    """The time integration failed; ``time_s`` is the simulated time where it happened."""
+
+    def __init__(self, message: str, time_s: float | None = None):
+        self.time_s = time_s
+        super().__init__(message if time_s is None else f"{message} (at simulated time t = {time_s:.6g} s)")
