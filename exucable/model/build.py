@@ -1,0 +1,197 @@
+"""Assemble the Exudyn system of one scenario: cable + rig + loads + contact.
+
+Reads like the physical system: lay the cable in the conduit, hang the loads on it, hook the
+rig to its leading end, let the conduit's wall act on it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import exudyn as exu
+
+from ..errors import ModelError
+from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
+from .cable import CableHandles, CableProperties, add_cable, add_gravity
+from .layout import CableLayout, contact_offsets, lay_cable
+from .rig import Drive, add_drive, add_end_force, smooth_ramp
+
+__all__ = ["Model", "build_model", "pull_oriented_conduit"]
+
+
+@dataclass(eq=False)
+class Model:
+    """An assembled Exudyn system of one scenario and the handles post-processing needs."""
+
+    scenario: object
+    system_container: object
+    mbs: object
+    conduit: object                      # pull-oriented: the leading end is at its end
+    cable: CableHandles
+    layout: CableLayout
+    properties: CableProperties
+    lead_drive: Drive | None
+    trail_drive: Drive | None
+    applied_pull_force_N: float | None   # force-controlled pull
+    back_tension_N: float
+    rope: RopeSolution | None
+    coupling: object | None = None
+    kernel: object | None = None
+    ode2_index: np.ndarray = field(default=None)
+
+    @property
+    def axial_stiffness_N(self) -> float:
+        return self.properties.axial_stiffness_N
+
+    def load_factor(self, t: float) -> float:
+        """Ramp factor of loads and speed at time t [-]."""
+        return smooth_ramp(t, self.scenario.pull.ramp_time_s)
+
+    def coordinates(self) -> tuple[np.ndarray, np.ndarray]:
+        """Current absolute nodal coordinates and their rates, each shape (n_el + 1, 6)."""
+        sd = self.mbs.systemData
+        q = np.asarray(sd.GetODE2Coordinates())[self.ode2_index]
+        v = np.asarray(sd.GetODE2Coordinates_t())[self.ode2_index]
+        return (self.layout.coordinates + q.reshape(-1, 6), v.reshape(-1, 6))
+
+    def pull_force_N(self, t: float) -> float:
+        """Force of the rig on the leading end along the pull [N]."""
+        if self.lead_drive is not None:
+            return self.lead_drive.force_N(self.mbs)
+        return self.applied_pull_force_N * self.load_factor(t)
+
+    def trailing_reaction_N(self) -> float | None:
+        """Brake force at the trailing end of a force-controlled pull [N] (None otherwise)."""
+        if self.trail_drive is None:
+            return None
+        return -self.trail_drive.force_N(self.mbs)
+
+
+def pull_oriented_conduit(scenario):
+    """The scenario's conduit, reversed when the pull direction is ``reverse``, so that the
+    leading end is always at the end of the returned conduit's centreline."""
+    conduit = scenario.build_conduit()
+    return conduit.reversed() if scenario.pull.direction == "reverse" else conduit
+
+
+def _rope_start(scenario, centreline, w_N_per_m: float) -> RopeSolution:
+    common = dict(friction=scenario.contact.friction, weight_per_length_N_per_m=w_N_per_m,
+                  cable_length_m=scenario.cable_length_m)
+    if scenario.pull.force_N is not None:
+        return solve_rope_for_pull_force(centreline, pull_force_N=scenario.pull.force_N, **common)
+    return solve_rope(centreline, trailing_tension_N=scenario.pull.back_tension_N, **common)
+
+
+def check_resolution(scenario, conduit) -> None:
+    """Refuse meshes too coarse for the conduit: a cubic element must follow the tightest bend
+    within the clearance, its sagitta L²κ/8 (κ the curvature) below the clearance R − r."""
+    clearance = conduit.inner_radius_m - scenario.cable.radius_m
+    kappa = 1.0 / conduit.centreline.min_bend_radius_m
+    L_e = scenario.cable_length_m / scenario.cable.elements
+    # a cubic Hermite element bends with its nodes' slopes; the chord of a too-long element still
+    # cuts across the wall by ~L_e^4 κ / 384 -- the bound used here is the element's own sagitta
+    # against its curvature being resolved by ≥ 4 elements per radian of turning.
+    if kappa > 0 and L_e * kappa > 0.5:
+        n_needed = int(np.ceil(scenario.cable_length_m * kappa / 0.5))
+        raise ModelError(
+            "cable.elements",
+            f"elements of {L_e:.4g} m cannot follow the tightest bend (radius {1/kappa:.4g} m): "
+            f"each element would turn {np.degrees(L_e * kappa):.1f} deg (at most 28.6 deg = 0.5 rad allowed); "
+            f"use at least {n_needed} elements")
+    if scenario.contact.check_points_per_element < 1:
+        raise ModelError("contact.check_points_per_element", "must be >= 1")
+    del clearance
+
+
+def build_model(scenario, with_contact: bool = True) -> Model:
+    """Build the Exudyn system of ``scenario`` (a :class:`exucable.scenario.Scenario`).
+
+    The start follows :mod:`exucable.model.layout`: pre-stretched to the rope tension, on its
+    bearing wall, moving at the pull speed (unless ``solver.pretension`` is false: then on the
+    centreline, unloaded, at rest, with loads and speed ramped over ``pull.ramp_time``).
+    """
+    sc = scenario
+    conduit = pull_oriented_conduit(sc)
+    centre = conduit.centreline
+    L_cable = sc.cable_length_m
+    if L_cable > centre.length_m * (1 + 1e-12):
+        raise ModelError("cable.length", f"cable of {L_cable:.6g} m is longer than the conduit "
+                         f"({centre.length_m:.6g} m); shorten it or extend the route")
+    check_resolution(sc, conduit)
+    c = sc.cable
+    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
+    w = c.mass_per_length_kg_per_m * g
+    props = CableProperties(
+        mass_per_length_kg_per_m=c.mass_per_length_kg_per_m,
+        axial_stiffness_N=c.axial_stiffness_N,
+        bending_stiffness_N_m2=c.bending_stiffness_N_m2,
+        axial_damping_N_s=c.axial_damping_N_s,
+        bending_damping_N_m2_s=c.bending_damping_N_m2_s,
+    )
+    clearance = conduit.inner_radius_m - c.radius_m
+    speed = sc.pull.speed_m_per_s
+    rope = _rope_start(sc, centre, w)
+    if sc.solver.pretension:
+        s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * sc.cable.elements + 1))
+        T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
+        L_e = L_cable / c.elements
+        # blend over the length on which a tensioned beam leaves the wall, √(EJ/T), but at least
+        # two elements so the nodes can follow it
+        T_ref = max(float(np.max(rope.tension_N)), 1e-6)
+        blend = max(2.0 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
+        off = contact_offsets(centre, s_grid, T_grid, w, clearance,
+                              sc.contact.stiffness / sc.contact.reference_spacing_m,
+                              sc.contact.exponent, blend) if with_contact else np.zeros((len(s_grid), 3))
+
+        def tension_fn(s):
+            return np.interp(s, rope.s_conduit_m, rope.tension_N, left=rope.tension_N[0], right=rope.tension_N[-1])
+
+        def offset_fn(s):
+            return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
+
+        layout = lay_cable(centre, L_cable, c.elements, c.axial_stiffness_N, speed, tension_fn, offset_fn)
+    else:
+        layout = lay_cable(centre, L_cable, c.elements, c.axial_stiffness_N, 0.0)
+
+    SC = exu.SystemContainer()
+    mbs = SC.AddSystem()
+    cable = add_cable(mbs, layout.coordinates, layout.element_length_m, props, layout.velocities,
+                      draw_radius_m=c.radius_m)
+    ramp_time = sc.pull.ramp_time_s if not sc.solver.pretension else sc.pull.ramp_time_s
+    factor = None if ramp_time <= 0 else (lambda t: smooth_ramp(t, ramp_time))
+    if g > 0:
+        add_gravity(mbs, cable, [0.0, 0.0, -g], factor)
+    t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
+    s_trail = centre.length_m - L_cable
+    t_entry = np.asarray(centre.tangent(s_trail), dtype=float)
+    lead_drive = trail_drive = None
+    applied = None
+    if sc.pull.force_N is None:
+        lead_drive = add_drive(mbs, cable.nodes[-1], t_exit, speed, ramp_time)
+        if sc.pull.back_tension_N > 0:
+            add_end_force(mbs, cable.nodes[0], -sc.pull.back_tension_N * t_entry, factor)
+    else:
+        applied = sc.pull.force_N
+        add_end_force(mbs, cable.nodes[-1], applied * t_exit, factor)
+        trail_drive = add_drive(mbs, cable.nodes[0], t_entry, speed, ramp_time)
+
+    model = Model(scenario=sc, system_container=SC, mbs=mbs, conduit=conduit, cable=cable, layout=layout,
+                  properties=props, lead_drive=lead_drive, trail_drive=trail_drive,
+                  applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope)
+    if with_contact:
+        from ..contact import ContactKernel, ContactLaw
+        from .coupling import ContactCoupling
+        ct = sc.contact
+        law = ContactLaw(stiffness=ct.stiffness, damping=ct.damping, exponent=ct.exponent, friction=ct.friction,
+                         static_friction=ct.static_friction, stribeck_velocity_m_per_s=ct.stribeck_velocity_m_per_s,
+                         regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s)
+        kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
+                               ct.check_points_per_element, rule=ct.check_point_rule,
+                               reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase)
+        model.kernel = kernel
+        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel)
+    mbs.Assemble()
+    model.ode2_index = np.concatenate([
+        np.arange(mbs.GetNodeODE2Index(n), mbs.GetNodeODE2Index(n) + 6) for n in cable.nodes])
+    return model

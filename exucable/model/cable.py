@@ -1,0 +1,117 @@
+"""The cable as Exudyn 3D ANCF cable elements (paper Sect. 2.2, Eqs. 2-13).
+
+``NodePointSlope1`` nodes carry ``[x, y, z, x', y', z']`` (position [m] and slope dr/dx [-]);
+``ObjectANCFCable`` elements join consecutive nodes. Strain and curvature are measured
+absolutely (``strainIsRelativeToReference = 0``), so a node layout that is stretched or curved
+carries tension or bending moment from the start: that is how a pre-tensioned start is built.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import exudyn as exu
+from exudyn.itemInterface import MarkerBodyMass, NodePointSlope1, ObjectANCFCable, LoadMassProportional
+
+__all__ = ["CableProperties", "CableHandles", "add_cable", "add_gravity"]
+
+
+@dataclass(frozen=True)
+class CableProperties:
+    """Section properties of the cable.
+
+    Attributes
+    ----------
+    mass_per_length_kg_per_m : float
+        ρA [kg/m].
+    axial_stiffness_N : float
+        EA [N].
+    bending_stiffness_N_m2 : float
+        EJ [N m²].
+    axial_damping_N_s : float
+        Axial (Kelvin-Voigt) damping, force per strain rate [N s].
+    bending_damping_N_m2_s : float
+        Bending damping, moment per curvature rate [N m² s].
+    """
+
+    mass_per_length_kg_per_m: float
+    axial_stiffness_N: float
+    bending_stiffness_N_m2: float
+    axial_damping_N_s: float = 0.0
+    bending_damping_N_m2_s: float = 0.0
+
+
+@dataclass(frozen=True)
+class CableHandles:
+    """Exudyn indices of the cable: ``nodes[0]`` is the trailing end."""
+
+    nodes: tuple[int, ...]
+    elements: tuple[int, ...]
+    element_length_m: np.ndarray
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.elements)
+
+
+def add_cable(mbs, coordinates, element_length_m, properties: CableProperties, velocities=None,
+              draw_radius_m: float = 0.0) -> CableHandles:
+    """Add ANCF cable nodes and elements to ``mbs``.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    coordinates : array_like (n_el + 1, 6)
+        Reference coordinates ``[x, y, z, x', y', z']`` of each node [m, -]; the simulation starts
+        there (initial displacement zero).
+    element_length_m : array_like (n_el,)
+        Unstretched element lengths [m].
+    properties : CableProperties
+    velocities : array_like (n_el + 1, 6), optional
+        Initial coordinate rates [m/s, 1/s].
+    draw_radius_m : float
+        Radius for Exudyn's renderer only [m].
+    """
+    coords = np.asarray(coordinates, dtype=float)
+    lengths = np.asarray(element_length_m, dtype=float)
+    if coords.ndim != 2 or coords.shape[1] != 6 or coords.shape[0] != len(lengths) + 1:
+        raise ValueError("coordinates must have shape (n_elements + 1, 6)")
+    vel = np.zeros_like(coords) if velocities is None else np.asarray(velocities, dtype=float)
+    nodes = tuple(
+        mbs.AddNode(NodePointSlope1(referenceCoordinates=list(c), initialVelocities=list(v)))
+        for c, v in zip(coords, vel)
+    )
+    p = properties
+    elements = tuple(
+        mbs.AddObject(ObjectANCFCable(
+            nodeNumbers=[nodes[i], nodes[i + 1]],
+            length=float(lengths[i]),
+            massPerLength=p.mass_per_length_kg_per_m,
+            axialStiffness=p.axial_stiffness_N,
+            bendingStiffness=p.bending_stiffness_N_m2,
+            axialDamping=p.axial_damping_N_s,
+            bendingDamping=p.bending_damping_N_m2_s,
+            visualization={"show": True, "radius": draw_radius_m, "color": [-1.0, -1.0, -1.0, -1.0]},
+        ))
+        for i in range(len(lengths))
+    )
+    return CableHandles(nodes=nodes, elements=elements, element_length_m=lengths)
+
+
+def add_gravity(mbs, cable: CableHandles, acceleration_m_per_s2, factor=None) -> list[int]:
+    """Weight of every element: a mass-proportional load ``ρA·g`` [N/m].
+
+    ``factor(t)`` (optional) scales it in time, for a ramped start.
+    """
+    g = [float(a) for a in acceleration_m_per_s2]
+    loads = []
+    for e in cable.elements:
+        m = mbs.AddMarker(MarkerBodyMass(bodyNumber=e))
+        if factor is None:
+            loads.append(mbs.AddLoad(LoadMassProportional(markerNumber=m, loadVector=g)))
+        else:
+            loads.append(mbs.AddLoad(LoadMassProportional(
+                markerNumber=m, loadVector=g,
+                loadVectorUserFunction=lambda mbs, t, load, f=factor: [f(t) * x for x in load])))
+    return loads

@@ -1,0 +1,234 @@
+"""Initial placement of the cable in its conduit (pure numpy; no Exudyn).
+
+Where the run starts decides what it costs: a cable laid on the centreline, unloaded, first
+slams onto the wall and sheds axial waves (thousands of tiny steps); a cable laid where it will
+slide anyway, already carrying its tension, starts in near-equilibrium and the solver takes
+large steps at once (``../shared/notes/exudyn-findings.md``: 116 s -> 0.6 s on Example 2).
+
+So the start is built from the quasi-static rope solution:
+
+* the cable is **pre-stretched**: a material element of length ``L_e`` spans ``(1 + T/EA) L_e``
+  of its path, so that N = EA·ε (paper Eq. 24) equals the rope tension T from the first step;
+* it is **offset toward the wall** it will bear on, by the clearance ``R - r`` plus the
+  penetration that the Hertz law needs to carry the sidewall load (paper Eqs. 14, 18); the
+  offset field is smoothed along the route so that the cable is not kinked where contact starts
+  (and straight runs without load stay off the wall: contact sitting exactly at the clearance
+  chatters);
+* it already **moves** at the pulling speed along its path (positions and slope rates).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["CableLayout", "lay_cable", "contact_offsets", "extended_point", "extended_tangent"]
+
+
+@dataclass(frozen=True, eq=False)
+class CableLayout:
+    """Nodal start state of an ANCF cable, nodes numbered from the trailing end.
+
+    Attributes
+    ----------
+    element_length_m : ndarray (n_el,)
+        Unstretched (material) element lengths [m].
+    node_x_m : ndarray (n_el + 1,)
+        Material coordinate of each node, from the trailing end [m].
+    node_s_m : ndarray (n_el + 1,)
+        Arc length of each node along the (pull-oriented) centreline [m]; beyond the conduit's
+        length the path continues straight along the exit tangent.
+    position_m, slope : ndarray (n_el + 1, 3)
+        Node positions [m] and slopes dr/dx [-] (|slope| = 1 + ε).
+    velocity_m_per_s, slope_rate_1_per_s : ndarray (n_el + 1, 3)
+        Initial time derivatives of position [m/s] and slope [1/s].
+    """
+
+    element_length_m: np.ndarray
+    node_x_m: np.ndarray
+    node_s_m: np.ndarray
+    position_m: np.ndarray
+    slope: np.ndarray
+    velocity_m_per_s: np.ndarray
+    slope_rate_1_per_s: np.ndarray
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.element_length_m)
+
+    @property
+    def coordinates(self) -> np.ndarray:
+        """Nodal coordinates ``[x, y, z, x', y', z']`` per node, shape (n_el + 1, 6)."""
+        return np.hstack([self.position_m, self.slope])
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """Nodal coordinate rates, shape (n_el + 1, 6)."""
+        return np.hstack([self.velocity_m_per_s, self.slope_rate_1_per_s])
+
+
+def extended_point(centreline, s_m: np.ndarray) -> np.ndarray:
+    """Centreline point at ``s_m`` [m], continued straight along the end tangents outside [0, L]."""
+    s = np.atleast_1d(np.asarray(s_m, dtype=float))
+    L = centreline.length_m
+    inside = np.clip(s, 0.0, L)
+    p = np.atleast_2d(centreline.point(inside)).copy()
+    lo, hi = s < 0.0, s > L
+    if lo.any():
+        p[lo] += (s[lo] - 0.0)[:, None] * np.atleast_2d(centreline.tangent(0.0))
+    if hi.any():
+        p[hi] += (s[hi] - L)[:, None] * np.atleast_2d(centreline.tangent(L))
+    return p
+
+
+def extended_tangent(centreline, s_m: np.ndarray) -> np.ndarray:
+    """Unit tangent at ``s_m``, constant beyond the conduit's ends."""
+    s = np.clip(np.atleast_1d(np.asarray(s_m, dtype=float)), 0.0, centreline.length_m)
+    return np.atleast_2d(centreline.tangent(s))
+
+
+def contact_offsets(
+    centreline,
+    s_m: np.ndarray,
+    tension_N: np.ndarray,
+    weight_per_length_N_per_m: float,
+    clearance_m: float,
+    line_stiffness_N_per_m_e_per_m: float,
+    exponent: float,
+    blend_length_m: float,
+) -> np.ndarray:
+    """Offset of the cable axis from the conduit axis at rest on its bearing wall.
+
+    The cable presses on the wall along the lateral load per length
+    ``p = T κ n - w (e_z - (e_z·t) t)`` (the rope equation's sidewall load); its axis sits at the
+    clearance plus the penetration ``δ = (|p| / k)^(1/e)`` that the distributed Hertz law
+    ``k δ^e`` (``k = K_n / h_ref``) needs to carry it. Unloaded stretches keep zero offset. The
+    field is smoothed with a Gaussian of width ``blend_length_m`` along s.
+
+    Parameters
+    ----------
+    s_m : ndarray (m,)
+        Uniform grid of arc lengths inside [0, L] [m].
+    tension_N : ndarray (m,)
+        Rope tension on the grid [N].
+    weight_per_length_N_per_m : float
+        w = ρAg [N/m] (0 without gravity).
+    clearance_m : float
+        R - r [m].
+    line_stiffness_N_per_m_e_per_m : float
+        Contact stiffness per unit cable length, K_n / h_ref [N/m^e per m].
+    exponent : float
+        Hertz exponent e [-].
+    blend_length_m : float
+        Smoothing length [m].
+
+    Returns
+    -------
+    ndarray (m, 3)
+        Offset vectors [m].
+    """
+    s = np.asarray(s_m, dtype=float)
+    t = np.atleast_2d(centreline.tangent(s))
+    kn = np.atleast_2d(centreline.curvature_vector(s))
+    ez = np.array([0.0, 0.0, 1.0])
+    w_perp = weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
+    load = np.asarray(tension_N, dtype=float)[:, None] * kn - w_perp
+    p = np.linalg.norm(load, axis=1)
+    scale = max(p.max(), 1e-300)
+    loaded = p > 1e-9 * scale
+    off = np.zeros_like(load)
+    if loaded.any():
+        delta = (p[loaded] / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent)
+        off[loaded] = load[loaded] / p[loaded, None] * (clearance_m + delta)[:, None]
+    ds = s[1] - s[0] if len(s) > 1 else 1.0
+    sigma = blend_length_m / ds
+    if sigma > 0.5 and loaded.any():
+        half = int(np.ceil(4 * sigma))
+        k = np.exp(-0.5 * (np.arange(-half, half + 1) / sigma) ** 2)
+        k /= k.sum()
+        # 'edge' padding: at the conduit's ends the wall the cable rests on continues.
+        pad = np.pad(off, ((half, half), (0, 0)), mode="edge")
+        off = np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(3)], axis=1)
+        # smoothing may only lift the cable off the wall, never push it further in than the load needs
+        mag = np.linalg.norm(off, axis=1)
+        cap = np.where(loaded, clearance_m + (p / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent), clearance_m)
+        too = mag > cap
+        off[too] *= (cap[too] / mag[too])[:, None]
+    return off
+
+
+def lay_cable(
+    centreline,
+    cable_length_m: float,
+    n_elements: int,
+    axial_stiffness_N: float,
+    speed_m_per_s: float = 0.0,
+    tension_N: Callable[[np.ndarray], np.ndarray] | None = None,
+    offset_m: Callable[[np.ndarray], np.ndarray] | None = None,
+    points_per_element: int = 40,
+) -> CableLayout:
+    """Lay a cable of ``n_elements`` equal material elements into the leading part of a conduit.
+
+    The trailing end sits at ``s = L - cable_length_m``; the pre-stretch (1 + T/EA) may carry the
+    leading end past the conduit's exit, along the exit tangent (where the rig holds it).
+
+    Parameters
+    ----------
+    centreline
+        Pull-oriented centreline (``point``, ``tangent``, ``length_m``); the leading end is at its end.
+    cable_length_m : float
+        Unstretched cable length [m], ≤ the centreline length.
+    n_elements : int
+        Number of ANCF cable elements.
+    axial_stiffness_N : float
+        EA [N].
+    speed_m_per_s : float
+        Initial sliding speed along the path [m/s].
+    tension_N : callable, optional
+        T(s) [N] on the conduit's arc length (vectorised); None = unstressed.
+    offset_m : callable, optional
+        Offset vector field o(s) [m] (vectorised, shape (m, 3)); None = on the centreline.
+    points_per_element : int
+        Resolution of the fine grid that integrates the stretched path.
+    """
+    L = float(centreline.length_m)
+    s0 = L - float(cable_length_m)
+    # Fine grid along s, long enough to hold the stretched cable (strain < 50 % is asserted below).
+    ds = cable_length_m / (n_elements * points_per_element)
+    s_end_max = s0 + 1.5 * cable_length_m
+    s = np.arange(s0, s_end_max + ds, ds)
+    T = np.zeros_like(s) if tension_N is None else np.asarray(tension_N(np.clip(s, 0.0, L)), dtype=float)
+    o = np.zeros((len(s), 3)) if offset_m is None else np.asarray(offset_m(np.clip(s, 0.0, L)), dtype=float)
+    P = extended_point(centreline, s) + o
+    dP = np.gradient(P, s, axis=0, edge_order=2)
+    speed_geom = np.linalg.norm(dP, axis=1)              # dσ/ds of the offset path
+    stretch = 1.0 + T / axial_stiffness_N                # dσ/dx
+    if np.any(stretch <= 0.5) or np.any(stretch > 1.5):
+        raise ValueError("tension profile implies a strain beyond ±50 %: check EA and the loads")
+    dx_ds = speed_geom / stretch
+    x = np.concatenate([[0.0], np.cumsum(0.5 * (dx_ds[1:] + dx_ds[:-1]) * np.diff(s))])
+    x_nodes = np.linspace(0.0, cable_length_m, n_elements + 1)
+    if x[-1] < cable_length_m:
+        raise ValueError("internal: fine grid too short for the stretched cable")
+    s_nodes = np.interp(x_nodes, x, s)
+    unit = dP / speed_geom[:, None]
+    slope_field = unit * stretch[:, None]
+    pos = np.stack([np.interp(s_nodes, s, P[:, j]) for j in range(3)], axis=1)
+    slope = np.stack([np.interp(s_nodes, s, slope_field[:, j]) for j in range(3)], axis=1)
+    # slope rate: the path's slope field is fixed in space while the material slides along it at
+    # speed V (per unit σ): d(slope)/dt = V · d(slope)/dσ.
+    dslope = np.gradient(slope_field, s, axis=0, edge_order=2) / speed_geom[:, None]
+    vel_field = unit * speed_m_per_s
+    vel = np.stack([np.interp(s_nodes, s, vel_field[:, j]) for j in range(3)], axis=1)
+    srate = np.stack([np.interp(s_nodes, s, speed_m_per_s * dslope[:, j]) for j in range(3)], axis=1)
+    return CableLayout(
+        element_length_m=np.diff(x_nodes),
+        node_x_m=x_nodes,
+        node_s_m=s_nodes,
+        position_m=pos,
+        slope=slope,
+        velocity_m_per_s=vel,
+        slope_rate_1_per_s=srate,
+    )

@@ -1,0 +1,61 @@
+"""Figures of one run: pulling and trailing force against time, tension along the cable."""
+
+from __future__ import annotations
+
+import io
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ..results import atomic_write_bytes  # noqa: E402
+
+__all__ = ["plot_pull_force", "plot_tension_profile", "save_figure"]
+
+
+def save_figure(fig, path) -> None:
+    """Save a matplotlib figure as PNG atomically and close it."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    atomic_write_bytes(path, buf.getvalue())
+
+
+def plot_pull_force(path, result) -> None:
+    """Pulling force and trailing tension [N] against time [s], with the steady window and the
+    rope reference when there is one."""
+    h, s = result.history, result.summary
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(h["time_s"], h["pull_force_N"], label="pulling force (leading end)")
+    ax.plot(h["time_s"], h["trailing_tension_N"], label="trailing-end tension")
+    rope = s.get("rope_pull_force_N")
+    if rope is not None:
+        ax.axhline(rope, color="k", ls="--", lw=1, label=f"rope reference {rope:.4g} N")
+    t0 = s.get("steady_from_s")
+    if s.get("steady") and t0 is not None:
+        ax.axvspan(t0, h["time_s"][-1], color="g", alpha=0.08, label="steady window")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("force [N]")
+    ax.set_title(f"{s.get('name', '')}: pulling force {s.get('pull_force_N', float('nan')):.4g} N")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    save_figure(fig, path)
+
+
+def plot_tension_profile(path, result) -> None:
+    """Tension [N] along the cable (arc length from the trailing end [m]) at the final time,
+    beside the rope reference."""
+    p = result.tension_profile
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(p["s_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
+    rp = result.rope_profile
+    if rp is not None and "s_cable_m" in result.extras:
+        ax.plot(result.extras["s_cable_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
+    ax.set_xlabel("arc length from the trailing end [m]")
+    ax.set_ylabel("tension [N]")
+    ax.set_title(f"{result.summary.get('name', '')}: tension along the cable")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    save_figure(fig, path)

@@ -1,0 +1,156 @@
+"""One scenario, start to finish: scenario → model → solve → post-processing → result files.
+
+``run_scenario`` is the programmatic entry (sweeps call it in worker processes);
+``exucable run`` is its command-line face.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .errors import ExucableError
+from .results import RunResult, write_results
+from .scenario import Scenario, load_scenario
+from .solve import Progress, simulate
+from .tension import detect_steady_state, tension_profile
+
+__all__ = ["run_scenario", "contact_profile", "add_arguments", "main"]
+
+
+def contact_profile(model, bins: int = 2000) -> tuple[dict, float] | tuple[None, float]:
+    """Sidewall bearing pressure along the conduit at the current state.
+
+    Returns the binned profile (``s_m`` along the scenario's conduit, normal force per unit length
+    [N/m] = Σ f_n in a bin / bin width, largest penetration [m] in the bin) and the largest
+    per-check-point pressure [N/m].
+    """
+    if model.kernel is None:
+        return None, 0.0
+    q, v = model.coordinates()
+    pts = model.kernel.points(q.reshape(-1), v.reshape(-1))
+    L = model.conduit.centreline.length_m
+    s = np.asarray(pts.s_conduit_m, dtype=float)
+    if model.scenario.pull.direction == "reverse":
+        s = L - s   # report along the scenario's own conduit
+    fn = np.asarray(pts.normal_force_N, dtype=float)
+    pen = np.asarray(pts.penetration_m, dtype=float)
+    edges = np.linspace(0.0, L, bins + 1)
+    idx = np.clip(np.searchsorted(edges, s, side="right") - 1, 0, bins - 1)
+    force = np.bincount(idx, weights=fn, minlength=bins)
+    pmax = np.full(bins, -np.inf)
+    np.maximum.at(pmax, idx, pen)
+    pmax[~np.isfinite(pmax)] = 0.0
+    width = L / bins
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    per_point = np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)
+    peak = float(per_point.max()) if per_point.size else 0.0
+    return ({"s_m": centres, "normal_force_per_length_N_per_m": force / width,
+             "penetration_m": np.maximum(pmax, 0.0)}, peak)
+
+
+def _versions() -> dict:
+    import exudyn
+    import numpy
+    import platform
+    return {"exucable": __version__, "exudyn": exudyn.__version__, "numpy": numpy.__version__,
+            "python": platform.python_version()}
+
+
+def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
+                 steady_stop: bool | None = None) -> RunResult:
+    """Run one scenario and (if ``out_dir`` is given) write its result files.
+
+    A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
+    message and the simulated time where it happened, and everything recorded until then is
+    written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
+    """
+    from .model.build import build_model
+
+    sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    t_start = time.perf_counter()
+    model = build_model(sc)
+    build_s = time.perf_counter() - t_start
+    progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
+    out = simulate(model, progress=progress, steady_stop=steady_stop)
+    h = out.history.arrays()
+    sp = sc.solver
+    st = detect_steady_state(h["time_s"], h["pull_force_N"], sp.steady_window_s, sp.steady_tolerance)
+    i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
+    q, _ = model.coordinates()
+    x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
+    cprof, peak_pressure = contact_profile(model)
+    rope = model.rope
+    summary = {
+        "name": sc.name,
+        "status": out.status,
+        "message": out.message,
+        "pull_force_N": st.mean_N,
+        "pull_force_std_N": st.std_N,
+        "pull_force_drift_N": st.drift_N,
+        "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
+        "max_tension_N": float(np.max(h["max_tension_N"][i0:])) if len(h["time_s"]) else None,
+        "steady": st.steady,
+        "steady_from_s": st.from_s,
+        "simulated_time_s": out.end_time_s,
+        "steps": out.steps,
+        "newton_iterations": out.newton_iterations,
+        "jacobian_updates": out.jacobian_updates,
+        "wall_time_s": out.wall_time_s,
+        "build_time_s": build_s,
+        "kernel_time_s": model.coupling.kernel_time_s if model.coupling is not None else 0.0,
+        "max_sidewall_pressure_N_per_m": peak_pressure,
+        "rope_pull_force_N": rope.pull_force_N if rope is not None else None,
+        "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
+        "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        "scenario": sc.to_dict(),
+        "versions": _versions(),
+    }
+    if out.status == "failed":
+        summary["failed_at_s"] = out.end_time_s
+    rope_profile = None
+    extras = {}
+    if rope is not None:
+        rope_profile = {"s_m": rope.s_conduit_m, "tension_N": rope.tension_N,
+                        "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m}
+        extras["s_cable_m"] = rope.s_cable_m
+    result = RunResult(summary=summary, history=h, tension_profile={"s_m": x, "tension_N": N},
+                       contact_profile=cprof, rope_profile=rope_profile, extras=extras)
+    if out_dir is not None:
+        write_results(out_dir, result, plots=plots)
+    return result
+
+
+def add_arguments(p) -> None:
+    p.add_argument("scenario", help="scenario file (TOML)")
+    p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    p.add_argument("--steady-stop", dest="steady_stop", action="store_true", default=None,
+                   help="stop once the pulling force is steady (overrides solver.steady_stop)")
+    p.add_argument("--no-steady-stop", dest="steady_stop", action="store_false",
+                   help="run to solver.end_time whatever the pulling force does")
+
+
+def main(args) -> int:
+    sc = load_scenario(args.scenario)
+    out_dir = Path(args.out) if args.out else Path("out") / sc.name
+    res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop)
+    s = res.summary
+    rope = s.get("rope_pull_force_N")
+    print(f"{sc.name}: status {s['status']}, pulling force {s['pull_force_N']:.6g} N "
+          f"(± {s['pull_force_std_N']:.2g}), trailing tension {s['trailing_tension_N']:.6g} N, "
+          f"max tension {s['max_tension_N']:.6g} N")
+    if rope is not None:
+        print(f"  rope reference: pulling force {rope:.6g} N "
+              f"({100 * (s['pull_force_N'] / rope - 1):+.3f} %)")
+    print(f"  steady from {s['steady_from_s']:.4g} s: {s['steady']}; {s['steps']} steps, "
+          f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    print(f"  results in {out_dir}/")
+    if s["status"] == "failed":
+        print(f"  FAILED: {s['message']} (at t = {s.get('failed_at_s', float('nan')):.6g} s)")
+        return 1
+    return 0

@@ -1,0 +1,146 @@
+"""Tension post-processing (paper Sect. 2.6, Eq. 24: N = EA·ε) and the steady-state detector.
+
+Pure numpy on nodal coordinates, so the same code serves live recording during a run and
+post-processing of saved states; a test checks it against Exudyn's own ``ForceLocal`` output.
+The strain is the ANCF cable's axial strain ε = |r'(x)| − 1 (paper Eq. 11), r' = ∂r/∂x along the
+unstretched (material) coordinate x.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["axial_strain", "tension_at", "tension_profile", "SteadyState", "detect_steady_state",
+           "hermite_derivative_weights"]
+
+
+def hermite_derivative_weights(xi: np.ndarray, length_m: np.ndarray) -> np.ndarray:
+    """Weights of [r_i, r'_i, r_j, r'_j] in ∂r/∂x at element coordinate ξ ∈ [0, 1].
+
+    Returns shape (m, 4): derivatives of N1 = 1 − 3ξ² + 2ξ³, N2 = L(ξ − 2ξ² + ξ³),
+    N3 = 3ξ² − 2ξ³, N4 = L(−ξ² + ξ³) with respect to x = ξL (paper Eqs. 5-6).
+    """
+    xi = np.asarray(xi, dtype=float)
+    L = np.asarray(length_m, dtype=float)
+    return np.stack([(-6 * xi + 6 * xi**2) / L, 1 - 4 * xi + 3 * xi**2,
+                     (6 * xi - 6 * xi**2) / L, -2 * xi + 3 * xi**2], axis=-1)
+
+
+def _locate(x_m, element_length_m):
+    x_nodes = np.concatenate([[0.0], np.cumsum(element_length_m)])
+    x = np.clip(np.asarray(x_m, dtype=float), 0.0, x_nodes[-1])
+    e = np.clip(np.searchsorted(x_nodes, x, side="right") - 1, 0, len(element_length_m) - 1)
+    xi = (x - x_nodes[e]) / element_length_m[e]
+    return e, xi
+
+
+def axial_strain(coordinates, element_length_m, x_m) -> np.ndarray:
+    """Axial strain ε = |∂r/∂x| − 1 [-] at material stations ``x_m`` [m] from the trailing end.
+
+    Parameters
+    ----------
+    coordinates : array_like (n_el + 1, 6)
+        Absolute nodal coordinates ``[x, y, z, x', y', z']``.
+    element_length_m : array_like (n_el,)
+        Unstretched element lengths [m].
+    x_m : array_like (m,)
+        Stations along the cable [m]; an element's end node belongs to the next element.
+    """
+    q = np.asarray(coordinates, dtype=float).reshape(-1, 6)
+    Le = np.asarray(element_length_m, dtype=float)
+    e, xi = _locate(x_m, Le)
+    w = hermite_derivative_weights(xi, Le[e])
+    d = (w[:, 0, None] * q[e, :3] + w[:, 1, None] * q[e, 3:] + w[:, 2, None] * q[e + 1, :3]
+         + w[:, 3, None] * q[e + 1, 3:])
+    return np.linalg.norm(d, axis=1) - 1.0
+
+
+def tension_at(coordinates, element_length_m, axial_stiffness_N, x_m) -> np.ndarray:
+    """Axial force N = EA·ε [N] (paper Eq. 24) at stations ``x_m`` [m] from the trailing end."""
+    return axial_stiffness_N * axial_strain(coordinates, element_length_m, x_m)
+
+
+def tension_profile(coordinates, element_length_m, axial_stiffness_N, points_per_element: int = 4):
+    """Tension along the whole cable: (x_m, tension_N) at ``points_per_element`` + 1 stations per
+    element including both ends (the end node of each element evaluated from its left element)."""
+    Le = np.asarray(element_length_m, dtype=float)
+    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
+    xi = np.linspace(0.0, 1.0, points_per_element + 1)[:-1]
+    x = (x_nodes[:-1, None] + xi[None, :] * Le[:, None]).ravel()
+    x = np.concatenate([x, [x_nodes[-1]]])
+    return x, tension_at(coordinates, Le, axial_stiffness_N, x)
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """A steady window of a force history.
+
+    Attributes
+    ----------
+    steady : bool
+        Whether a window satisfying both bounds was found.
+    from_s : float
+        Start of the steady window [s] (the last ``min_window_s`` when not steady).
+    mean_N, std_N : float
+        Mean and standard deviation of the force in the window [N].
+    drift_N : float
+        Change of the least-squares line across the window [N].
+    """
+
+    steady: bool
+    from_s: float
+    mean_N: float
+    std_N: float
+    drift_N: float
+
+
+def _window_stats(t, f):
+    mean = float(np.mean(f))
+    std = float(np.std(f))
+    if len(t) > 1 and t[-1] > t[0]:
+        slope = np.polyfit(t - t[0], f, 1)[0]
+        drift = float(slope * (t[-1] - t[0]))
+    else:
+        drift = 0.0
+    return mean, std, drift
+
+
+def detect_steady_state(time_s, force_N, min_window_s: float, rel_tolerance: float = 1e-3,
+                        abs_tolerance_N: float = 1e-6) -> SteadyState:
+    """Find the longest final window in which the force is steady.
+
+    A window [t0, t_end] is steady when it is at least ``min_window_s`` long and both the drift
+    of a least-squares line across it and the standard deviation are below
+    ``rel_tolerance·|mean| + abs_tolerance_N``. The earliest such t0 (scanned on the saved times)
+    is returned, so the mean uses as much of the steady sliding as there is.
+    """
+    t = np.asarray(time_s, dtype=float)
+    f = np.asarray(force_N, dtype=float)
+    if len(t) == 0:
+        return SteadyState(False, float("nan"), float("nan"), float("nan"), float("nan"))
+    t_end = t[-1]
+
+    def ok(i0):
+        mean, std, drift = _window_stats(t[i0:], f[i0:])
+        bound = rel_tolerance * abs(mean) + abs_tolerance_N
+        return abs(drift) <= bound and std <= bound, (mean, std, drift)
+
+    last = int(np.searchsorted(t, t_end - min_window_s, side="right")) - 1
+    last = max(last, 0)
+    good, stats = ok(last)
+    if t_end - t[last] < min_window_s * (1 - 1e-9) or not good:
+        return SteadyState(False, float(t[last]), *stats)
+    # extend the window backwards while it stays steady (coarse-to-fine scan over saved times)
+    lo = last
+    step = max(1, last // 64)
+    while step >= 1:
+        while lo - step >= 0:
+            g, st = ok(lo - step)
+            if not g:
+                break
+            lo -= step
+            stats = st
+        step //= 2
+    return SteadyState(True, float(t[lo]), *stats)

@@ -1,0 +1,38 @@
+"""Shared helpers for the tests: scenarios built from dicts (the TOML contract)."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+
+from exucable.scenario import parse_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+
+PAPER_CABLE = {"radius": 0.0025, "density": 1000.0, "youngs_modulus": 1.0e9}
+
+
+def make_scenario(**tables):
+    """A scenario from TOML-like tables; unspecified tables get small, valid defaults."""
+    data = {
+        "name": tables.pop("name", "test"),
+        "cable": dict(PAPER_CABLE, elements=10),
+        "conduit": {"inner_radius": 0.0035, "path": [{"straight": 1.0}]},
+        "pull": {"speed": 0.1},
+        "solver": {"end_time": 0.2, "step": 0.01},
+    }
+    for k, v in tables.items():
+        if isinstance(v, dict) and isinstance(data.get(k), dict):
+            d = copy.deepcopy(data[k])
+            d.update(v)
+            data[k] = d
+        else:
+            data[k] = v
+    return parse_scenario(data, ROOT, default_name="test")
+
+
+@pytest.fixture
+def scenario_factory():
+    return make_scenario
