@@ -1,0 +1,438 @@
+"""Independent quasi-static rope solution: a cable without bending stiffness sliding through a 3D conduit.
+
+This is the project's reference against which the multibody model is checked (see
+``/work/shared/paper/NOTES.md``, "Independent reference"). It uses numpy and scipy only; it knows nothing
+of Exudyn or of the contact kernel.
+
+A cable with unit tangent ``t``, curvature vector ``κn`` [1/m] and weight per length ``w = ρAg`` [N/m]
+(acting along ``−e_z``), sliding steadily toward increasing arc length ``s``, satisfies
+
+    dT/ds = μ · |T κn − w (e_z − (e_z·t) t)| + w (e_z·t),
+
+the first term being Coulomb friction on the sidewall bearing pressure (paper Eq. 19 applied per unit length)
+and the second the weight component along the cable. The bearing pressure is
+
+    p(s) = |T κn − w (e_z − (e_z·t) t)|   [N/m].
+
+On a straight incline this gives the paper's Eq. (25); without weight it gives the capstan law, Eq. (26).
+
+The centreline only needs the interface of :mod:`exucable.geometry`'s ``Centreline``: ``length_m``,
+``pieces`` (each with ``s_start_m`` and ``length_m``), ``tangent(s)``, ``curvature_vector(s)`` and
+``reversed()``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from exucable.errors import ModelError
+
+__all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "sidewall_pressure_N_per_m"]
+
+# solve_ivp tolerances. DOP853 at rtol 1e-11 reproduces the closed forms to ~1e-12 relative; the absolute
+# tolerance only matters where T passes close to zero (slack onset) and is set far below any force of interest.
+_RTOL = 1e-11
+_ATOL_N = 1e-13
+# Evaluation points inside a piece are kept this fraction of the piece length away from its ends, so that the
+# centreline never answers with the curvature of the neighbouring piece (κ jumps at piece boundaries).
+_EDGE_FRACTION = 1e-12
+# Grid used to find where a slack stretch of cable becomes taut again (see _end_of_slack).
+_SLACK_SCAN_POINTS = 257
+
+_E_Z = np.array([0.0, 0.0, 1.0])
+
+
+def _as_rows(v, n: int) -> np.ndarray:
+    """Geometry answers (3,) for a scalar and (n, 3) for an array; always return (n, 3)."""
+    return np.asarray(v, dtype=float).reshape(n, 3)
+
+
+def _transverse_load(centreline, s_m: np.ndarray, tension_N: np.ndarray, w_N_per_m: float):
+    """Return (T κn − w (e_z − (e_z·t) t), e_z·t) at arc lengths ``s_m`` [m] with tensions ``tension_N`` [N]."""
+    s = np.atleast_1d(np.asarray(s_m, dtype=float))
+    n = s.size
+    t = _as_rows(centreline.tangent(s), n)
+    kn = _as_rows(centreline.curvature_vector(s), n)
+    tz = t[:, 2]
+    gravity_perp = _E_Z[None, :] - tz[:, None] * t  # e_z − (e_z·t) t
+    load = np.asarray(tension_N, dtype=float).reshape(-1, 1) * kn - w_N_per_m * gravity_perp
+    return load, tz
+
+
+def sidewall_pressure_N_per_m(centreline, s_m, tension_N, weight_per_length_N_per_m: float = 0.0) -> np.ndarray:
+    """Sidewall bearing pressure p = |T κn − w (e_z − (e_z·t) t)| [N/m].
+
+    Parameters
+    ----------
+    centreline : Centreline
+        Conduit centreline (see module docstring for the interface used).
+    s_m : array_like
+        Conduit arc lengths [m].
+    tension_N : array_like
+        Cable tension at those arc lengths [N] (broadcast against ``s_m``).
+    weight_per_length_N_per_m : float
+        Weight per length w = ρAg [N/m], acting along −z.
+
+    Returns
+    -------
+    ndarray
+        Bearing pressure [N/m], same length as ``s_m``.
+    """
+    s = np.atleast_1d(np.asarray(s_m, dtype=float))
+    tension = np.broadcast_to(np.asarray(tension_N, dtype=float), s.shape)
+    load, _ = _transverse_load(centreline, s, tension, float(weight_per_length_N_per_m))
+    return np.linalg.norm(load, axis=1)
+
+
+@dataclass(frozen=True, eq=False)
+class RopeSolution:
+    """Quasi-static tension along a cable pulled through a conduit.
+
+    Arrays are ordered from the trailing end (``s_cable_m = 0``) to the leading, pulled end.
+
+    Attributes
+    ----------
+    s_conduit_m : ndarray
+        Arc length along the *original* conduit centreline of each output point [m]; it increases along the
+        cable for ``direction="forward"`` and decreases for ``"reverse"``.
+    s_cable_m : ndarray
+        Distance along the cable from its trailing end [m].
+    tension_N : ndarray
+        Cable tension T [N].
+    sidewall_pressure_N_per_m : ndarray
+        Sidewall bearing pressure p [N/m] (at a point where κ jumps, the value of one of the two sides).
+    pull_force_N : float
+        Tension at the leading (pulled) end [N].
+    trailing_tension_N : float
+        Tension at the trailing end (back tension) [N].
+    max_tension_N : float
+        Largest tension along the cable [N], over the output grid and the integrator's nodes.
+    max_sidewall_pressure_N_per_m : float
+        Largest bearing pressure [N/m], over the same points evaluated on both sides of every piece boundary.
+    direction : str
+        ``"forward"`` or ``"reverse"``.
+    slack : bool
+        True if the tension was clamped at zero somewhere (the cable runs slack there).
+    """
+
+    s_conduit_m: np.ndarray
+    s_cable_m: np.ndarray
+    tension_N: np.ndarray
+    sidewall_pressure_N_per_m: np.ndarray
+    pull_force_N: float
+    trailing_tension_N: float
+    max_tension_N: float
+    max_sidewall_pressure_N_per_m: float
+    direction: str = "forward"
+    slack: bool = False
+    # (s_lo, s_hi, T(s)) in cable coordinates; T from solve_ivp's dense output or a constant 0 (slack).
+    _branches: tuple = field(default=(), repr=False)
+
+    @property
+    def cable_length_m(self) -> float:
+        """Length of the cable inside the conduit [m]."""
+        return float(self.s_cable_m[-1])
+
+    def tension_at(self, s_cable_m) -> np.ndarray | float:
+        """Tension [N] at distances ``s_cable_m`` [m] from the trailing end, from the integrator's dense output.
+
+        Accurate to about the integration tolerance (1e-11 relative), unlike interpolation of ``tension_N``.
+        Raises ``ValueError`` outside ``[0, cable_length_m]``.
+        """
+        s = np.asarray(s_cable_m, dtype=float)
+        flat = np.atleast_1d(s).ravel()
+        length = self.cable_length_m
+        tol = 1e-12 * max(length, 1.0)
+        if np.any(flat < -tol) or np.any(flat > length + tol):
+            raise ValueError(f"s_cable_m outside the cable [0, {length:g}] m")
+        out = _evaluate_branches(self._branches, np.clip(flat, 0.0, length))
+        return float(out[0]) if s.ndim == 0 else out.reshape(s.shape)
+
+
+def _evaluate_branches(branches, s: np.ndarray) -> np.ndarray:
+    """Tension [N] at cable coordinates ``s`` [m] (1-D) from (s_lo, s_hi, fn) branches covering them."""
+    out = np.full(s.shape, np.nan)
+    for s_lo, s_hi, fn in branches:
+        mask = np.isnan(out) & (s >= s_lo) & (s <= s_hi)
+        if np.any(mask):
+            out[mask] = fn(s[mask])
+    return out
+
+
+def _piece_intervals(centreline, s_from: float, s_to: float) -> list[tuple[float, float, float, float]]:
+    """Pieces clipped to [s_from, s_to] as (lo, hi, piece_lo, piece_hi) [m], in order; empty ones dropped."""
+    out = []
+    for piece in sorted(centreline.pieces, key=lambda p: p.s_start_m):
+        a = float(piece.s_start_m)
+        b = a + float(piece.length_m)
+        lo, hi = max(a, s_from), min(b, s_to)
+        if hi - lo > 1e-14 * max(1.0, abs(s_to)):
+            out.append((lo, hi, a, b))
+    return out
+
+
+def _inside(piece_lo: float, piece_hi: float) -> tuple[float, float]:
+    """Interval of a piece shrunk by a hair at both ends [m], so that evaluations there see this piece's curvature
+    (the centreline answers with the later piece exactly at a boundary)."""
+    edge = _EDGE_FRACTION * (piece_hi - piece_lo) + 4.0 * np.spacing(max(abs(piece_lo), abs(piece_hi)))
+    return piece_lo + edge, piece_hi - edge
+
+
+def _end_of_slack(g0: Callable[[float], float], s_lo: float, s_hi: float) -> float:
+    """First arc length in (s_lo, s_hi] where the slack rate g0(s) = dT/ds|_{T=0} turns positive.
+
+    Scans ``_SLACK_SCAN_POINTS`` points and refines with brentq; a taut excursion shorter than the scan
+    spacing would be missed (irrelevant for the piecewise-constant-curvature routes used here).
+    """
+    grid = np.linspace(s_lo, s_hi, _SLACK_SCAN_POINTS)
+    values = np.array([g0(x) for x in grid])
+    idx = np.nonzero(values[1:] > 0.0)[0]
+    if idx.size == 0:
+        return s_hi
+    i = idx[0] + 1  # values[i - 1] <= 0 < values[i]
+    return float(brentq(g0, grid[i - 1], grid[i], xtol=1e-14 * max(1.0, abs(s_hi)), rtol=1e-15))
+
+
+def _integrate(curve, mu: float, w: float, s0: float, s1: float, trailing_N: float, dense: bool):
+    """Integrate the rope ODE from s0 to s1 on ``curve``; return (T(s1) [N], branches, slack).
+
+    branches (only if ``dense``): list of (s_lo, s_hi, piece_lo, piece_hi, fn, nodes) in curve coordinates,
+    ``fn`` the vectorised tension T(s) [N] on [s_lo, s_hi], ``nodes`` the integrator's steps (for maxima).
+    """
+    branches = []
+    slack_seen = False
+    tension = float(trailing_N)
+    for lo, hi, plo, phi in _piece_intervals(curve, s0, s1):
+        s_min, s_max = _inside(plo, phi)
+
+        def rate(s, y, s_min=s_min, s_max=s_max):
+            # s is clamped into the piece so that RK stages at the piece's end use this piece's curvature.
+            sc = min(max(s, s_min), s_max)
+            load, tz = _transverse_load(curve, np.array([sc]), np.array([y[0]]), w)
+            return [mu * np.linalg.norm(load[0]) + w * tz[0]]
+
+        def g0(s, rate=rate):
+            return rate(s, [0.0])[0]
+
+        def hits_zero(s, y):
+            return y[0]
+
+        hits_zero.terminal = True
+        hits_zero.direction = -1.0
+
+        s = lo
+        for _ in range(10_000):  # guard: every pass advances s (a slack stretch or an ODE run)
+            if s >= hi:
+                break
+            rate_at_zero = g0(s) if tension <= 0.0 else 1.0
+            if rate_at_zero <= 0.0:
+                # Steep downhill with no tension left: the rope ODE would drive T negative, which a cable cannot
+                # carry. Clamp T = 0 (the cable runs slack) until the weight/friction balance turns positive.
+                # (rate 0 exactly, e.g. no weight and no back tension, keeps T = 0 without being "slack".)
+                slack_seen = slack_seen or rate_at_zero < 0.0
+                s_next = _end_of_slack(g0, s, hi)
+                if dense:
+                    branches.append((s, s_next, plo, phi, _zero, np.array([s, s_next])))
+                s, tension = s_next, 0.0
+                if s >= hi:
+                    break
+            sol = solve_ivp(rate, (s, hi), [tension], method="DOP853", rtol=_RTOL, atol=_ATOL_N,
+                            dense_output=dense, events=hits_zero)
+            if sol.status < 0:
+                raise ModelError("rope", f"rope ODE integration failed at s = {s:.6g} m: {sol.message}")
+            if sol.status == 1:  # tension reached zero inside the piece; the next pass decides if it stays slack
+                s_end = float(sol.t_events[0][0])
+                tension = 0.0
+            else:
+                s_end = hi
+                tension = max(float(sol.y[0, -1]), 0.0)
+            if dense:
+                branches.append((s, s_end, plo, phi, _dense_fn(sol.sol), sol.t))
+            s = s_end
+        else:  # pragma: no cover
+            raise ModelError("rope", f"rope ODE made no progress near s = {s:.6g} m")
+    return tension, branches, slack_seen
+
+
+def _zero(s):
+    return np.zeros_like(np.asarray(s, dtype=float))
+
+
+def _dense_fn(ode_solution):
+    def fn(s):
+        return np.maximum(ode_solution(np.asarray(s, dtype=float))[0], 0.0)
+
+    return fn
+
+
+def _validate(centreline, friction, w, direction, cable_length_m):
+    mu = float(friction)
+    if not np.isfinite(mu) or mu < 0.0:
+        raise ModelError("friction", f"friction coefficient must be finite and >= 0, got {friction!r}")
+    w = float(w)
+    if not np.isfinite(w) or w < 0.0:
+        raise ModelError("weight_per_length_N_per_m", f"weight per length must be finite and >= 0, got {w!r}")
+    if direction not in ("forward", "reverse"):
+        raise ModelError("direction", f"direction must be 'forward' or 'reverse', got {direction!r}")
+    conduit_length = float(centreline.length_m)
+    length = conduit_length if cable_length_m is None else float(cable_length_m)
+    if not np.isfinite(length) or length <= 0.0:
+        raise ModelError("cable_length_m", f"cable length must be > 0, got {cable_length_m!r}")
+    if length > conduit_length * (1.0 + 1e-12):
+        raise ModelError("cable_length_m", f"cable ({length:g} m) is longer than the conduit ({conduit_length:g} m)")
+    return mu, w, min(length, conduit_length), conduit_length
+
+
+def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0.0, trailing_tension_N: float = 0.0,
+               direction: str = "forward", cable_length_m: float | None = None, n_output: int = 801) -> RopeSolution:
+    """Tension along a rope pulled steadily through a conduit, given the trailing (back) tension.
+
+    Integrates ``dT/ds = μ|T κn − w(e_z − (e_z·t)t)| + w(e_z·t)`` piece by piece (restarting at every piece
+    boundary, where κ jumps) with scipy's DOP853 at rtol 1e-11.
+
+    If the ODE would drive the tension negative (a downhill stretch steeper than the friction angle,
+    tan θ > μ), the tension is clamped at 0: the cable runs slack there, and the tension rises again from 0
+    where the slope flattens. ``RopeSolution.slack`` reports it.
+
+    Parameters
+    ----------
+    centreline : Centreline
+        Conduit centreline (``exucable.geometry``).
+    friction : float
+        Coulomb friction coefficient μ between cable and conduit [-].
+    weight_per_length_N_per_m : float
+        Weight per length w = ρAg [N/m], acting along −z.
+    trailing_tension_N : float
+        Back tension at the trailing end [N] (>= 0).
+    direction : {"forward", "reverse"}
+        "forward": the cable is pulled out at the conduit's end (s = L), moving toward increasing s.
+        "reverse": pulled out at s = 0 (solved on ``centreline.reversed()``).
+    cable_length_m : float, optional
+        Length of cable in the conduit [m]; default the conduit length. A shorter cable lies in the leading
+        part of the conduit (forward: from s = L − cable_length to L).
+    n_output : int
+        Number of points of the output profile (uniform in cable length).
+
+    Returns
+    -------
+    RopeSolution
+    """
+    mu, w, length, conduit_length = _validate(centreline, friction, weight_per_length_N_per_m, direction,
+                                              cable_length_m)
+    trailing = float(trailing_tension_N)
+    if not np.isfinite(trailing) or trailing < 0.0:
+        raise ModelError("trailing_tension_N", f"trailing tension must be finite and >= 0, got {trailing_tension_N!r}")
+    if int(n_output) < 2:
+        raise ModelError("n_output", "n_output must be >= 2")
+    curve = centreline if direction == "forward" else centreline.reversed()
+    s0 = conduit_length - length  # trailing end, in the coordinates of `curve`
+    pull, raw_branches, slack = _integrate(curve, mu, w, s0, conduit_length, trailing, dense=True)
+
+    # Branches in cable coordinates (s_cable = s_curve − s0).
+    # The first and last branch are widened to exactly [0, length] so that rounding of s0 leaves no gap.
+    branches = [[b[0] - s0, b[1] - s0, _shifted(b[4], s0, b[0], b[1])] for b in raw_branches]
+    branches[0][0], branches[-1][1] = 0.0, length
+    branches = tuple(tuple(b) for b in branches)
+    s_cable = np.linspace(0.0, length, int(n_output))
+    s_curve = s_cable + s0
+    s_curve[-1] = conduit_length  # exact end despite rounding
+    tension = _evaluate_branches(branches, s_cable)
+    tension[0] = trailing
+    tension[-1] = pull
+    pressure = sidewall_pressure_N_per_m(curve, s_curve, tension, w)
+
+    # Maxima over the output grid plus the integrator's nodes, each evaluated inside its own piece.
+    max_t = float(np.max(tension))
+    max_p = float(np.max(pressure))
+    for b in raw_branches:
+        s_lo, s_hi, plo, phi, fn, nodes = b
+        pts = np.concatenate([nodes, [s_lo, s_hi], s_curve[(s_curve >= s_lo) & (s_curve <= s_hi)]])
+        pts = np.clip(pts, *_inside(plo, phi))
+        tens = fn(pts)
+        max_t = max(max_t, float(np.max(tens)))
+        max_p = max(max_p, float(np.max(sidewall_pressure_N_per_m(curve, pts, tens, w))))
+
+    s_conduit = s_curve if direction == "forward" else conduit_length - s_curve
+    return RopeSolution(
+        s_conduit_m=s_conduit,
+        s_cable_m=s_cable,
+        tension_N=tension,
+        sidewall_pressure_N_per_m=pressure,
+        pull_force_N=float(pull),
+        trailing_tension_N=trailing,
+        max_tension_N=max_t,
+        max_sidewall_pressure_N_per_m=max_p,
+        direction=direction,
+        slack=bool(slack),
+        _branches=branches,
+    )
+
+
+def _shifted(fn, offset, lo, hi):
+    """fn in cable coordinates: s_curve = s_cable + offset, kept inside the branch's own range [lo, hi]."""
+    def shifted(s):
+        return fn(np.clip(np.asarray(s, dtype=float) + offset, lo, hi))
+
+    return shifted
+
+
+def solve_rope_for_pull_force(centreline, friction: float, pull_force_N: float,
+                              weight_per_length_N_per_m: float = 0.0, direction: str = "forward",
+                              cable_length_m: float | None = None) -> RopeSolution:
+    """Force-controlled pull: the trailing tension for which the leading end carries ``pull_force_N``.
+
+    The map trailing tension → pull force is continuous and non-decreasing (strictly increasing unless the
+    cable runs slack), so the trailing tension is found with brentq on it. If the cable runs slack for every
+    trailing tension up to the root, the smallest trailing tension (0) is returned.
+
+    Parameters
+    ----------
+    centreline, friction, weight_per_length_N_per_m, direction, cable_length_m
+        As in :func:`solve_rope`.
+    pull_force_N : float
+        Tension applied at the leading end [N].
+
+    Returns
+    -------
+    RopeSolution
+        The full solution for the trailing tension found.
+
+    Raises
+    ------
+    ModelError
+        If ``pull_force_N`` is below the force needed to pull the cable with zero back tension.
+    """
+    mu, w, length, conduit_length = _validate(centreline, friction, weight_per_length_N_per_m, direction,
+                                              cable_length_m)
+    target = float(pull_force_N)
+    if not np.isfinite(target) or target < 0.0:
+        raise ModelError("pull_force_N", f"pull force must be finite and >= 0, got {pull_force_N!r}")
+    curve = centreline if direction == "forward" else centreline.reversed()
+    s0 = conduit_length - length
+
+    def pull_of(trailing):
+        return _integrate(curve, mu, w, s0, conduit_length, trailing, dense=False)[0]
+
+    minimum = pull_of(0.0)
+    if target < minimum * (1.0 - 1e-12):
+        raise ModelError("pull_force_N", f"pull force {target:.6g} N is below {minimum:.6g} N, the force needed to "
+                                          "pull this cable with zero back tension")
+    if target <= minimum:
+        trailing = 0.0
+    else:
+        hi = max(target, 1e-9)
+        f_hi = pull_of(hi)
+        for _ in range(200):
+            if f_hi >= target:
+                break
+            hi *= 2.0
+            f_hi = pull_of(hi)
+        else:  # pragma: no cover - the pull force grows at least linearly in the back tension
+            raise ModelError("pull_force_N", "could not bracket the trailing tension")
+        trailing = float(brentq(lambda x: pull_of(x) - target, 0.0, hi, xtol=1e-15 * max(1.0, hi), rtol=1e-14))
+    return solve_rope(centreline, mu, w, trailing, direction, length)
