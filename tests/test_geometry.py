@@ -187,7 +187,7 @@ ERROR_CASES = [
     ([0, 0, 0], [1, 0, 0], [Bend(0.0, 1.0)], "path[0].bend"),
     ([0, 0, 0], [1, 0, 0], [Bend(360.0, 1.0)], "path[0].bend"),
     ([0, 0, 0], [1, 0, 0], [Bend(90, 1.0, "sideways")], "path[0].turn"),
-    ([0, 0, 0], [1, 0, 0], [Bend(90, 1.0, turn=None)], "path[0].turn"),
+    ([0, 0, 0], [1, 0, 0], [Bend(90, 1.0, turn="left", axis=(0, 0, 1))], "path[0].axis"),
     ([0, 0, 0], [1, 0, 0], [Bend(90, 1.0, "left", axis=(0, 0, 1))], "path[0].axis"),
     ([0, 0, 0], [1, 0, 0], [Bend(90, 1.0, None, axis=(2, 0, 0))], "path[0].axis"),
     ([0, 0, 0], [1, 0, 0], [Bend(90, 1.0, None, axis=(0, 0, 0))], "path[0].axis"),

@@ -52,16 +52,17 @@ class Bend:
         Bend radius of the centreline [m], > 0.
     turn : str or None
         ``"left"``/``"right"``: about +z/−z (right-hand rule); ``"up"``/``"down"``: in the vertical
-        plane containing the current heading, toward +z/−z. ``None`` when ``axis`` is given.
+        plane containing the current heading, toward +z/−z. Default: ``"left"`` unless ``axis``
+        is given.
     axis : tuple of 3 float or None
         Rotation axis (right-hand rule). Its component along the current heading is removed; the
-        bend is refused if little remains. Give exactly one of ``turn`` and ``axis``
-        (``Bend(90, 0.5, turn=None, axis=(1, 0, 0))``).
+        bend is refused if little remains. Give at most one of ``turn`` and ``axis``
+        (``Bend(90, 0.5, axis=(1, 0, 0))``).
     """
 
     angle_deg: float
     radius_m: float
-    turn: str | None = "left"
+    turn: str | None = None
     axis: tuple[float, float, float] | None = None
 
 
@@ -129,15 +130,14 @@ def _perpendicular_axis(axis: np.ndarray, heading: np.ndarray, key: str, what: s
 
 
 def _bend_axis(item: Bend, heading: np.ndarray, key: str) -> np.ndarray:
-    if (item.turn is None) == (item.axis is None):
-        raise GeometryError(key + (".axis" if item.axis is not None else ".turn"),
-                            "give exactly one of turn (left/right/up/down) and axis")
+    if item.turn is not None and item.axis is not None:
+        raise GeometryError(key + ".axis", "give either turn (left/right/up/down) or axis, not both")
     if item.axis is not None:
         axis = _vector3(item.axis, key + ".axis")
         if np.linalg.norm(axis) == 0.0:
             raise GeometryError(key + ".axis", "axis must not be the zero vector")
         return _perpendicular_axis(axis, heading, key + ".axis", "axis")
-    turn = item.turn
+    turn = "left" if item.turn is None else item.turn
     if turn in ("left", "right"):
         return _perpendicular_axis(_EZ if turn == "left" else -_EZ, heading, key + ".turn",
                                    f"the {turn} turn's axis (±z)")
