@@ -1,0 +1,26 @@
+"""Cable-conduit contact (paper Sects. 2.4-2.5): check points, AABB broad phase, Hertz normal force,
+regularised Coulomb friction, generalized forces and their exact Jacobians.
+
+Pure numpy reference (:mod:`.kernel`) plus a numba fast path (:mod:`.fast`, the default). Nothing
+here imports Exudyn; the model layer wraps :class:`ContactKernel` in Exudyn user functions.
+"""
+
+from .checkpoints import check_points
+from .kernel import (
+    CheckPointState,
+    ContactKernel,
+    ContactResult,
+    assemble_blocks_dense,
+    block_sparsity,
+)
+from .law import ContactLaw
+
+__all__ = [
+    "ContactLaw",
+    "check_points",
+    "ContactKernel",
+    "ContactResult",
+    "CheckPointState",
+    "assemble_blocks_dense",
+    "block_sparsity",
+]

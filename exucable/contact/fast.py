@@ -1,0 +1,650 @@
+"""Compiled (numba) contact kernel: the fast path of :class:`exucable.contact.ContactKernel`.
+
+Same equations as the numpy reference in :mod:`exucable.contact.kernel` (paper Eqs. 2-8, 14-23).
+One pass per element, each step a loop over the element's check points over contiguous arrays
+(struct of arrays, rows of one work table) so that LLVM vectorises it:
+
+- positions P = S(ξ) q_e from the Hermite values tabulated once per check point;
+- narrow phase: segment-major over the element's candidate segments only, keeping per point the
+  nearest distance, segment and residual P - Pc;
+- force law with branch-free masks (a point out of contact gets weight 0, which zeroes its force
+  and derivatives), skipped for elements without contact;
+- Q_e and the 12×12 blocks Σ_k (N_k N_kᵀ) ⊗ J_k as contiguous sums, with the ten distinct
+  products N_a N_b tabulated once (unit element length, scaled by L afterwards);
+- nothing is allocated inside the loops.
+
+Compiled with ``cache=True``: the first call in a fresh environment compiles (a few seconds),
+later processes load the machine code from ``__pycache__``. A :class:`FastKernel` owns its work
+buffers: use one per thread.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .broadphase import SweepBroadPhase, candidates_all_segments
+
+__all__ = ["FastKernel"]
+
+# Reassociation lets LLVM vectorise the sums over check points; no-NaN/no-inf assumptions are left
+# out on purpose (a point without candidate segments carries an infinite distance).
+_FASTMATH = {"nsz", "arcp", "contract", "reassoc"}
+
+# (a, b) node-block pairs with a <= b, in the order of the columns of the pair table
+_PAIRS = np.array([(a, b) for a in range(4) for b in range(a, 4)], dtype=np.int64)
+
+# segment table columns: start point A (3), unit axis a (3), length, end point B (3)
+_SEG_COLUMNS = 10
+
+
+_JIT = dict(cache=True, fastmath=_FASTMATH, nogil=True, error_model="numpy")
+
+# Rows of the per-element work table, one column per check point. Each loop below reads and
+# writes contiguous rows; LLVM vectorises a loop only while the number of runtime alias checks
+# between its arrays stays small (measured: about s(s-1)/2 + s·l <= 128 for s written and l read
+# rows), hence several short loops rather than one long one.
+_PX, _PY, _PZ, _BEST = 0, 1, 2, 3  # position P, squared distance to the nearest segment
+_RX, _RY, _RZ = 4, 5, 6  # residual P - Pc
+_AX, _AY, _AZ = 7, 8, 9  # segment axis where the projection is inside the segment, else 0
+_NX, _NY, _NZ = 10, 11, 12  # contact normal n
+_INVD, _DELTA, _TOUCH = 13, 14, 15  # 1/d, penetration δ, 1 where δ > 0 else 0
+_VX, _VY, _VZ = 16, 17, 18  # velocity v
+_VN, _G, _F, _WACT, _DDPOW = 19, 20, 21, 22, 23  # v_n, |v_τ|², w f_n, w (0 if no force), dδ^e/dδ
+_TX, _TY, _TZ = 24, 25, 26  # sliding velocity v_τ
+_MU, _DMU, _SR, _HF = 27, 28, 29, 30  # μ, dμ/d|v_τ|², √(|v_τ|² + ε²), μ w f_n / √(...)
+_FX = 31  # rows 31..33: force F on the cable [N]
+_MVX, _MTX = 34, 37  # rows 34..36: M v, rows 37..39: M v_τ (M = ∂n/∂P)
+_KD, _WC, _FM, _C2, _GV, _MUS = 40, 41, 42, 43, 44, 45  # scalar factors of the Jacobian
+_J0 = 46  # rows 46..63: ∂F/∂P (9, row-major) then ∂F/∂v (9)
+_ROWS = 64
+
+
+@njit(inline="always", **_JIT)
+def _positions(q, b, le, n1, n2, n3, n4, px, py, pz):
+    """Check point positions P = S(ξ) q_e (Eq. 2) of the element whose coordinates start at q[b]."""
+    r0 = q[b]
+    r1 = q[b + 1]
+    r2 = q[b + 2]
+    s0 = le * q[b + 3]
+    s1 = le * q[b + 4]
+    s2 = le * q[b + 5]
+    u0 = q[b + 6]
+    u1 = q[b + 7]
+    u2 = q[b + 8]
+    t0 = le * q[b + 9]
+    t1 = le * q[b + 10]
+    t2 = le * q[b + 11]
+    for k in range(n1.shape[0]):
+        px[k] = n1[k] * r0 + n2[k] * s0 + n3[k] * u0 + n4[k] * t0
+        py[k] = n1[k] * r1 + n2[k] * s1 + n3[k] * u1 + n4[k] * t1
+        pz[k] = n1[k] * r2 + n2[k] * s2 + n3[k] * u2 + n4[k] * t2
+
+
+@njit(inline="always", **_JIT)
+def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_in, ay_in,
+                      az_in):
+    """Narrow phase of one element: nearest candidate segment of every check point.
+
+    Projection parameter clamped to the segment (a point beyond a kink's outer side sees the
+    vertex). Segment-major so that the inner loop over points vectorises; the strict ``<`` in
+    increasing candidate order keeps the lower segment index on ties, as the numpy reference.
+    """
+    n_k = px.shape[0]
+    for k in range(n_k):
+        best[k] = np.inf
+        sel[k] = -1
+        rx[k] = 0.0
+        ry[k] = 0.0
+        rz[k] = 0.0
+        ax_in[k] = 0.0
+        ay_in[k] = 0.0
+        az_in[k] = 0.0
+    for c in range(c0, c1):
+        s = cand[c]
+        sax = seg[s, 0]
+        say = seg[s, 1]
+        saz = seg[s, 2]
+        ax = seg[s, 3]
+        ay = seg[s, 4]
+        az = seg[s, 5]
+        ln = seg[s, 6]
+        sbx = seg[s, 7]
+        sby = seg[s, 8]
+        sbz = seg[s, 9]
+        for k in range(n_k):
+            dx = px[k] - sax
+            dy = py[k] - say
+            dz = pz[k] - saz
+            t = dx * ax + dy * ay + dz * az
+            low = t <= 0.0
+            high = t >= ln
+            ex = dx - t * ax
+            ey = dy - t * ay
+            ez = dz - t * az
+            ex = px[k] - sbx if high else ex  # clamped to the end vertex
+            ey = py[k] - sby if high else ey
+            ez = pz[k] - sbz if high else ez
+            ex = dx if low else ex  # clamped to the start vertex
+            ey = dy if low else ey
+            ez = dz if low else ez
+            d2 = ex * ex + ey * ey + ez * ez
+            inside = 0.0 if (low | high) else 1.0
+            if d2 < best[k]:  # strict: ties keep the lower segment index
+                best[k] = d2
+                sel[k] = s
+                rx[k] = ex
+                ry[k] = ey
+                rz[k] = ez
+                ax_in[k] = inside * ax
+                ay_in[k] = inside * ay
+                az_in[k] = inside * az
+
+
+@njit(**_JIT)
+def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest):
+    """Contact search only (no force law): nearest segment of every check point, -1 if none."""
+    for e in range(length.shape[0]):
+        _positions(q, 6 * e, length[e], n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])
+        _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, off[e], off[e + 1],
+                          tab[_BEST], nearest[e], tab[_RX], tab[_RY], tab[_RZ], tab[_AX],
+                          tab[_AY], tab[_AZ])
+
+
+@njit(**_JIT)
+def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, off, cand,
+                    gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
+                    inv_href, jacobian, force, jq, jqt, tab, sel, acc):
+    """Generalized contact force and its 12×12 Jacobian blocks; returns (n_in_contact, max δ)."""
+    n_k = n1.shape[0]
+    n_contact = 0
+    max_d2 = -1.0
+    for e in range(length.shape[0]):
+        c0 = off[e]
+        c1 = off[e + 1]
+        if c0 == c1:
+            continue
+        le = length[e]
+        b = 6 * e
+        _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])  # Eq. 2
+        _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
+                          tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ])
+        n_touch, max_d2 = _normals(tab, n_k, gap, max_d2)
+        if n_touch == 0:
+            continue
+        n_contact += n_touch
+        _positions(qt, b, le, n1, n2, n3, n4, tab[_VX], tab[_VY], tab[_VZ])  # Eq. 8
+        _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
+                      exponent_mode)
+        _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
+        # Q_e = Σ S(ξ)ᵀ F (slope rows carry the factor L)
+        fxr = tab[_FX]
+        fyr = tab[_FX + 1]
+        fzr = tab[_FX + 2]
+        for a in range(4):
+            na = n1 if a == 0 else (n2 if a == 1 else (n3 if a == 2 else n4))
+            scale = le if (a == 1 or a == 3) else 1.0
+            sx = 0.0
+            sy = 0.0
+            sz = 0.0
+            for k in range(n_k):
+                sx += na[k] * fxr[k]
+                sy += na[k] * fyr[k]
+                sz += na[k] * fzr[k]
+            force[b + 3 * a] += scale * sx
+            force[b + 3 * a + 1] += scale * sy
+            force[b + 3 * a + 2] += scale * sz
+        if not jacobian:
+            continue
+        _point_jacobians(tab, n_k, stiffness, damping)
+        _accumulate_blocks(tab, pair_t, pair_ab, le, acc, jq[e], jqt[e])
+    max_pen = math.sqrt(max_d2) - gap if max_d2 >= 0.0 else -np.inf
+    return n_contact, max_pen
+
+
+@njit(cache=True, fastmath=_FASTMATH | {"nnan"}, nogil=True, error_model="numpy")
+def _max_finite(x, n):
+    """Largest finite entry of x[:n], -1 if none (x >= 0 or inf, never NaN: lets it vectorise)."""
+    m = -1.0
+    for k in range(n):
+        m = max(m, x[k] if x[k] < np.inf else -1.0)
+    return m
+
+
+@njit(inline="always", **_JIT)
+def _normals(tab, n_k, gap, max_d2):
+    """δ (Eq. 14) and n (Eq. 15) of every point; returns (points with δ > 0, running max d²)."""
+    best = tab[_BEST]
+    rx = tab[_RX]
+    ry = tab[_RY]
+    rz = tab[_RZ]
+    nx = tab[_NX]
+    ny = tab[_NY]
+    nz = tab[_NZ]
+    invd = tab[_INVD]
+    delta = tab[_DELTA]
+    touch = tab[_TOUCH]
+    gap2 = gap * gap
+    for k in range(n_k):
+        d2 = best[k]
+        hit = d2 > gap2  # δ > 0 without a square root (no candidate segment: d² = inf)
+        d = math.sqrt(d2 if hit else gap2)  # out of contact any finite d keeps n finite
+        inv_d = 1.0 / d
+        nx[k] = rx[k] * inv_d  # outward from the axis
+        ny[k] = ry[k] * inv_d
+        nz[k] = rz[k] * inv_d
+        invd[k] = inv_d
+        delta[k] = max(d - gap, 0.0)  # guards the square root against rounding
+        touch[k] = 1.0 if hit else 0.0
+    n_touch = 0.0
+    for k in range(n_k):
+        n_touch += touch[k]
+    return int(n_touch), max(max_d2, _max_finite(best, n_k))
+
+
+@njit(inline="always", **_JIT)
+def _normal_force(tab, omega, n_k, weight_scale, stiffness, damping, exponent, exponent_mode):
+    """v_n, v_τ (Eqs. 16-17) and the weighted normal force w·max(0, K δ^e + C δ̇) (Eq. 18)."""
+    nx = tab[_NX]
+    ny = tab[_NY]
+    nz = tab[_NZ]
+    vx = tab[_VX]
+    vy = tab[_VY]
+    vz = tab[_VZ]
+    delta = tab[_DELTA]
+    touch = tab[_TOUCH]
+    vnr = tab[_VN]
+    txr = tab[_TX]
+    tyr = tab[_TY]
+    tzr = tab[_TZ]
+    gr = tab[_G]
+    fr = tab[_F]
+    wr = tab[_WACT]
+    ddr = tab[_DDPOW]
+    # δ^e into the force row and its derivative, one loop per case (a branch on the exponent
+    # inside the loop would stop vectorisation)
+    if exponent_mode == 1:  # e = 1.5, the project's value: no pow
+        for k in range(n_k):
+            sq = math.sqrt(delta[k])
+            fr[k] = delta[k] * sq
+            ddr[k] = 1.5 * sq
+    elif exponent_mode == 2:  # e = 1
+        for k in range(n_k):
+            fr[k] = delta[k]
+            ddr[k] = 1.0
+    else:
+        for k in range(n_k):
+            fr[k] = delta[k] ** exponent
+            ddr[k] = exponent * delta[k] ** (exponent - 1.0)
+    for k in range(n_k):
+        vn = nx[k] * vx[k] + ny[k] * vy[k] + nz[k] * vz[k]  # Eq. 16, = δ̇
+        raw = stiffness * fr[k] + damping * vn  # Eq. 18
+        # weight w = L ω / h_ref; 0 out of contact or where the force would pull
+        w_act = weight_scale * omega[k] * touch[k] if raw > 0.0 else 0.0
+        tx = vx[k] - vn * nx[k]  # Eq. 17
+        ty = vy[k] - vn * ny[k]
+        tz = vz[k] - vn * nz[k]
+        vnr[k] = vn
+        txr[k] = tx
+        tyr[k] = ty
+        tzr[k] = tz
+        gr[k] = tx * tx + ty * ty + tz * tz
+        fr[k] = w_act * raw
+        wr[k] = w_act
+
+
+@njit(inline="always", **_JIT)
+def _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2):
+    """μ(|v_τ|) and the force F = -f n - μ f v_τ/√(|v_τ|² + ε²) (Eqs. 19-23)."""
+    gr = tab[_G]
+    mur = tab[_MU]
+    dmur = tab[_DMU]
+    if dmu != 0.0:  # Stribeck: μ = μ_k + (μ_s - μ_k) exp(-|v_τ|²/v_s²)
+        for k in range(n_k):
+            decay = math.exp(-gr[k] * inv_vs2)
+            mur[k] = mu_k + dmu * decay
+            dmur[k] = -dmu * inv_vs2 * decay
+    else:
+        for k in range(n_k):
+            mur[k] = mu_k
+            dmur[k] = 0.0
+    fr = tab[_F]
+    nx = tab[_NX]
+    ny = tab[_NY]
+    nz = tab[_NZ]
+    tx = tab[_TX]
+    ty = tab[_TY]
+    tz = tab[_TZ]
+    srr = tab[_SR]
+    hfr = tab[_HF]
+    fxr = tab[_FX]
+    fyr = tab[_FX + 1]
+    fzr = tab[_FX + 2]
+    for k in range(n_k):
+        sr = math.sqrt(gr[k] + eps2)
+        hf = mur[k] * fr[k] / sr  # friction force per unit of v_τ
+        srr[k] = sr
+        hfr[k] = hf
+        fxr[k] = -fr[k] * nx[k] - hf * tx[k]
+        fyr[k] = -fr[k] * ny[k] - hf * ty[k]
+        fzr[k] = -fr[k] * nz[k] - hf * tz[k]
+
+
+@njit(inline="always", **_JIT)
+def _point_jacobians(tab, n_k, stiffness, damping):
+    """∂F/∂P and ∂F/∂v of every check point of the element (rows _J0 ... _J0 + 17).
+
+    Every coupling: the normal force through δ and δ̇ = n·v (n depends on P), friction through
+    f_n, through v_τ (which depends on n) and through μ(|v_τ|). With M = ∂n/∂P = (Π - n nᵀ)/d
+    (Π = I - a aᵀ inside the segment, I at a vertex) and h = μ f/s, s = √(|v_τ|² + ε²):
+
+        ∂F/∂P = -u (k_d n + w C Mv)ᵀ - (f - h v_n) M - c₂ v_τ (M v_τ)ᵀ + h n (Mv)ᵀ
+        ∂F/∂v = -w C u nᵀ - g_v v_τ v_τᵀ - h (I - n nᵀ)
+
+    where u = n + (μ/s) v_τ, k_d = w K e δ^(e-1), c₂ = -2 v_n c_g, g_v = 2 c_g and
+    c_g = f (μ'/s - μ/(2 s³)) is ∂h/∂|v_τ|² at fixed f. Zero where w = 0.
+    """
+    ax = tab[_AX]
+    ay = tab[_AY]
+    az = tab[_AZ]
+    nx = tab[_NX]
+    ny = tab[_NY]
+    nz = tab[_NZ]
+    invd = tab[_INVD]
+    vx = tab[_VX]
+    vy = tab[_VY]
+    vz = tab[_VZ]
+    tx = tab[_TX]
+    ty = tab[_TY]
+    tz = tab[_TZ]
+    mvx = tab[_MVX]
+    mvy = tab[_MVX + 1]
+    mvz = tab[_MVX + 2]
+    mtx = tab[_MTX]
+    mty = tab[_MTX + 1]
+    mtz = tab[_MTX + 2]
+    for k in range(n_k):  # M v and M v_τ
+        a0 = ax[k]
+        a1 = ay[k]
+        a2 = az[k]
+        n0 = nx[k]
+        n1_ = ny[k]
+        n2_ = nz[k]
+        inv_d = invd[k]
+        m00 = (1.0 - a0 * a0 - n0 * n0) * inv_d
+        m11 = (1.0 - a1 * a1 - n1_ * n1_) * inv_d
+        m22 = (1.0 - a2 * a2 - n2_ * n2_) * inv_d
+        m01 = (-a0 * a1 - n0 * n1_) * inv_d
+        m02 = (-a0 * a2 - n0 * n2_) * inv_d
+        m12 = (-a1 * a2 - n1_ * n2_) * inv_d
+        mvx[k] = m00 * vx[k] + m01 * vy[k] + m02 * vz[k]
+        mvy[k] = m01 * vx[k] + m11 * vy[k] + m12 * vz[k]
+        mvz[k] = m02 * vx[k] + m12 * vy[k] + m22 * vz[k]
+        mtx[k] = m00 * tx[k] + m01 * ty[k] + m02 * tz[k]
+        mty[k] = m01 * tx[k] + m11 * ty[k] + m12 * tz[k]
+        mtz[k] = m02 * tx[k] + m12 * ty[k] + m22 * tz[k]
+    wr = tab[_WACT]
+    ddr = tab[_DDPOW]
+    fr = tab[_F]
+    mur = tab[_MU]
+    dmur = tab[_DMU]
+    srr = tab[_SR]
+    hfr = tab[_HF]
+    vnr = tab[_VN]
+    kdr = tab[_KD]
+    wcr = tab[_WC]
+    fmr = tab[_FM]
+    c2r = tab[_C2]
+    gvr = tab[_GV]
+    musr = tab[_MUS]
+    for k in range(n_k):  # scalar factors
+        sr = srr[k]
+        cg = fr[k] * (dmur[k] / sr - 0.5 * mur[k] / (sr * sr * sr))
+        kdr[k] = wr[k] * stiffness * ddr[k]
+        wcr[k] = wr[k] * damping
+        fmr[k] = fr[k] - hfr[k] * vnr[k]
+        c2r[k] = -2.0 * vnr[k] * cg
+        gvr[k] = 2.0 * cg
+        musr[k] = mur[k] / sr
+    # three calls with literal rows so that each inlined copy has constant row indices
+    _jacobian_rows(tab, n_k, 0)
+    _jacobian_rows(tab, n_k, 1)
+    _jacobian_rows(tab, n_k, 2)
+
+
+@njit(inline="always", **_JIT)
+def _jacobian_rows(tab, n_k, i):
+    """Row i of ∂F/∂P and of ∂F/∂v (see :func:`_point_jacobians`)."""
+    e0 = 1.0 if i == 0 else 0.0  # row i of the identity
+    e1 = 1.0 if i == 1 else 0.0
+    e2 = 1.0 if i == 2 else 0.0
+    ni = tab[_NX + i]
+    ti = tab[_TX + i]
+    ai = tab[_AX + i]
+    nx = tab[_NX]
+    ny = tab[_NY]
+    nz = tab[_NZ]
+    ax = tab[_AX]
+    ay = tab[_AY]
+    az = tab[_AZ]
+    invd = tab[_INVD]
+    mvx = tab[_MVX]
+    mvy = tab[_MVX + 1]
+    mvz = tab[_MVX + 2]
+    mtx = tab[_MTX]
+    mty = tab[_MTX + 1]
+    mtz = tab[_MTX + 2]
+    kdr = tab[_KD]
+    wcr = tab[_WC]
+    fmr = tab[_FM]
+    c2r = tab[_C2]
+    musr = tab[_MUS]
+    hfr = tab[_HF]
+    o0 = tab[_J0 + 3 * i]
+    o1 = tab[_J0 + 3 * i + 1]
+    o2 = tab[_J0 + 3 * i + 2]
+    for k in range(n_k):  # ∂F/∂P, row i
+        n_i = ni[k]
+        t_i = ti[k]
+        u_i = n_i + musr[k] * t_i
+        kd = kdr[k]
+        wc = wcr[k]
+        fmd = fmr[k] * invd[k]
+        ct = c2r[k] * t_i
+        hn = hfr[k] * n_i
+        aa = ai[k]
+        o0[k] = (-u_i * (kd * nx[k] + wc * mvx[k]) - fmd * (e0 - aa * ax[k] - n_i * nx[k])
+                 - ct * mtx[k] + hn * mvx[k])
+        o1[k] = (-u_i * (kd * ny[k] + wc * mvy[k]) - fmd * (e1 - aa * ay[k] - n_i * ny[k])
+                 - ct * mty[k] + hn * mvy[k])
+        o2[k] = (-u_i * (kd * nz[k] + wc * mvz[k]) - fmd * (e2 - aa * az[k] - n_i * nz[k])
+                 - ct * mtz[k] + hn * mvz[k])
+    tx = tab[_TX]
+    ty = tab[_TY]
+    tz = tab[_TZ]
+    gvr = tab[_GV]
+    p0 = tab[_J0 + 9 + 3 * i]
+    p1 = tab[_J0 + 9 + 3 * i + 1]
+    p2 = tab[_J0 + 9 + 3 * i + 2]
+    for k in range(n_k):  # ∂F/∂v, row i
+        n_i = ni[k]
+        t_i = ti[k]
+        wu = wcr[k] * (n_i + musr[k] * t_i)
+        gt = gvr[k] * t_i
+        hf = hfr[k]
+        p0[k] = -wu * nx[k] - gt * tx[k] - hf * (e0 - n_i * nx[k])
+        p1[k] = -wu * ny[k] - gt * ty[k] - hf * (e1 - n_i * ny[k])
+        p2[k] = -wu * nz[k] - gt * tz[k] - hf * (e2 - n_i * nz[k])
+
+
+@njit(inline="always", **_JIT)
+def _accumulate_blocks(tab, pair_t, pair_ab, le, acc, bq, bqt):
+    """Element blocks Σ_k (N_k N_kᵀ) ⊗ J_k from the ten distinct products N_a N_b."""
+    n_k = pair_t.shape[1]
+    p0 = pair_t[0]
+    p1 = pair_t[1]
+    p2 = pair_t[2]
+    p3 = pair_t[3]
+    p4 = pair_t[4]
+    p5 = pair_t[5]
+    p6 = pair_t[6]
+    p7 = pair_t[7]
+    p8 = pair_t[8]
+    p9 = pair_t[9]
+    for col in range(18):
+        jc = tab[_J0 + col]
+        s0 = 0.0
+        s1 = 0.0
+        s2 = 0.0
+        s3 = 0.0
+        s4 = 0.0
+        s5 = 0.0
+        s6 = 0.0
+        s7 = 0.0
+        s8 = 0.0
+        s9 = 0.0
+        for k in range(n_k):  # each J column read once for the ten products
+            jv = jc[k]
+            s0 += p0[k] * jv
+            s1 += p1[k] * jv
+            s2 += p2[k] * jv
+            s3 += p3[k] * jv
+            s4 += p4[k] * jv
+            s5 += p5[k] * jv
+            s6 += p6[k] * jv
+            s7 += p7[k] * jv
+            s8 += p8[k] * jv
+            s9 += p9[k] * jv
+        acc[0, col] = s0
+        acc[1, col] = s1
+        acc[2, col] = s2
+        acc[3, col] = s3
+        acc[4, col] = s4
+        acc[5, col] = s5
+        acc[6, col] = s6
+        acc[7, col] = s7
+        acc[8, col] = s8
+        acc[9, col] = s9
+    for p in range(10):
+        a = pair_ab[p, 0]
+        bb = pair_ab[p, 1]
+        scale = 1.0
+        if a == 1 or a == 3:  # slope shape functions carry a factor L
+            scale *= le
+        if bb == 1 or bb == 3:
+            scale *= le
+        for i in range(3):
+            for j in range(3):
+                vq = scale * acc[p, 3 * i + j]
+                vt = scale * acc[p, 9 + 3 * i + j]
+                bq[3 * a + i, 3 * bb + j] = vq
+                bqt[3 * a + i, 3 * bb + j] = vt
+                if a != bb:  # (N Nᵀ) is symmetric: block (b, a) has the same 3×3
+                    bq[3 * bb + i, 3 * a + j] = vq
+                    bqt[3 * bb + i, 3 * a + j] = vt
+
+
+def _exponent_mode(exponent: float) -> int:
+    """1 for e = 1.5 (square root instead of pow), 2 for e = 1, 0 otherwise."""
+    if exponent == 1.5:
+        return 1
+    if exponent == 1.0:
+        return 2
+    return 0
+
+
+class FastKernel:
+    """Numba evaluation of the contact force and Jacobian for a fixed conduit and cable mesh.
+
+    Built by :class:`exucable.contact.ContactKernel`; see there for the parameters' meaning.
+
+    Parameters
+    ----------
+    seg_start_m, seg_end_m, seg_axis, seg_length_m : ndarray
+        Segment start/end points [m], unit axes and lengths [m].
+    seg_lo_m, seg_hi_m : ndarray, shape (n_seg, 3)
+        Segment boxes inflated by the inner radius [m].
+    element_length_m : ndarray, shape (n_el,)
+    nh_unit : ndarray, shape (n_k, 4)
+        Hermite values of a unit-length element at the check points.
+    omega : ndarray, shape (n_k,)
+        Check point weights.
+    law : ContactLaw
+    gap_m : float
+        Clearance R - r [m].
+    cable_radius_m : float
+    reference_spacing_m : float
+    broad_phase : {"aabb", "none"}
+    """
+
+    def __init__(self, seg_start_m, seg_end_m, seg_axis, seg_length_m, seg_lo_m, seg_hi_m,
+                 element_length_m, nh_unit, omega, law, gap_m, cable_radius_m,
+                 reference_spacing_m, broad_phase):
+        n_s = seg_start_m.shape[0]
+        self.seg = np.empty((n_s, _SEG_COLUMNS))
+        self.seg[:, 0:3] = seg_start_m
+        self.seg[:, 3:6] = seg_axis
+        self.seg[:, 6] = seg_length_m
+        self.seg[:, 7:10] = seg_end_m
+        self.length = np.ascontiguousarray(element_length_m, dtype=float)
+        self.nh = np.ascontiguousarray(nh_unit, dtype=float)
+        self.omega = np.ascontiguousarray(omega, dtype=float)
+        # N_a N_b of a unit-length element, one row per (a, b) of _PAIRS
+        self.pair_t = np.ascontiguousarray((self.nh[:, _PAIRS[:, 0]] * self.nh[:, _PAIRS[:, 1]]).T)
+        self.gap = float(gap_m)
+        self.law = law
+        self.inv_href = 1.0 / float(reference_spacing_m)
+        self.n_el = self.length.shape[0]
+        self.n_coordinates = 6 * (self.n_el + 1)
+        self.broad_phase = broad_phase
+        if broad_phase == "aabb":
+            self.sweep = SweepBroadPhase(seg_lo_m, seg_hi_m, self.length, cable_radius_m)
+        else:
+            self.all_off, self.all_cand = candidates_all_segments(self.n_el, n_s)
+        n_k = self.nh.shape[0]
+        self._n = [np.ascontiguousarray(self.nh[:, i]) for i in range(4)]
+        self._sel = np.empty(n_k, dtype=np.int64)
+        self._tab = np.empty((_ROWS, n_k))
+        self._acc = np.empty((10, 18))
+        self._empty_blocks = np.empty((0, 12, 12))
+
+    def candidates(self, q):
+        """CSR candidate segment lists (offsets, indices) for coordinates ``q``."""
+        if self.broad_phase == "aabb":
+            return self.sweep.candidates(q)
+        return self.all_off, self.all_cand
+
+    def nearest_segments(self, q):
+        """Contact search only: nearest segment per check point, shape (n_el, n_k) (-1: none)."""
+        q = np.ascontiguousarray(q, dtype=float)
+        off, cand = self.candidates(q)
+        nearest = np.empty((self.n_el, self.nh.shape[0]), dtype=np.int64)
+        n1, n2, n3, n4 = self._n
+        _search_kernel(q, self.length, n1, n2, n3, n4, self.seg, off, cand, self._tab, nearest)
+        return nearest
+
+    def evaluate(self, q, q_t, jacobian):
+        """Return (Q, ∂Q/∂q blocks or None, ∂Q/∂q̇ blocks or None, n_in_contact, max δ [m])."""
+        q = np.ascontiguousarray(q, dtype=float)
+        q_t = np.ascontiguousarray(q_t, dtype=float)
+        off, cand = self.candidates(q)
+        force = np.zeros(self.n_coordinates)
+        if jacobian:
+            jq = np.zeros((self.n_el, 12, 12))
+            jqt = np.zeros((self.n_el, 12, 12))
+        else:
+            jq = jqt = self._empty_blocks
+        law = self.law
+        n1, n2, n3, n4 = self._n
+        n_contact, max_pen = _contact_kernel(
+            q, q_t, self.length, n1, n2, n3, n4, self.pair_t, _PAIRS, self.omega, self.seg, off,
+            cand,
+            self.gap, float(law.stiffness), float(law.damping), float(law.exponent),
+            _exponent_mode(law.exponent), float(law.friction), float(law.static_excess),
+            1.0 / law.stribeck_velocity_m_per_s**2, law.regularisation_velocity_m_per_s**2,
+            self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc)
+        if not jacobian:
+            jq = jqt = None
+        return force, jq, jqt, int(n_contact), float(max_pen)

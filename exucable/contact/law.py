@@ -1,0 +1,127 @@
+"""Contact law between a cable check point and the conduit wall (paper Sect. 2.4, Eqs. 18-20).
+
+Pure numpy; nothing here knows of Exudyn or of the geometry. The functions work on arrays of
+any shape, one entry per check point, and are the reference the compiled kernel is tested
+against.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["ContactLaw", "normal_force_magnitude", "friction_coefficient"]
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """Hertz normal force with damping (Eq. 18) and regularised Coulomb friction (Eqs. 19-20).
+
+    Parameters
+    ----------
+    stiffness : float
+        Normal contact stiffness K_n [N/m^e] of one check point of weight 1 (the kernel scales it
+        by the check point's share of the element length, see :class:`ContactKernel`).
+    damping : float
+        Normal contact damping C_n [N·s/m], acting on the penetration rate δ̇ (Eq. 18).
+    exponent : float
+        Hertz exponent e [-] of f_n = K_n δ^e + C_n δ̇; at least 1 so that ∂f_n/∂δ stays finite
+        at first touch (the paper's value is lost; the project uses 1.5).
+    friction : float
+        Kinetic (sliding) friction coefficient μ_k [-] (Eq. 19).
+    static_friction : float or None
+        Static friction coefficient μ_s >= μ_k [-]. ``None`` (default): μ = μ_k at every speed.
+    stribeck_velocity_m_per_s : float
+        Stribeck velocity v_s [m/s]: μ(v) = μ_k + (μ_s - μ_k)·exp(-(v/v_s)²). Unused when
+        ``static_friction`` is None.
+    regularisation_velocity_m_per_s : float
+        Friction regularisation velocity ε [m/s]: the friction direction is v_τ/√(|v_τ|² + ε²)
+        instead of v_τ/|v_τ| (Eq. 20), so the force is smooth through zero sliding speed.
+    """
+
+    stiffness: float
+    damping: float
+    exponent: float
+    friction: float
+    static_friction: float | None = None
+    stribeck_velocity_m_per_s: float = 1e-2
+    regularisation_velocity_m_per_s: float = 1e-3
+
+    def __post_init__(self):
+        # The kernel is below the scenario layer, which reports bad user input with its own
+        # keys; here a bad value is a programming error, hence ValueError.
+        checks = [
+            ("stiffness", self.stiffness >= 0.0, "must be >= 0"),
+            ("damping", self.damping >= 0.0, "must be >= 0"),
+            ("exponent", self.exponent >= 1.0, "must be >= 1 (finite stiffness at first touch)"),
+            ("friction", self.friction >= 0.0, "must be >= 0"),
+            ("stribeck_velocity_m_per_s", self.stribeck_velocity_m_per_s > 0.0, "must be > 0"),
+            ("regularisation_velocity_m_per_s", self.regularisation_velocity_m_per_s > 0.0,
+             "must be > 0"),
+        ]
+        for name, ok, message in checks:
+            value = getattr(self, name)
+            if not (ok and math.isfinite(value)):
+                raise ValueError(f"ContactLaw.{name} = {value!r}: {message}")
+        if self.static_friction is not None and not (
+            math.isfinite(self.static_friction) and self.static_friction >= self.friction
+        ):
+            raise ValueError(
+                f"ContactLaw.static_friction = {self.static_friction!r}: must be >= friction "
+                f"({self.friction}) or None"
+            )
+
+    @property
+    def static_excess(self) -> float:
+        """μ_s - μ_k [-]; 0 when there is no static friction."""
+        return 0.0 if self.static_friction is None else self.static_friction - self.friction
+
+
+def normal_force_magnitude(law: ContactLaw, penetration_m, penetration_rate_m_per_s):
+    """Unweighted normal force max(0, K_n δ^e + C_n δ̇) [N] (Eq. 18, never pulling).
+
+    Parameters
+    ----------
+    law : ContactLaw
+    penetration_m : array_like
+        Penetration δ [m]; entries <= 0 give zero force.
+    penetration_rate_m_per_s : array_like
+        Penetration rate δ̇ = n·v [m/s].
+
+    Returns
+    -------
+    ndarray
+        f_n [N], same shape as the inputs.
+    """
+    delta = np.asarray(penetration_m, dtype=float)
+    rate = np.asarray(penetration_rate_m_per_s, dtype=float)
+    touching = delta > 0.0
+    raw = law.stiffness * np.where(touching, delta, 0.0) ** law.exponent + law.damping * rate
+    return np.where(touching & (raw > 0.0), raw, 0.0)
+
+
+def friction_coefficient(law: ContactLaw, sliding_speed_squared):
+    """Friction coefficient μ(|v_τ|) [-] with the optional Stribeck decay.
+
+    Parameters
+    ----------
+    law : ContactLaw
+    sliding_speed_squared : array_like
+        |v_τ|² [m²/s²]; the square is the argument so that μ is smooth at zero speed.
+
+    Returns
+    -------
+    mu : ndarray
+        μ_k + (μ_s - μ_k)·exp(-|v_τ|²/v_s²).
+    dmu_dg : ndarray
+        dμ/d(|v_τ|²) [s²/m²], used by the Jacobian.
+    """
+    g = np.asarray(sliding_speed_squared, dtype=float)
+    excess = law.static_excess
+    if excess == 0.0:
+        return np.full_like(g, law.friction), np.zeros_like(g)
+    inv_vs2 = 1.0 / law.stribeck_velocity_m_per_s**2
+    decay = np.exp(-g * inv_vs2)
+    return law.friction + excess * decay, -excess * inv_vs2 * decay
