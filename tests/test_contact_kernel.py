@@ -350,6 +350,37 @@ def test_point_outside_the_conduit_feels_no_force():
     assert np.all(st.segment == -1) and np.all(np.isnan(st.penetration_m))
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_conduit_ends_are_open(backend):
+    """A cable pulled out of the conduit (or still to enter it) touches nothing beyond the end
+    planes, however far it sits from the axis line's continuation; with ``open_ends=False`` the
+    end vertex acts as a wall (the paper's closed polyline), and the points inside the conduit
+    feel the same force either way (1e-12)."""
+    route = straight_route(n_seg=3, length=1.2)
+    d = route.tangent(np.array([0.0]))[0]
+    side = perpendicular_unit(d[None, :], np.random.default_rng(1))[0]
+    p_end = route.centre(np.array([route.length]))[0]
+    # one element straddling the exit: first node inside at the wall, second 5 cm beyond the end
+    q = np.zeros(12)
+    q[0:3] = p_end - 0.05 * d + (GAP + 2e-4) * side
+    q[3:6] = d
+    q[6:9] = p_end + 0.05 * d + (GAP + 2e-4) * side
+    q[9:12] = d
+    q_t = np.concatenate([0.1 * d, np.zeros(3), 0.1 * d, np.zeros(3)])
+    open_k = ContactKernel(route.segments, 0.1, R_CABLE, SLIDING, 40, n_elements=1, backend=backend)
+    closed_k = ContactKernel(route.segments, 0.1, R_CABLE, SLIDING, 40, n_elements=1, backend=backend,
+                             open_ends=False)
+    st_open = open_k.points(q, q_t)
+    st_closed = closed_k.points(q, q_t)
+    s_along = (st_open.position_m - route.centre(np.array([0.0]))[0]) @ d
+    inside = s_along < route.length
+    assert inside.any() and (~inside).any()
+    assert np.all(st_open.in_contact[inside]) and not np.any(st_open.in_contact[~inside])
+    assert np.all(st_closed.in_contact)   # the closed end vertex is a wall
+    np.testing.assert_allclose(st_open.normal_force_N[inside], st_closed.normal_force_N[inside], rtol=1e-12)
+    assert open_k.evaluate(q, q_t).n_in_contact == inside.sum()
+
+
 # ---------------------------------------------------------------------------------------------
 # Jacobians against central finite differences
 # ---------------------------------------------------------------------------------------------

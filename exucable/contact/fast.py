@@ -85,12 +85,14 @@ def _positions(q, b, le, n1, n2, n3, n4, px, py, pz):
 
 @njit(inline="always", **_JIT)
 def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_in, ay_in,
-                      az_in):
+                      az_in, open_first, open_last):
     """Narrow phase of one element: nearest candidate segment of every check point.
 
     Projection parameter clamped to the segment (a point beyond a kink's outer side sees the
     vertex). Segment-major so that the inner loop over points vectorises; the strict ``<`` in
     increasing candidate order keeps the lower segment index on ties, as the numpy reference.
+    A point beyond the conduit's open ends (before segment ``open_first``'s start or past
+    segment ``open_last``'s end; -1 = closed) is outside the conduit: it gets d² = 0, no contact.
     """
     n_k = px.shape[0]
     for k in range(n_k):
@@ -114,6 +116,8 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
         sbx = seg[s, 7]
         sby = seg[s, 8]
         sbz = seg[s, 9]
+        end0 = s == open_first
+        end1 = s == open_last
         for k in range(n_k):
             dx = px[k] - sax
             dy = py[k] - say
@@ -131,6 +135,7 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
             ey = dy if low else ey
             ez = dz if low else ez
             d2 = ex * ex + ey * ey + ez * ez
+            d2 = 0.0 if ((low & end0) | (high & end1)) else d2
             inside = 0.0 if (low | high) else 1.0
             if d2 < best[k]:  # strict: ties keep the lower segment index
                 best[k] = d2
@@ -144,19 +149,19 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
 
 
 @njit(**_JIT)
-def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest):
+def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open_first, open_last):
     """Contact search only (no force law): nearest segment of every check point, -1 if none."""
     for e in range(length.shape[0]):
         _positions(q, 6 * e, length[e], n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])
         _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, off[e], off[e + 1],
                           tab[_BEST], nearest[e], tab[_RX], tab[_RY], tab[_RZ], tab[_AX],
-                          tab[_AY], tab[_AZ])
+                          tab[_AY], tab[_AZ], open_first, open_last)
 
 
 @njit(**_JIT)
 def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, off, cand,
                     gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
-                    inv_href, jacobian, force, jq, jqt, tab, sel, acc):
+                    inv_href, jacobian, force, jq, jqt, tab, sel, acc, open_first, open_last):
     """Generalized contact force and its 12×12 Jacobian blocks; returns (n_in_contact, max δ)."""
     n_k = n1.shape[0]
     n_contact = 0
@@ -170,7 +175,8 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         b = 6 * e
         _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])  # Eq. 2
         _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
-                          tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ])
+                          tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ],
+                          open_first, open_last)
         n_touch, max_d2 = _normals(tab, n_k, gap, max_d2)
         if n_touch == 0:
             continue
@@ -581,8 +587,10 @@ class FastKernel:
 
     def __init__(self, seg_start_m, seg_end_m, seg_axis, seg_length_m, seg_lo_m, seg_hi_m,
                  element_length_m, nh_unit, omega, law, gap_m, cable_radius_m,
-                 reference_spacing_m, broad_phase):
+                 reference_spacing_m, broad_phase, open_ends=True):
         n_s = seg_start_m.shape[0]
+        self.open_first = 0 if open_ends else -1
+        self.open_last = n_s - 1 if open_ends else -1
         self.seg = np.empty((n_s, _SEG_COLUMNS))
         self.seg[:, 0:3] = seg_start_m
         self.seg[:, 3:6] = seg_axis
@@ -622,7 +630,8 @@ class FastKernel:
         off, cand = self.candidates(q)
         nearest = np.empty((self.n_el, self.nh.shape[0]), dtype=np.int64)
         n1, n2, n3, n4 = self._n
-        _search_kernel(q, self.length, n1, n2, n3, n4, self.seg, off, cand, self._tab, nearest)
+        _search_kernel(q, self.length, n1, n2, n3, n4, self.seg, off, cand, self._tab, nearest,
+                       self.open_first, self.open_last)
         return nearest
 
     def evaluate(self, q, q_t, jacobian):
@@ -644,7 +653,8 @@ class FastKernel:
             self.gap, float(law.stiffness), float(law.damping), float(law.exponent),
             _exponent_mode(law.exponent), float(law.friction), float(law.static_excess),
             1.0 / law.stribeck_velocity_m_per_s**2, law.regularisation_velocity_m_per_s**2,
-            self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc)
+            self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc,
+            self.open_first, self.open_last)
         if not jacobian:
             jq = jqt = None
         return force, jq, jqt, int(n_contact), float(max_pen)

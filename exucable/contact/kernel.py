@@ -166,7 +166,7 @@ def _element_values(q: np.ndarray) -> np.ndarray:
     return np.stack([nodes[:-1, :3], nodes[:-1, 3:], nodes[1:, :3], nodes[1:, 3:]], axis=1)
 
 
-def _nearest(p, cand, seg_start, seg_end, seg_axis, seg_length):
+def _nearest(p, cand, seg_start, seg_end, seg_axis, seg_length, open_first=-1, open_last=-1):
     """Closest point of each of the points ``p`` (m, 3) on the segments ``cand``.
 
     Returns (segment index, clamped projection parameter t [m], residual P - Pc, inside flag);
@@ -187,9 +187,13 @@ def _nearest(p, cand, seg_start, seg_end, seg_axis, seg_length):
     ey = np.where(low, dy, np.where(high, p[:, None, 1] - end[None, :, 1], dy - t * a[None, :, 1]))
     ez = np.where(low, dz, np.where(high, p[:, None, 2] - end[None, :, 2], dz - t * a[None, :, 2]))
     d2 = ex * ex + ey * ey + ez * ez
+    # beyond an open end of the conduit: outside it, no contact (d² = 0, as the compiled kernel)
+    beyond = (low & (cand == open_first)[None, :]) | (high & (cand == open_last)[None, :])
+    d2 = np.where(beyond, 0.0, d2)
     j = np.argmin(d2, axis=1)  # first minimum: ties keep the lower segment index
     rows = np.arange(p.shape[0])
     residual = np.stack([ex[rows, j], ey[rows, j], ez[rows, j]], axis=1)
+    residual[beyond[rows, j]] = 0.0
     t_clamped = np.clip(t[rows, j], 0.0, length[0, j])
     return cand[j], t_clamped, residual, inside[rows, j]
 
@@ -303,7 +307,7 @@ class ContactKernel:
     def __init__(self, segments: Segments, element_length_m, cable_radius_m: float,
                  law: ContactLaw, check_points_per_element: int, rule: str = "gauss",
                  reference_spacing_m: float = 1e-3, broad_phase: str = "aabb",
-                 backend: str = "auto", n_elements: int | None = None):
+                 backend: str = "auto", n_elements: int | None = None, open_ends: bool = True):
         length = np.asarray(element_length_m, dtype=float)
         if length.ndim == 0:
             if n_elements is None:
@@ -331,6 +335,10 @@ class ContactKernel:
         self.gap_m = segments.inner_radius_m - radius
         self.reference_spacing_m = float(reference_spacing_m)
         self.broad_phase = broad_phase
+        # The conduit's ends are open: a check point past the first segment's start or the last
+        # segment's end is outside the conduit (the cable's lead pulled out, or still to enter).
+        self.open_ends = bool(open_ends)
+        self._open = (0, segments.count - 1) if self.open_ends else (-1, -1)
         self.xi, self.omega = check_points(check_points_per_element, rule)
         self.rule = rule
         self._nh = hermite_unit(self.xi)
@@ -355,7 +363,7 @@ class ContactKernel:
             self._fast = FastKernel(self._seg_start, self._seg_end, self._seg_axis,
                                     self._seg_length, self._seg_lo, self._seg_hi, length,
                                     self._nh, self.omega, law, self.gap_m, radius,
-                                    self.reference_spacing_m, broad_phase)
+                                    self.reference_spacing_m, broad_phase, self.open_ends)
 
     @property
     def n_elements(self) -> int:
@@ -465,7 +473,7 @@ class ContactKernel:
             if cand.size == 0:
                 continue
             s, te, re, ins = _nearest(p[e], cand, self._seg_start, self._seg_end,
-                                      self._seg_axis, self._seg_length)
+                                      self._seg_axis, self._seg_length, *self._open)
             segment[e], t[e], residual[e] = s, te, re
             axis_inside[e] = np.where(ins[:, None], self._seg_axis[s], 0.0)
         w = (self.element_length_m[:, None] * self.omega[None, :]) / self.reference_spacing_m
