@@ -214,6 +214,9 @@ class ContactSpec:
         Each check point's force is scaled by (its share of the element length) / this [m].
     broad_phase : str
         ``"aabb"`` (paper Sect. 2.5) or ``"none"``.
+    surface : str
+        ``"smooth"``: closest points on the exact bends and helices (default);
+        ``"segments"``: on the straight segments, as the paper (see exucable.contact.smooth).
     """
 
     stiffness: float
@@ -227,6 +230,7 @@ class ContactSpec:
     check_point_rule: str
     reference_spacing_m: float
     broad_phase: str
+    surface: str = "smooth"
 
     def to_dict(self) -> dict:
         """The ``[contact]`` table in TOML key names, defaults filled in."""
@@ -245,6 +249,7 @@ class ContactSpec:
             check_point_rule=self.check_point_rule,
             reference_spacing=self.reference_spacing_m,
             broad_phase=self.broad_phase,
+            surface=self.surface,
         )
         return d
 
@@ -945,7 +950,7 @@ def _parse_contact(data) -> ContactSpec:
         {
             "stiffness", "damping", "exponent", "friction", "static_friction", "stribeck_velocity",
             "friction_regularisation_velocity", "check_points_per_element", "check_point_rule",
-            "reference_spacing", "broad_phase",
+            "reference_spacing", "broad_phase", "surface",
         },
     )
     friction = t.number("friction", "", default=0.0, ge=0.0)
@@ -969,6 +974,7 @@ def _parse_contact(data) -> ContactSpec:
         check_point_rule=t.choice("check_point_rule", ("gauss", "uniform"), default="gauss"),
         reference_spacing_m=t.number("reference_spacing", "m", default=1.0e-3, gt=0.0),
         broad_phase=t.choice("broad_phase", ("aabb", "none"), default="aabb"),
+        surface=t.choice("surface", ("smooth", "segments"), default="smooth"),
     )
 
 

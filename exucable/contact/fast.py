@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from .broadphase import SweepBroadPhase, candidates_all_segments
+from .smooth import NEWTON_ITERATIONS
 
 __all__ = ["FastKernel"]
 
@@ -148,6 +149,83 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
                 az_in[k] = inside * az
 
 
+@njit(inline="always", **_JIT)
+def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, seg_piece, pieces,
+                   seg_phi, n_newton):
+    """Closest points on the exact bends/helices (see :mod:`exucable.contact.smooth`).
+
+    Overwrites the residual, the squared distance and the Jacobian axis √β·T of every point whose
+    nearest segment lies on a curved piece. Points beyond an open end (d² = 0) are left alone.
+    """
+    for k in range(px.shape[0]):
+        sg = sel[k]
+        if sg < 0 or best[k] == 0.0:
+            continue
+        pi = seg_piece[sg]
+        if pieces[pi, 15] == 0.0:
+            continue
+        # initial angle from the chord's projection parameter
+        dx = px[k] - seg[sg, 0]
+        dy = py[k] - seg[sg, 1]
+        dz = pz[k] - seg[sg, 2]
+        ln = seg[sg, 6]
+        t = dx * seg[sg, 3] + dy * seg[sg, 4] + dz * seg[sg, 5]
+        t = min(max(t, 0.0), ln)
+        phi = seg_phi[sg, 0] + t / ln * (seg_phi[sg, 1] - seg_phi[sg, 0])
+        xx = px[k] - pieces[pi, 0]
+        xy = py[k] - pieces[pi, 1]
+        xz = pz[k] - pieces[pi, 2]
+        x1 = xx * pieces[pi, 3] + xy * pieces[pi, 4] + xz * pieces[pi, 5]
+        x2 = xx * pieces[pi, 6] + xy * pieces[pi, 7] + xz * pieces[pi, 8]
+        xk = xx * pieces[pi, 9] + xy * pieces[pi, 10] + xz * pieces[pi, 11]
+        a = pieces[pi, 12]
+        h = pieces[pi, 13]
+        big_phi = pieces[pi, 14]
+        for _ in range(n_newton):
+            cs = math.cos(phi)
+            sn = math.sin(phi)
+            g = -(a * (-sn * x1 + cs * x2) + h * (xk - h * phi))
+            dg = a * (cs * x1 + sn * x2) + h * h
+            phi = phi - g / dg
+        inside = 0.0 <= phi <= big_phi
+        phic = min(max(phi, 0.0), big_phi)
+        cs = math.cos(phic)
+        sn = math.sin(phic)
+        w = math.sqrt(a * a + h * h)
+        r1 = x1 - a * cs
+        r2 = x2 - a * sn
+        r3 = xk - h * phic
+        t1 = -a * sn / w
+        t2 = a * cs / w
+        t3 = h / w
+        beta = 1.0
+        if inside:
+            # κ = -(a/w²)(cos φ e1 + sin φ e2);  β = 1/(1 - r·κ)
+            beta = 1.0 / (1.0 + a / (w * w) * (r1 * cs + r2 * sn))
+        else:
+            along = r1 * t1 + r2 * t2 + r3 * t3
+            r1 -= along * t1
+            r2 -= along * t2
+            r3 -= along * t3
+        sb = math.sqrt(beta)
+        e1x = pieces[pi, 3]
+        e1y = pieces[pi, 4]
+        e1z = pieces[pi, 5]
+        e2x = pieces[pi, 6]
+        e2y = pieces[pi, 7]
+        e2z = pieces[pi, 8]
+        kx = pieces[pi, 9]
+        ky = pieces[pi, 10]
+        kz = pieces[pi, 11]
+        rx[k] = r1 * e1x + r2 * e2x + r3 * kx
+        ry[k] = r1 * e1y + r2 * e2y + r3 * ky
+        rz[k] = r1 * e1z + r2 * e2z + r3 * kz
+        best[k] = r1 * r1 + r2 * r2 + r3 * r3
+        ax_in[k] = sb * (t1 * e1x + t2 * e2x + t3 * kx)
+        ay_in[k] = sb * (t1 * e1y + t2 * e2y + t3 * ky)
+        az_in[k] = sb * (t1 * e1z + t2 * e2z + t3 * kz)
+
+
 @njit(**_JIT)
 def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open_first, open_last):
     """Contact search only (no force law): nearest segment of every check point, -1 if none."""
@@ -161,7 +239,8 @@ def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open
 @njit(**_JIT)
 def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, off, cand,
                     gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
-                    inv_href, jacobian, force, jq, jqt, tab, sel, acc, open_first, open_last):
+                    inv_href, jacobian, force, jq, jqt, tab, sel, acc, open_first, open_last,
+                    smooth, seg_piece, pieces, seg_phi, n_newton):
     """Generalized contact force and its 12×12 Jacobian blocks; returns (n_in_contact, max δ)."""
     n_k = n1.shape[0]
     n_contact = 0
@@ -177,6 +256,10 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
                           tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ],
                           open_first, open_last)
+        if smooth:
+            _refine_smooth(tab[_PX], tab[_PY], tab[_PZ], seg, sel, tab[_BEST], tab[_RX], tab[_RY],
+                           tab[_RZ], tab[_AX], tab[_AY], tab[_AZ], seg_piece, pieces, seg_phi,
+                           n_newton)
         n_touch, max_d2 = _normals(tab, n_k, gap, max_d2)
         if n_touch == 0:
             continue
@@ -587,10 +670,17 @@ class FastKernel:
 
     def __init__(self, seg_start_m, seg_end_m, seg_axis, seg_length_m, seg_lo_m, seg_hi_m,
                  element_length_m, nh_unit, omega, law, gap_m, cable_radius_m,
-                 reference_spacing_m, broad_phase, open_ends=True):
+                 reference_spacing_m, broad_phase, open_ends=True, wall=None):
         n_s = seg_start_m.shape[0]
         self.open_first = 0 if open_ends else -1
         self.open_last = n_s - 1 if open_ends else -1
+        self.smooth = wall is not None
+        if wall is not None:
+            self.seg_piece, self.pieces, self.seg_phi = wall.seg_piece, wall.pieces, wall.seg_phi
+        else:
+            self.seg_piece = np.zeros(n_s, dtype=np.int64)
+            self.pieces = np.zeros((1, 16))
+            self.seg_phi = np.zeros((n_s, 2))
         self.seg = np.empty((n_s, _SEG_COLUMNS))
         self.seg[:, 0:3] = seg_start_m
         self.seg[:, 3:6] = seg_axis
@@ -654,7 +744,8 @@ class FastKernel:
             _exponent_mode(law.exponent), float(law.friction), float(law.static_excess),
             1.0 / law.stribeck_velocity_m_per_s**2, law.regularisation_velocity_m_per_s**2,
             self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc,
-            self.open_first, self.open_last)
+            self.open_first, self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
+            NEWTON_ITERATIONS)
         if not jacobian:
             jq = jqt = None
         return force, jq, jqt, int(n_contact), float(max_pen)

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..geometry.segments import Segments
 from .broadphase import candidates_all_pairs, candidates_all_segments, element_aabbs
+from .smooth import SmoothWall, refine_closest_points
 from .checkpoints import check_points, hermite_unit
 from .law import ContactLaw, friction_coefficient
 
@@ -307,7 +308,8 @@ class ContactKernel:
     def __init__(self, segments: Segments, element_length_m, cable_radius_m: float,
                  law: ContactLaw, check_points_per_element: int, rule: str = "gauss",
                  reference_spacing_m: float = 1e-3, broad_phase: str = "aabb",
-                 backend: str = "auto", n_elements: int | None = None, open_ends: bool = True):
+                 backend: str = "auto", n_elements: int | None = None, open_ends: bool = True,
+                 surface: str = "segments", centreline=None):
         length = np.asarray(element_length_m, dtype=float)
         if length.ndim == 0:
             if n_elements is None:
@@ -338,6 +340,14 @@ class ContactKernel:
         # The conduit's ends are open: a check point past the first segment's start or the last
         # segment's end is outside the conduit (the cable's lead pulled out, or still to enter).
         self.open_ends = bool(open_ends)
+        # "segments": the paper's wall of straight hollow cylinders; "smooth": the same search,
+        # then the closest point refined onto the exact bend/helix (exucable.contact.smooth)
+        if surface not in ("segments", "smooth"):
+            raise ValueError(f"surface must be 'segments' or 'smooth', got {surface!r}")
+        if surface == "smooth" and centreline is None:
+            raise ValueError("surface='smooth' needs the centreline the segments were cut from")
+        self.surface = surface
+        self.wall = SmoothWall(centreline, segments) if surface == "smooth" else None
         self._open = (0, segments.count - 1) if self.open_ends else (-1, -1)
         self.xi, self.omega = check_points(check_points_per_element, rule)
         self.rule = rule
@@ -363,7 +373,8 @@ class ContactKernel:
             self._fast = FastKernel(self._seg_start, self._seg_end, self._seg_axis,
                                     self._seg_length, self._seg_lo, self._seg_hi, length,
                                     self._nh, self.omega, law, self.gap_m, radius,
-                                    self.reference_spacing_m, broad_phase, self.open_ends)
+                                    self.reference_spacing_m, broad_phase, self.open_ends,
+                                    self.wall)
 
     @property
     def n_elements(self) -> int:
@@ -432,6 +443,10 @@ class ContactKernel:
         sh = seg[has]
         frac = st["t"][has] / self._seg_length[sh]
         s_conduit[has] = s_vertex[sh] + frac * (s_vertex[sh + 1] - s_vertex[sh])
+        if st["phi"] is not None:  # on the smooth wall: the exact arc length of Pc
+            sm = np.isfinite(st["phi"])
+            piece = self.wall.seg_piece[seg[sm]]
+            s_conduit[sm] = self.wall.s_piece_start_m[piece] + st["phi"][sm] * self.wall.piece_speed_m_per_rad[piece]
         law = st["law"]
         share = (self.element_length_m[:, None] * self.omega[None, :]).reshape(-1)
         return CheckPointState(
@@ -476,11 +491,23 @@ class ContactKernel:
                                       self._seg_axis, self._seg_length, *self._open)
             segment[e], t[e], residual[e] = s, te, re
             axis_inside[e] = np.where(ins[:, None], self._seg_axis[s], 0.0)
+        phi = None
+        if self.wall is not None:
+            # beyond an open end the residual is zero: leave those points alone
+            seg_flat = segment.reshape(-1).copy()
+            seg_flat[~np.any(residual.reshape(-1, 3) != 0.0, axis=1)] = -1
+            mask, r_s, ax_s, phi = refine_closest_points(p.reshape(-1, 3), seg_flat, t.reshape(-1),
+                                                         self._seg_length, self.wall)
+            res_flat = residual.reshape(-1, 3)
+            ax_flat = axis_inside.reshape(-1, 3)
+            res_flat[mask] = r_s[mask]
+            ax_flat[mask] = ax_s[mask]
+            phi = np.where(mask, phi, np.nan)
         w = (self.element_length_m[:, None] * self.omega[None, :]) / self.reference_spacing_m
         law = _point_law(residual.reshape(-1, 3), v.reshape(-1, 3), axis_inside.reshape(-1, 3),
                          w.reshape(-1), self.law, self.gap_m, jacobian)
         return {"p": p.reshape(-1, 3), "v": v.reshape(-1, 3), "segment": segment.reshape(-1),
-                "t": t.reshape(-1), "shape": shape, "law": law}
+                "t": t.reshape(-1), "shape": shape, "law": law, "phi": phi}
 
     def _evaluate_numpy(self, q, q_t, jacobian):
         st = self._state_numpy(q, q_t, jacobian)

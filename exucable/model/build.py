@@ -137,9 +137,9 @@ def build_model(scenario, with_contact: bool = True) -> Model:
         T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
         L_e = L_cable / c.elements
         # blend over the length on which a tensioned beam leaves the wall, √(EJ/T), but at least
-        # two elements so the nodes can follow it
+        # half an element so the nodes can follow it
         T_ref = max(float(np.max(rope.tension_N)), 1e-6)
-        blend = max(2.0 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
+        blend = max(0.5 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
         off = contact_offsets(centre, s_grid, T_grid, w, clearance,
                               sc.contact.stiffness / sc.contact.reference_spacing_m,
                               sc.contact.exponent, blend) if with_contact else np.zeros((len(s_grid), 3))
@@ -188,7 +188,8 @@ def build_model(scenario, with_contact: bool = True) -> Model:
                          regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s)
         kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
                                ct.check_points_per_element, rule=ct.check_point_rule,
-                               reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase)
+                               reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
+                               surface=ct.surface, centreline=centre)
         model.kernel = kernel
         model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel)
     mbs.Assemble()

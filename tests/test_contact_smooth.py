@@ -1,0 +1,141 @@
+"""The smooth wall (contact.surface = "smooth"): exact closest points on bends and helices."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from exucable.contact import ContactKernel, ContactLaw, assemble_blocks_dense
+from exucable.geometry import Bend, Conduit, Helix, Straight, centreline_from_path
+
+R_CABLE, R_CONDUIT = 0.0025, 0.0035
+GAP = R_CONDUIT - R_CABLE
+LAW = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.2)
+
+
+def conduit(kind, segments_per_bend=12):
+    items = {"bend": [Straight(0.3), Bend(90, 0.5, "left"), Straight(0.3)],
+             "helix": [Helix(1.25, 0.4, 0.3)],
+             "sbend": [Straight(0.2), Bend(60, 0.4, "left"), Bend(45, 0.6, "up"), Straight(0.2)]}[kind]
+    c = centreline_from_path([0, 0, 0], [1, 0, 0], items)
+    return Conduit.build(R_CONDUIT, c, segments_per_bend=segments_per_bend)
+
+
+def cable_on_offset_curve(cond, s_nodes, offset_dir, distance, speed=0.1, rng=None, noise=0.0):
+    """Nodes on the curve C(s) + distance·u(s) with slopes along the centreline tangent."""
+    c = cond.centreline
+    t = c.tangent(s_nodes)
+    u = offset_dir(s_nodes, t)
+    pos = c.point(s_nodes) + distance * u
+    vel = speed * t
+    if rng is not None:
+        vel = vel + rng.normal(scale=noise, size=vel.shape)
+    q = np.hstack([pos, t]).reshape(-1)
+    q_t = np.hstack([vel, np.zeros_like(t) if rng is None else rng.normal(scale=2 * noise, size=t.shape)]).reshape(-1)
+    return q, q_t
+
+
+def towards_centre(cond):
+    def f(s, t):
+        kn = cond.centreline.curvature_vector(s)
+        n = np.linalg.norm(kn, axis=1, keepdims=True)
+        return kn / n
+    return f
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_points_at_a_known_distance_from_a_bend_get_exactly_that_penetration(backend):
+    """Check points on a curve at distance GAP + δ0 from the bend's axis: the smooth wall gives
+    δ = δ0 at every point (up to the Hermite interpolation of the cable between nodes, ~1e-8 m
+    here), while the chords of the paper's wall give δ0 less up to the sagitta ρ(1-cos(Δθ/2))."""
+    cond = conduit("bend", segments_per_bend=12)
+    s_bend = 0.3 + 0.5 * np.pi / 2 * np.array([0.1, 0.9])
+    s_nodes = np.linspace(*s_bend, 33)
+    delta0 = 3e-4
+    q, q_t = cable_on_offset_curve(cond, s_nodes, towards_centre(cond), GAP + delta0)
+    L = np.diff(s_nodes) * (1 - (GAP + delta0) / 0.5)  # arc lengths of the offset curve (unit slopes)
+    smooth = ContactKernel(cond.segments, L, R_CABLE, LAW, 16, backend=backend, surface="smooth",
+                           centreline=cond.centreline)
+    st = smooth.points(q, q_t)
+    # the cable's axis radius is R_b - GAP - δ0; Hermite cubics with unit slopes on an arc of
+    # 0.039 rad per element stay within ~1e-8 m of it (error ~ R φ⁴/100)
+    np.testing.assert_allclose(st.penetration_m, delta0, atol=2e-8)
+    segs = ContactKernel(cond.segments, L, R_CABLE, LAW, 16, backend=backend)
+    sag = 0.5 * (1 - np.cos(np.radians(90 / 12) / 2))
+    dev = segs.points(q, q_t).penetration_m - delta0
+    # the chords lie between the arc and its centre: toward the centre they cut the penetration by
+    # up to the sagitta
+    assert dev.min() < -0.5 * sag and dev.max() < 1e-8 and dev.min() > -sag - 1e-8
+
+
+@pytest.mark.parametrize("kind", ["bend", "helix", "sbend"])
+def test_numba_equals_numpy_on_the_smooth_wall(kind):
+    """Same forces and Jacobians from both backends (1e-11 relative: coordinates of order 1 m,
+    penetrations of 1e-4 m, and a few Newton steps on the helix)."""
+    cond = conduit(kind)
+    rng = np.random.default_rng(3)
+    L_total = cond.centreline.length_m
+    s_nodes = np.linspace(0.1, L_total - 0.1, 7)
+    def sideways(s, t):  # a fixed oblique direction across the tangent: inner, outer and side walls
+        v = np.cross(t, [0.3, 0.2, 1.0])
+        return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+    q, q_t = cable_on_offset_curve(cond, s_nodes, sideways, GAP + 3e-4, rng=rng, noise=0.02)
+    L = np.full(6, (s_nodes[-1] - s_nodes[0]) / 6)
+    res = {}
+    for backend in ("numpy", "numba"):
+        k = ContactKernel(cond.segments, L, R_CABLE, LAW, 20, backend=backend, surface="smooth",
+                          centreline=cond.centreline)
+        res[backend] = k.evaluate(q, q_t, jacobian=True)
+    a, b = res["numpy"], res["numba"]
+    assert a.n_in_contact == b.n_in_contact > 10
+    scale = np.abs(a.generalized_force).max()
+    assert np.abs(a.generalized_force - b.generalized_force).max() <= 1e-11 * scale
+    for ja, jb in ((a.jac_q_blocks, b.jac_q_blocks), (a.jac_qt_blocks, b.jac_qt_blocks)):
+        assert np.abs(ja - jb).max() <= 1e-10 * np.abs(ja).max()
+
+
+@pytest.mark.parametrize("kind", ["bend", "helix"])
+def test_smooth_wall_jacobians_match_finite_differences(kind):
+    """∂Q/∂q (including ∂(P − Pc)/∂P = I − T Tᵀ/(1 − r·κ) on the curve) and ∂Q/∂q̇ against central
+    differences: steps 1e-8 / 1e-7, tolerance 1e-6 of max|J| (truncation (h/δ)² ≤ 1e-6 with
+    δ ≥ 1e-4 m here; rounding ~1e-10)."""
+    cond = conduit(kind, segments_per_bend=10)
+    rng = np.random.default_rng(5)
+    s0 = 0.35 if kind == "bend" else 0.5
+    s_nodes = np.linspace(s0, s0 + 0.3, 3)
+    q, q_t = cable_on_offset_curve(cond, s_nodes, towards_centre(cond), GAP + 3e-4, rng=rng, noise=0.02)
+    L = np.diff(s_nodes)
+    k = ContactKernel(cond.segments, L, R_CABLE, LAW, 6, backend="numpy", surface="smooth",
+                      centreline=cond.centreline)
+    st = k.points(q, q_t)
+    assert st.in_contact.all() and np.all(st.penetration_m > 1e-4)
+    res = k.evaluate(q, q_t, jacobian=True)
+    n = q.size
+    jq_fd = np.zeros((n, n))
+    jqt_fd = np.zeros((n, n))
+    for i in range(n):
+        d = np.zeros(n)
+        d[i] = 1e-8
+        jq_fd[:, i] = (k.evaluate(q + d, q_t).generalized_force - k.evaluate(q - d, q_t).generalized_force) / 2e-8
+        d[i] = 1e-7
+        jqt_fd[:, i] = (k.evaluate(q, q_t + d).generalized_force - k.evaluate(q, q_t - d).generalized_force) / 2e-7
+    jq = assemble_blocks_dense(res.jac_q_blocks)
+    jqt = assemble_blocks_dense(res.jac_qt_blocks)
+    assert np.abs(jq - jq_fd).max() < 1e-6 * np.abs(jq).max()
+    assert np.abs(jqt - jqt_fd).max() < 1e-6 * np.abs(jqt).max()
+
+
+def test_smooth_wall_reports_exact_arc_length():
+    """points().s_conduit_m is the centreline arc length of the exact closest point (1e-9 m)."""
+    cond = conduit("bend", segments_per_bend=8)
+    s_nodes = np.linspace(0.4, 0.9, 3)
+    q, q_t = cable_on_offset_curve(cond, s_nodes, towards_centre(cond), GAP + 2e-4)
+    k = ContactKernel(cond.segments, np.diff(s_nodes), R_CABLE, LAW, 5, backend="numpy", surface="smooth",
+                      centreline=cond.centreline)
+    st = k.points(q, q_t)
+    # the closest point of P = C(s) + d·n(s) on the arc is C(s): compare with a dense search
+    dense = np.linspace(0.3, 1.1, 200001)
+    pts = cond.centreline.point(dense)
+    for p, s in zip(st.position_m, st.s_conduit_m):
+        assert abs(dense[np.argmin(np.sum((pts - p) ** 2, axis=1))] - s) < 1e-5
