@@ -324,6 +324,8 @@ class SolverSpec:
         Generalized-α ρ∞ [-] in [0, 1].
     newton_max_iterations : int
         Newton iterations per step before the step is cut.
+    newton_tolerance : float
+        Relative tolerance of Newton's residual [-].
     output_interval_s : float
         Interval between stored output states [s].
     steady_stop : bool
@@ -346,6 +348,7 @@ class SolverSpec:
     steady_window_s: float
     steady_tolerance: float
     pretension: bool
+    newton_tolerance: float = 1.0e-7
 
     def to_dict(self) -> dict:
         """The ``[solver]`` table in TOML key names, defaults filled in."""
@@ -355,6 +358,7 @@ class SolverSpec:
             "min_step": self.min_step_s,
             "spectral_radius": self.spectral_radius,
             "newton_max_iterations": self.newton_max_iterations,
+            "newton_tolerance": self.newton_tolerance,
             "output_interval": self.output_interval_s,
             "steady_stop": self.steady_stop,
             "steady_window": self.steady_window_s,
@@ -1009,7 +1013,8 @@ def _parse_solver(data) -> SolverSpec:
         data,
         "solver",
         {
-            "end_time", "step", "min_step", "spectral_radius", "newton_max_iterations", "output_interval",
+            "end_time", "step", "min_step", "spectral_radius", "newton_max_iterations", "newton_tolerance",
+            "output_interval",
             "steady_stop", "steady_window", "steady_tolerance", "pretension",
         },
     )
@@ -1023,7 +1028,10 @@ def _parse_solver(data) -> SolverSpec:
         step_s=step,
         min_step_s=min_step,
         spectral_radius=t.number("spectral_radius", "", default=0.5, ge=0.0, le=1.0),
-        newton_max_iterations=t.integer("newton_max_iterations", default=8, ge=1),
+        # 12 iterations and 1e-7: measured on Example 2, 735 -> 155 steps at the same pulling
+        # force (within 0.02 %) as 8 and 1e-8 (exudyn-findings had 8 with a different start)
+        newton_max_iterations=t.integer("newton_max_iterations", default=12, ge=1),
+        newton_tolerance=t.number("newton_tolerance", "", default=1.0e-7, gt=0.0, lt=1.0),
         output_interval_s=t.number("output_interval", "s", default=max(step, end_time / 1000.0), gt=0.0),
         steady_stop=t.boolean("steady_stop", default=False),
         steady_window_s=t.number("steady_window", "s", default=0.2, gt=0.0),

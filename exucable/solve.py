@@ -90,6 +90,7 @@ def solver_settings(solver_spec) -> exu.SimulationSettings:
     ti.adaptiveStepRecoverySteps = 2
     ti.newton.useModifiedNewton = False          # full Newton on the exact Jacobian
     ti.newton.maxIterations = solver_spec.newton_max_iterations
+    ti.newton.relativeTolerance = solver_spec.newton_tolerance
     ti.generalizedAlpha.spectralRadius = solver_spec.spectral_radius
     ti.verboseMode = 0
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
@@ -126,7 +127,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     out_dt = sp.output_interval_s
     next_out = [0.0]
     stopped_steady = [False]
-    record_state(model, 0.0, history)
+    # nothing is recorded at t = 0: the rig's reaction (a Lagrange multiplier) exists only
+    # once a step has been solved
     next_out[0] = out_dt
 
     def post_step(mbs, t):
