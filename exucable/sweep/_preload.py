@@ -1,0 +1,20 @@
+"""Imported once by the forkserver of the local pool, so that every case's process, forked
+from it, starts with numpy, scipy, Exudyn, the compiled contact kernel and matplotlib already
+loaded (about 1.7 s per case otherwise). Nothing here *uses* Exudyn: a process is forked only
+from this clean, import-only state, never from one that has run a model.
+"""
+
+try:  # a failed import only costs start-up time in the workers; it must not kill the forkserver
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import exudyn  # noqa: F401
+
+    import exucable.contact  # noqa: F401  (numba, imported lazily by model building)
+    import exucable.contact.fast  # noqa: F401
+    import exucable.model.build  # noqa: F401
+    import exucable.plots.results  # noqa: F401
+    import exucable.run  # noqa: F401
+    import exucable.sweep.worker  # noqa: F401
+except Exception:  # pragma: no cover
+    pass
