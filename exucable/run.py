@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 
@@ -135,22 +136,27 @@ def add_arguments(p) -> None:
                    help="run to solver.end_time whatever the pulling force does")
 
 
+def _f(value, fmt=".6g") -> str:
+    return "n/a" if value is None or not np.isfinite(value) else format(value, fmt)
+
+
 def main(args) -> int:
     sc = load_scenario(args.scenario)
     out_dir = Path(args.out) if args.out else Path("out") / sc.name
     res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop)
     s = res.summary
     rope = s.get("rope_pull_force_N")
-    print(f"{sc.name}: status {s['status']}, pulling force {s['pull_force_N']:.6g} N "
-          f"(± {s['pull_force_std_N']:.2g}), trailing tension {s['trailing_tension_N']:.6g} N, "
-          f"max tension {s['max_tension_N']:.6g} N")
-    if rope is not None:
+    print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
+          f"(± {_f(s['pull_force_std_N'], '.2g')}), trailing tension {_f(s['trailing_tension_N'])} N, "
+          f"max tension {_f(s['max_tension_N'])} N")
+    if rope is not None and s["pull_force_N"] is not None and np.isfinite(s["pull_force_N"]):
         print(f"  rope reference: pulling force {rope:.6g} N "
               f"({100 * (s['pull_force_N'] / rope - 1):+.3f} %)")
-    print(f"  steady from {s['steady_from_s']:.4g} s: {s['steady']}; {s['steps']} steps, "
+    print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
           f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
     if s["status"] == "failed":
-        print(f"  FAILED: {s['message']} (at t = {s.get('failed_at_s', float('nan')):.6g} s)")
+        print(f"  FAILED: {s['message']} (at t = {_f(s.get('failed_at_s'))} s); "
+              f"the results recorded until then are in {out_dir}/", file=sys.stderr)
         return 1
     return 0
