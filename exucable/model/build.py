@@ -150,7 +150,8 @@ def build_model(scenario, with_contact: bool = True) -> Model:
         def offset_fn(s):
             return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
 
-        layout = lay_cable(centre, L_cable, c.elements, c.axial_stiffness_N, speed, tension_fn, offset_fn)
+        layout = lay_cable(centre, L_cable, c.elements, c.axial_stiffness_N, speed, tension_fn, offset_fn,
+                           clearance_m=clearance if with_contact else None)
     else:
         layout = lay_cable(centre, L_cable, c.elements, c.axial_stiffness_N, 0.0)
 
@@ -181,7 +182,7 @@ def build_model(scenario, with_contact: bool = True) -> Model:
                   applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope)
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
-        from .coupling import ContactCoupling
+        from .coupling import ContactCoupling, StartupDamper
         ct = sc.contact
         law = ContactLaw(stiffness=ct.stiffness, damping=ct.damping, exponent=ct.exponent, friction=ct.friction,
                          static_friction=ct.static_friction, stribeck_velocity_m_per_s=ct.stribeck_velocity_m_per_s,
@@ -191,7 +192,13 @@ def build_model(scenario, with_contact: bool = True) -> Model:
                                reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
                                surface=ct.surface, centreline=centre)
         model.kernel = kernel
-        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel)
+        damper = None
+        sp = sc.solver
+        if sp.pretension and sp.startup_time_s > 0.0:
+            Le = layout.element_length_m
+            lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
+            damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
+        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel, damper)
     mbs.Assemble()
     model.ode2_index = np.concatenate([
         np.arange(mbs.GetNodeODE2Index(n), mbs.GetNodeODE2Index(n) + 6) for n in cable.nodes])
