@@ -72,6 +72,9 @@ class CableSpec:
         Number of cable finite elements.
     length_m : float or None
         Cable length [m]; None means the conduit's centreline length.
+    integration : str
+        Exudyn's quadrature of the element's internal forces: ``"lobatto"`` (default),
+        ``"reduced"`` or ``"full"`` (useReducedOrderIntegration 2, 1, 0).
     damping_time_s : float
         Kelvin–Voigt retardation time τ [s]; internal damping = τ × stiffness.
     """
@@ -83,6 +86,7 @@ class CableSpec:
     elements: int
     length_m: float | None
     damping_time_s: float
+    integration: str = "lobatto"
 
     @property
     def area_m2(self) -> float:
@@ -121,6 +125,7 @@ class CableSpec:
         if self.length_m is not None:
             d["length"] = self.length_m
         d["damping_time"] = self.damping_time_s
+        d["integration"] = self.integration
         return d
 
 
@@ -719,7 +724,8 @@ def _parse_cable(data) -> CableSpec:
     t = _Table(
         data,
         "cable",
-        {"radius", "density", "mass_per_length", "youngs_modulus", "elements", "length", "damping_time"},
+        {"radius", "density", "mass_per_length", "youngs_modulus", "elements", "length", "damping_time",
+         "integration"},
     )
     radius = t.number("radius", "m", gt=0.0)
     if t.has("density") and t.has("mass_per_length"):
@@ -740,6 +746,7 @@ def _parse_cable(data) -> CableSpec:
         elements=t.integer("elements", ge=1),
         length_m=t.number("length", "m", default=None, gt=0.0),
         damping_time_s=t.number("damping_time", "s", default=_DEFAULT_DAMPING_TIME_S, ge=0.0),
+        integration=t.choice("integration", ("lobatto", "reduced", "full"), default="lobatto"),
     )
 
 

@@ -15,7 +15,7 @@ from ..errors import ModelError
 from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, contact_offsets, lay_cable
-from .rig import Drive, add_drive, add_end_force, smooth_ramp
+from .rig import Drive, Guide, add_drive, add_end_force, smooth_ramp
 
 __all__ = ["Model", "build_model", "pull_oriented_conduit"]
 
@@ -128,6 +128,7 @@ def build_model(scenario, with_contact: bool = True) -> Model:
         bending_stiffness_N_m2=c.bending_stiffness_N_m2,
         axial_damping_N_s=c.axial_damping_N_s,
         bending_damping_N_m2_s=c.bending_damping_N_m2_s,
+        integration=c.integration,
     )
     clearance = conduit.inner_radius_m - c.radius_m
     speed = sc.pull.speed_m_per_s
@@ -198,7 +199,12 @@ def build_model(scenario, with_contact: bool = True) -> Model:
             Le = layout.element_length_m
             lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
             damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
-        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel, damper)
+        guide = None
+        if applied is not None:
+            # the sheave of a force-controlled pull: lateral stiffness of the contact law's order at
+            # its working point (1e6 N/m), damped near-critically for the end node's mass
+            guide = Guide(len(cable.nodes) - 1, t_exit, 1.0e6, 2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / c.elements))
+        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel, damper, guide)
     mbs.Assemble()
     model.ode2_index = np.concatenate([
         np.arange(mbs.GetNodeODE2Index(n), mbs.GetNodeODE2Index(n) + 6) for n in cable.nodes])

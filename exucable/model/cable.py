@@ -14,7 +14,12 @@ import numpy as np
 import exudyn as exu
 from exudyn.itemInterface import MarkerBodyMass, NodePointSlope1, ObjectANCFCable, LoadMassProportional
 
-__all__ = ["CableProperties", "CableHandles", "add_cable", "add_gravity"]
+__all__ = ["CableProperties", "CableHandles", "add_cable", "add_gravity", "INTEGRATION"]
+
+# Exudyn's useReducedOrderIntegration. Full Gauss quadrature lets coarse elements on curves carry
+# a saw-tooth of axial force (Example 3 with 40 elements: 43.5 N inside a cable pulled with
+# 40 N); Lobatto quadrature of the axial term removes it (40.6 N) at the same end forces.
+INTEGRATION = {"full": 0, "reduced": 1, "lobatto": 2}
 
 
 @dataclass(frozen=True)
@@ -33,6 +38,8 @@ class CableProperties:
         Axial (Kelvin-Voigt) damping, force per strain rate [N s].
     bending_damping_N_m2_s : float
         Bending damping, moment per curvature rate [N m² s].
+    integration : str
+        ``"full"``, ``"reduced"`` or ``"lobatto"`` quadrature (see ``INTEGRATION``).
     """
 
     mass_per_length_kg_per_m: float
@@ -40,6 +47,7 @@ class CableProperties:
     bending_stiffness_N_m2: float
     axial_damping_N_s: float = 0.0
     bending_damping_N_m2_s: float = 0.0
+    integration: str = "full"
 
 
 @dataclass(frozen=True)
@@ -92,6 +100,7 @@ def add_cable(mbs, coordinates, element_length_m, properties: CableProperties, v
             bendingStiffness=p.bending_stiffness_N_m2,
             axialDamping=p.axial_damping_N_s,
             bendingDamping=p.bending_damping_N_m2_s,
+            useReducedOrderIntegration=INTEGRATION[p.integration],
             visualization={"show": True, "radius": draw_radius_m, "color": [-1.0, -1.0, -1.0, -1.0]},
         ))
         for i in range(len(lengths))

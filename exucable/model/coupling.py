@@ -73,7 +73,7 @@ class ContactCoupling:
         Number of user-function calls.
     """
 
-    def __init__(self, mbs, nodes, reference_coordinates, kernel, startup_damper=None):
+    def __init__(self, mbs, nodes, reference_coordinates, kernel, startup_damper=None, guide=None):
         from ..contact import block_sparsity
 
         self.kernel = kernel
@@ -98,6 +98,12 @@ class ContactCoupling:
             self._rows = (unique // self.n).astype(float)
             self._cols = (unique % self.n).astype(float)
             self._n_unique = unique.size
+        self.guide = guide
+        if guide is not None:
+            i0 = 6 * guide.node_index
+            ii, jj = np.meshgrid(np.arange(i0, i0 + 3), np.arange(i0, i0 + 3), indexing="ij")
+            pos = {int(v): k for k, v in enumerate((self._rows * self.n + self._cols).astype(np.int64))}
+            self._guide_index = np.array([pos[int(a * self.n + b)] for a, b in zip(ii.ravel(), jj.ravel())])
         self.kernel_time_s = 0.0
         self.force_calls = 0
         self.jacobian_calls = 0
@@ -122,9 +128,12 @@ class ContactCoupling:
         res = self.kernel.evaluate(qa, va, jacobian=False)
         self.kernel_time_s += time.perf_counter() - t0
         self.force_calls += 1
+        Q = res.generalized_force
         if self.damper is not None:
-            return res.generalized_force + self.damper.force(t, va)
-        return res.generalized_force
+            Q = Q + self.damper.force(t, va)
+        if self.guide is not None:
+            Q = Q + self.guide.force(np.asarray(q, dtype=float), va)
+        return Q
 
     def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
         qa, va = self.absolute(q, q_t)
@@ -137,6 +146,9 @@ class ContactCoupling:
         vals = np.bincount(self._inverse, weights=blocks.reshape(-1), minlength=self._n_unique)
         if self.damper is not None:
             vals[self._diag_index] -= f_v * self.damper.rate_jacobian_diagonal(t)
+        if self.guide is not None:
+            g = self.guide
+            vals[self._guide_index] += (f_q * g.k + f_v * g.c) * g.P.ravel()
         nz = vals != 0.0  # Exudyn's sparse triplets must not contain zeros
         m = exu.MatrixContainer()
         if nz.any():

@@ -17,7 +17,7 @@ import exudyn as exu
 from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, MarkerNodeCoordinate,
                                   MarkerNodePosition, NodePointGround)
 
-__all__ = ["Drive", "add_drive", "add_end_force", "smooth_ramp", "ramped_displacement"]
+__all__ = ["Drive", "Guide", "add_drive", "add_end_force", "smooth_ramp", "ramped_displacement"]
 
 
 def smooth_ramp(t: float, ramp_time_s: float) -> float:
@@ -85,3 +85,28 @@ def add_end_force(mbs, node: int, force_vector_N, factor: Callable[[float], floa
     return mbs.AddLoad(LoadForceVector(
         markerNumber=m, loadVector=f,
         loadVectorUserFunction=lambda mbs, t, load, fac=factor: [fac(t) * x for x in load]))
+
+
+
+class Guide:
+    """A sheave on the exit tangent for a force-controlled pull: node ``node`` is held near the
+    line through its start position along unit ``direction`` by a stiff lateral spring-damper
+    (force −k·P·u − c·P·v with P = I − d dᵀ, u its displacement), free to move along it.
+
+    Applied through the contact coupling's user function (Exudyn 1.13's
+    ObjectConnectorCoordinateVector enforced only the first of two such rows in our tests)."""
+
+    def __init__(self, node_index: int, direction, stiffness_N_per_m: float, damping_N_s_per_m: float):
+        d = np.asarray(direction, dtype=float)
+        d = d / np.linalg.norm(d)
+        self.node_index = int(node_index)      # index of the node within the cable (0 = trailing)
+        self.P = np.eye(3) - np.outer(d, d)
+        self.k = float(stiffness_N_per_m)
+        self.c = float(damping_N_s_per_m)
+
+    def force(self, q_disp, v) -> np.ndarray:
+        """Generalized force on the cable coordinates (displacements ``q_disp`` from the start)."""
+        Q = np.zeros_like(v)
+        i = 6 * self.node_index
+        Q[i:i + 3] = -self.P @ (self.k * q_disp[i:i + 3] + self.c * v[i:i + 3])
+        return Q
