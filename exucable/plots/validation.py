@@ -1,0 +1,95 @@
+"""The validation figures, one per figure of the paper they reproduce."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .results import save_figure  # noqa: E402
+
+__all__ = ["plot_validation_figures"]
+
+
+def _ends_against_time(ax, res, title):
+    h = res.history
+    ax.plot(h["time_s"], h["pull_force_N"], label="T1 (leading end)")
+    ax.plot(h["time_s"], h["trailing_tension_N"], label="T2 (trailing end)")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("tension [N]")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+
+
+def plot_validation_figures(vr, out) -> list:
+    """Write fig07 … fig14 PNGs for the cases present in ``vr``; returns their paths."""
+    from ..validate import load_reference
+    ref = load_reference()
+    written = []
+    r = vr.runs.get("Ex. 1")
+    if r is not None:
+        fig, ax = plt.subplots(figsize=(7, 4))
+        x = np.asarray(r.tension_profile["s_m"])
+        ax.plot(x, r.tension_profile["tension_N"], ".", ms=3, label="exucable")
+        xs = np.linspace(0, x.max(), 50)
+        ax.plot(xs, ref["example1"]["tension_slope_N_per_m"] * xs, "k-", lw=1, label="Eq. 25")
+        ax.set_xlabel("x from the lower (free) end [m]")
+        ax.set_ylabel("tension [N]")
+        ax.set_title("Fig. 7: tension along the 30° incline (Example 1)")
+        ax.grid(alpha=0.3)
+        ax.legend()
+        save_figure(fig, out / "fig07_ex1_tension_along_incline.png")
+        written.append(out / "fig07_ex1_tension_along_incline.png")
+    for case, name, title, refline in (
+            ("Ex. 2", "fig09_ex2_end_tensions.png", "Fig. 9: end tensions, 90° bend (Example 2)",
+             ("T1 capstan", ref["example2"]["pull_force_N"])),
+            ("Ex. 3", "fig11_ex3_end_tensions.png", "Fig. 11: end tensions, helix (Example 3)",
+             ("T2 capstan", ref["example3"]["back_tension_N"]))):
+        r = vr.runs.get(case)
+        if r is None:
+            continue
+        fig, ax = plt.subplots(figsize=(7, 4))
+        _ends_against_time(ax, r, title)
+        ax.axhline(refline[1], color="k", ls="--", lw=1, label=f"{refline[0]} {refline[1]:.5g} N")
+        ax.legend(fontsize=8)
+        save_figure(fig, out / name)
+        written.append(out / name)
+    if vr.sweep_rows:
+        key = next(k for k in vr.sweep_rows[0] if k.endswith("helix_turns"))
+        n = np.array([float(row[key]) for row in vr.sweep_rows])
+        F = np.array([float(row["pull_force_N"]) if row.get("status") in ("ok", "steady") else np.nan
+                      for row in vr.sweep_rows])
+        order = np.argsort(n)
+        fig, ax = plt.subplots(figsize=(7, 4))
+        nn = np.linspace(0.5, n.max() + 0.5, 100)
+        coils = np.asarray(ref["fig12"]["coils"], dtype=float)
+        law = np.asarray(ref["fig12"]["pull_force_N"], dtype=float)
+        # the law 10 e^(0.1 β(n)), β linear in n: interpolate its logarithm
+        rate = np.polyfit(coils, np.log(law), 1)
+        ax.semilogy(nn, np.exp(np.polyval(rate, nn)), "k-", lw=1, label="10·e^(0.1·β(n))")
+        ax.semilogy(n[order], F[order], "o", label="exucable")
+        ax.set_xlabel("number of coils")
+        ax.set_ylabel("pulling force T1 [N]")
+        ax.set_title("Fig. 12: pulling force against coils (T2 = 10 N, μ = 0.1)")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend()
+        save_figure(fig, out / "fig12_coils.png")
+        written.append(out / "fig12_coils.png")
+    r = vr.runs.get("Ex. 4")
+    if r is not None:
+        fig, ax = plt.subplots(figsize=(7, 4))
+        h = r.history
+        ax.plot(h["time_s"], h["pull_force_N"], label="exucable")
+        rope = r.summary.get("rope_pull_force_N")
+        if rope is not None:
+            ax.axhline(rope, color="k", ls="--", lw=1, label=f"rope solution {rope:.5g} N")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("pulling force [N]")
+        ax.set_title("Fig. 14: pulling force, spatial conduit (Example 4)")
+        ax.grid(alpha=0.3)
+        ax.legend()
+        save_figure(fig, out / "fig14_ex4_pull_force.png")
+        written.append(out / "fig14_ex4_pull_force.png")
+    return written
