@@ -139,3 +139,24 @@ def test_smooth_wall_reports_exact_arc_length():
     pts = cond.centreline.point(dense)
     for p, s in zip(st.position_m, st.s_conduit_m):
         assert abs(dense[np.argmin(np.sum((pts - p) ** 2, axis=1))] - s) < 1e-5
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_open_ends_do_not_hide_contact_behind_the_start_plane(backend):
+    """A U-turn route whose return leg runs behind the first segment's start plane: points there
+    are far from the open end and must still touch the wall, with or without the broad phase
+    (regression: the open-end test was once made per candidate segment, so the brute-force search
+    dropped them)."""
+    c = centreline_from_path([0, 0, 0], [1, 0, 0], [Straight(1.0), Bend(180, 0.3, "left"), Straight(1.6)])
+    cond = Conduit.build(R_CONDUIT, c, segments_per_bend=20)
+    s_nodes = np.linspace(c.length_m - 1.2, c.length_m - 0.1, 6)   # on the return leg, x < 0 partly
+    q, q_t = cable_on_offset_curve(cond, s_nodes, lambda s, t: np.tile([0.0, 0.0, -1.0], (len(s), 1)),
+                                   GAP + 2e-4)
+    L = np.diff(s_nodes)
+    res = {}
+    for bp in ("aabb", "none"):
+        k = ContactKernel(cond.segments, L, R_CABLE, LAW, 8, backend=backend, broad_phase=bp,
+                          surface="smooth", centreline=c)
+        res[bp] = k.evaluate(q, q_t)
+        assert res[bp].n_in_contact == 5 * 8
+    np.testing.assert_array_equal(res["aabb"].generalized_force, res["none"].generalized_force)

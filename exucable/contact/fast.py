@@ -60,7 +60,8 @@ _FX = 31  # rows 31..33: force F on the cable [N]
 _MVX, _MTX = 34, 37  # rows 34..36: M v, rows 37..39: M v_τ (M = ∂n/∂P)
 _KD, _WC, _FM, _C2, _GV, _MUS = 40, 41, 42, 43, 44, 45  # scalar factors of the Jacobian
 _J0 = 46  # rows 46..63: ∂F/∂P (9, row-major) then ∂F/∂v (9)
-_ROWS = 64
+_BEYOND = 64  # 1 where the nearest segment is an open end's and the point lies past it
+_ROWS = 65
 
 
 @njit(inline="always", **_JIT)
@@ -86,7 +87,7 @@ def _positions(q, b, le, n1, n2, n3, n4, px, py, pz):
 
 @njit(inline="always", **_JIT)
 def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_in, ay_in,
-                      az_in, open_first, open_last):
+                      az_in, open_first, open_last, beyond):
     """Narrow phase of one element: nearest candidate segment of every check point.
 
     Projection parameter clamped to the segment (a point beyond a kink's outer side sees the
@@ -94,6 +95,8 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
     increasing candidate order keeps the lower segment index on ties, as the numpy reference.
     A point beyond the conduit's open ends (before segment ``open_first``'s start or past
     segment ``open_last``'s end; -1 = closed) is outside the conduit: it gets d² = 0, no contact.
+    That is decided after the search, on the nearest segment by true distance: a point far from
+    the ends may well lie behind the first segment's start plane.
     """
     n_k = px.shape[0]
     for k in range(n_k):
@@ -105,6 +108,7 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
         ax_in[k] = 0.0
         ay_in[k] = 0.0
         az_in[k] = 0.0
+        beyond[k] = 0.0
     for c in range(c0, c1):
         s = cand[c]
         sax = seg[s, 0]
@@ -136,7 +140,7 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
             ey = dy if low else ey
             ez = dz if low else ez
             d2 = ex * ex + ey * ey + ez * ez
-            d2 = 0.0 if ((low & end0) | (high & end1)) else d2
+            past = 1.0 if ((low & end0) | (high & end1)) else 0.0
             inside = 0.0 if (low | high) else 1.0
             if d2 < best[k]:  # strict: ties keep the lower segment index
                 best[k] = d2
@@ -147,6 +151,9 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
                 ax_in[k] = inside * ax
                 ay_in[k] = inside * ay
                 az_in[k] = inside * az
+                beyond[k] = past
+    for k in range(n_k):
+        best[k] = 0.0 if beyond[k] != 0.0 else best[k]
 
 
 @njit(inline="always", **_JIT)
@@ -233,7 +240,7 @@ def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open
         _positions(q, 6 * e, length[e], n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])
         _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, off[e], off[e + 1],
                           tab[_BEST], nearest[e], tab[_RX], tab[_RY], tab[_RZ], tab[_AX],
-                          tab[_AY], tab[_AZ], open_first, open_last)
+                          tab[_AY], tab[_AZ], open_first, open_last, tab[_BEYOND])
 
 
 @njit(**_JIT)
@@ -255,7 +262,7 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])  # Eq. 2
         _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
                           tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ],
-                          open_first, open_last)
+                          open_first, open_last, tab[_BEYOND])
         if smooth:
             _refine_smooth(tab[_PX], tab[_PY], tab[_PZ], seg, sel, tab[_BEST], tab[_RX], tab[_RY],
                            tab[_RZ], tab[_AX], tab[_AY], tab[_AZ], seg_piece, pieces, seg_phi,

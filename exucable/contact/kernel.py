@@ -188,12 +188,13 @@ def _nearest(p, cand, seg_start, seg_end, seg_axis, seg_length, open_first=-1, o
     ey = np.where(low, dy, np.where(high, p[:, None, 1] - end[None, :, 1], dy - t * a[None, :, 1]))
     ez = np.where(low, dz, np.where(high, p[:, None, 2] - end[None, :, 2], dz - t * a[None, :, 2]))
     d2 = ex * ex + ey * ey + ez * ez
-    # beyond an open end of the conduit: outside it, no contact (d² = 0, as the compiled kernel)
-    beyond = (low & (cand == open_first)[None, :]) | (high & (cand == open_last)[None, :])
-    d2 = np.where(beyond, 0.0, d2)
     j = np.argmin(d2, axis=1)  # first minimum: ties keep the lower segment index
     rows = np.arange(p.shape[0])
     residual = np.stack([ex[rows, j], ey[rows, j], ez[rows, j]], axis=1)
+    # nearest to an open end's segment and past it: outside the conduit, no contact (residual 0,
+    # as the compiled kernel). Decided on the nearest segment: a point far from the ends may well
+    # lie behind the first segment's start plane.
+    beyond = (low & (cand == open_first)[None, :]) | (high & (cand == open_last)[None, :])
     residual[beyond[rows, j]] = 0.0
     t_clamped = np.clip(t[rows, j], 0.0, length[0, j])
     return cand[j], t_clamped, residual, inside[rows, j]
