@@ -22,12 +22,13 @@ from .tension import detect_steady_state, tension_profile
 __all__ = ["run_scenario", "contact_profile", "add_arguments", "main"]
 
 
-def contact_profile(model, bins: int = 2000) -> tuple[dict, float] | tuple[None, float]:
+def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
     """Sidewall bearing pressure along the conduit at the current state.
 
-    Returns the binned profile (``s_m`` along the scenario's conduit, normal force per unit length
-    [N/m] = Σ f_n in a bin / bin width, largest penetration [m] in the bin) and the largest
-    per-check-point pressure [N/m].
+    One row per check point in contact order of ``s`` along the scenario's conduit (normal force
+    per unit length [N/m] = the point's force over its share of the element, penetration [m]);
+    beyond ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
+    penetration: max). Also returns the largest per-point pressure [N/m].
     """
     if model.kernel is None:
         return None, 0.0
@@ -35,22 +36,20 @@ def contact_profile(model, bins: int = 2000) -> tuple[dict, float] | tuple[None,
     pts = model.kernel.points(q.reshape(-1), v.reshape(-1))
     L = model.conduit.centreline.length_m
     s = np.asarray(pts.s_conduit_m, dtype=float)
+    keep = np.isfinite(s) & (s >= 0.0) & (s <= L)
     if model.scenario.pull.direction == "reverse":
         s = L - s   # report along the scenario's own conduit
-    fn = np.asarray(pts.normal_force_N, dtype=float)
-    pen = np.asarray(pts.penetration_m, dtype=float)
-    edges = np.linspace(0.0, L, bins + 1)
-    idx = np.clip(np.searchsorted(edges, s, side="right") - 1, 0, bins - 1)
-    force = np.bincount(idx, weights=fn, minlength=bins)
-    pmax = np.full(bins, -np.inf)
-    np.maximum.at(pmax, idx, pen)
-    pmax[~np.isfinite(pmax)] = 0.0
-    width = L / bins
-    centres = 0.5 * (edges[1:] + edges[:-1])
-    per_point = np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)
-    peak = float(per_point.max()) if per_point.size else 0.0
-    return ({"s_m": centres, "normal_force_per_length_N_per_m": force / width,
-             "penetration_m": np.maximum(pmax, 0.0)}, peak)
+    order = np.argsort(s[keep])
+    s = s[keep][order]
+    p = np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order]
+    pen = np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)
+    peak = float(p.max()) if p.size else 0.0
+    if s.size > max_rows:
+        groups = np.array_split(np.arange(s.size), max_rows)
+        s = np.array([s[g].mean() for g in groups])
+        p = np.array([p[g].mean() for g in groups])
+        pen = np.array([pen[g].max() for g in groups])
+    return {"s_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
 
 
 def _versions() -> dict:

@@ -1,0 +1,91 @@
+"""`exucable run` end to end: result files, failures reported with their time, bad input refused."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from exucable.errors import ModelError, ScenarioError
+from exucable.model.build import build_model
+from exucable.results import read_csv
+from exucable.run import run_scenario
+
+from conftest import ROOT, make_scenario
+
+
+def test_run_writes_the_documented_results(tmp_path):
+    res = run_scenario(ROOT / "scenarios/fast/paper_ex1_incline.toml", tmp_path, quiet=True)
+    s = json.loads((tmp_path / "summary.json").read_text())
+    for key in ("pull_force_N", "pull_force_std_N", "trailing_tension_N", "max_tension_N", "steady_from_s",
+                "steps", "wall_time_s", "rope_pull_force_N", "max_sidewall_pressure_N_per_m", "scenario",
+                "versions"):
+        assert key in s, key
+    assert s["versions"]["exudyn"].startswith("1.13")
+    assert s["scenario"]["contact"]["friction"] == 0.3          # echoed with defaults filled in
+    assert list(read_csv(tmp_path / "history.csv")) == ["time_s", "pull_force_N", "trailing_tension_N",
+                                                         "max_tension_N"]
+    assert list(read_csv(tmp_path / "tension_profile.csv")) == ["s_m", "tension_N"]
+    contact = read_csv(tmp_path / "contact_profile.csv")
+    assert list(contact) == ["s_m", "normal_force_per_length_N_per_m", "penetration_m"]
+    # the sidewall pressure of a cable resting on an incline is w·cos θ (1e-3: binning at the ends)
+    w = 1000 * np.pi * 0.0025**2 * 9.8
+    mid = (contact["s_m"] > 10) & (contact["s_m"] < 40)
+    np.testing.assert_allclose(contact["normal_force_per_length_N_per_m"][mid], w * np.cos(np.pi / 6), rtol=1e-3)
+    for png in ("pull_force.png", "tension_profile.png"):
+        assert (tmp_path / png).stat().st_size > 5000
+    assert not list(tmp_path.glob(".*.tmp"))                   # atomic writes leave no temp files
+    assert res.summary["status"] in ("ok", "steady")
+
+
+def test_solver_failure_is_reported_with_its_time_and_keeps_results(tmp_path):
+    """One Newton iteration and no room to cut the step: the solve fails; the run still writes
+    what it has, says where it failed, and the CLI exits non-zero with that message."""
+    sc = make_scenario(pull={"speed": 0.1, "back_tension": 150.0},
+                       conduit={"inner_radius": 0.0035, "path": [{"straight": 0.5}, {"bend": 90, "radius": 0.5, "turn": "left"}]},
+                       solver={"end_time": 0.2, "step": 0.01, "min_step": 0.01, "newton_max_iterations": 1})
+    res = run_scenario(sc, tmp_path, quiet=True)
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["status"] == "failed" and s["message"]
+    assert 0.0 <= s["failed_at_s"] < 0.2
+    assert (tmp_path / "history.csv").exists() and (tmp_path / "tension_profile.csv").exists()
+    assert res.summary["status"] == "failed"
+
+
+@pytest.mark.parametrize("tables, key", [
+    ({"cable": dict(radius=0.0025, density=1000.0, youngs_modulus=1e9, elements=10, length=5.0)}, "cable.length"),
+    ({"pull": {"speed": 0.0}}, "pull.speed"),
+    ({"solver": {"end_time": 0.2, "step": -0.01}}, "solver.step"),
+    ({"conduit": {"inner_radius": 0.002, "path": [{"straight": 1.0}]}}, "conduit.inner_radius"),
+])
+def test_bad_model_input_is_refused_naming_the_key(tables, key):
+    with pytest.raises(ScenarioError) as e:
+        make_scenario(**tables)
+    assert e.value.key == key
+
+
+def test_elements_too_long_for_the_tightest_bend_are_refused():
+    sc = make_scenario(cable=dict(radius=0.0025, density=1000.0, youngs_modulus=1e9, elements=2),
+                       conduit={"inner_radius": 0.0035, "path": [{"straight": 0.5}, {"bend": 90, "radius": 0.3, "turn": "left"}]})
+    with pytest.raises(ModelError) as e:
+        build_model(sc)
+    assert e.value.key == "cable.elements" and "at least" in str(e.value)
+
+
+def test_cli_reports_user_errors_without_traceback(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((ROOT / "scenarios/fast/paper_ex2_bend90.toml").read_text().replace("radius = 0.5", "radius = -0.5"))
+    p = subprocess.run([sys.executable, "-m", "exucable", "run", str(bad), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True)
+    assert p.returncode == 2
+    assert "conduit.path[1].radius" in p.stderr and "Traceback" not in p.stderr
+
+
+def test_cli_lists_every_subcommand():
+    p = subprocess.run([sys.executable, "-m", "exucable", "--help"], capture_output=True, text=True)
+    assert p.returncode == 0
+    for cmd in ("route", "run", "validate", "sweep", "compare"):
+        assert cmd in p.stdout
