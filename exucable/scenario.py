@@ -219,6 +219,9 @@ class ContactSpec:
         Each check point's force is scaled by (its share of the element length) / this [m].
     broad_phase : str
         ``"aabb"`` (paper Sect. 2.5) or ``"none"``.
+    damping_onset_m : float
+        Penetration over which the contact damping grows from zero [m] (default 1e-5; 0: the
+        paper's Eq. 18, whose damping force jumps to C δ̇ at first touch).
     surface : str
         ``"smooth"``: closest points on the exact bends and helices (default);
         ``"segments"``: on the straight segments, as the paper (see exucable.contact.smooth).
@@ -236,6 +239,7 @@ class ContactSpec:
     reference_spacing_m: float
     broad_phase: str
     surface: str = "smooth"
+    damping_onset_m: float = 1.0e-5
 
     def to_dict(self) -> dict:
         """The ``[contact]`` table in TOML key names, defaults filled in."""
@@ -255,6 +259,7 @@ class ContactSpec:
             reference_spacing=self.reference_spacing_m,
             broad_phase=self.broad_phase,
             surface=self.surface,
+            damping_onset=self.damping_onset_m,
         )
         return d
 
@@ -969,7 +974,7 @@ def _parse_contact(data) -> ContactSpec:
         {
             "stiffness", "damping", "exponent", "friction", "static_friction", "stribeck_velocity",
             "friction_regularisation_velocity", "check_points_per_element", "check_point_rule",
-            "reference_spacing", "broad_phase", "surface",
+            "reference_spacing", "broad_phase", "surface", "damping_onset",
         },
     )
     friction = t.number("friction", "", default=0.0, ge=0.0)
@@ -994,6 +999,7 @@ def _parse_contact(data) -> ContactSpec:
         reference_spacing_m=t.number("reference_spacing", "m", default=1.0e-3, gt=0.0),
         broad_phase=t.choice("broad_phase", ("aabb", "none"), default="aabb"),
         surface=t.choice("surface", ("smooth", "segments"), default="smooth"),
+        damping_onset_m=t.number("damping_onset", "m", default=1.0e-5, ge=0.0),
     )
 
 

@@ -44,7 +44,7 @@ def test_resting_cable_carries_its_weight_on_the_wall(pulled_straight):
     L = model.layout.element_length_m.sum()
     # the rig's multiplier is minus its force on the node
     assert pts.normal_force_N.sum() - rig[2] == pytest.approx(W * L, rel=1e-6)
-    mid = (pts.s_conduit_m > 1.0) & (pts.s_conduit_m < 5.0)
+    mid = (pts.s_conduit_m > 1.0) & (pts.s_conduit_m < 4.5)   # away from the ends
     delta = (W * 1e-3 / 1.0e6) ** (1 / 1.5)
     np.testing.assert_allclose(pts.penetration_m[mid], delta, rtol=1e-4)
     # the force also carries the contact damping C·δ̇ of that residual motion (≤ 1e-3 here)

@@ -61,7 +61,8 @@ _MVX, _MTX = 34, 37  # rows 34..36: M v, rows 37..39: M v_τ (M = ∂n/∂P)
 _KD, _WC, _FM, _C2, _GV, _MUS = 40, 41, 42, 43, 44, 45  # scalar factors of the Jacobian
 _J0 = 46  # rows 46..63: ∂F/∂P (9, row-major) then ∂F/∂v (9)
 _BEYOND = 64  # 1 where the nearest segment is an open end's and the point lies past it
-_ROWS = 65
+_RAMP, _DRAMP = 65, 66  # damping onset g(δ) and dg/dδ
+_ROWS = 67
 
 
 @njit(inline="always", **_JIT)
@@ -247,7 +248,7 @@ def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open
 def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, off, cand,
                     gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
                     inv_href, jacobian, force, jq, jqt, tab, sel, acc, open_first, open_last,
-                    smooth, seg_piece, pieces, seg_phi, n_newton):
+                    smooth, seg_piece, pieces, seg_phi, n_newton, inv_onset):
     """Generalized contact force and its 12×12 Jacobian blocks; returns (n_in_contact, max δ)."""
     n_k = n1.shape[0]
     n_contact = 0
@@ -273,7 +274,7 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         n_contact += n_touch
         _positions(qt, b, le, n1, n2, n3, n4, tab[_VX], tab[_VY], tab[_VZ])  # Eq. 8
         _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
-                      exponent_mode)
+                      exponent_mode, inv_onset)
         _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
         # Q_e = Σ S(ξ)ᵀ F (slope rows carry the factor L)
         fxr = tab[_FX]
@@ -341,7 +342,8 @@ def _normals(tab, n_k, gap, max_d2):
 
 
 @njit(inline="always", **_JIT)
-def _normal_force(tab, omega, n_k, weight_scale, stiffness, damping, exponent, exponent_mode):
+def _normal_force(tab, omega, n_k, weight_scale, stiffness, damping, exponent, exponent_mode,
+                  inv_onset):
     """v_n, v_τ (Eqs. 16-17) and the weighted normal force w·max(0, K δ^e + C δ̇) (Eq. 18)."""
     nx = tab[_NX]
     ny = tab[_NY]
@@ -374,9 +376,21 @@ def _normal_force(tab, omega, n_k, weight_scale, stiffness, damping, exponent, e
         for k in range(n_k):
             fr[k] = delta[k] ** exponent
             ddr[k] = exponent * delta[k] ** (exponent - 1.0)
+    rr = tab[_RAMP]
+    drr = tab[_DRAMP]
+    if inv_onset > 0.0:  # damping onset g = min(δ/δ_d, 1)
+        for k in range(n_k):
+            x = delta[k] * inv_onset
+            below = x < 1.0
+            rr[k] = x if below else 1.0
+            drr[k] = inv_onset if below else 0.0
+    else:
+        for k in range(n_k):
+            rr[k] = 1.0
+            drr[k] = 0.0
     for k in range(n_k):
         vn = nx[k] * vx[k] + ny[k] * vy[k] + nz[k] * vz[k]  # Eq. 16, = δ̇
-        raw = stiffness * fr[k] + damping * vn  # Eq. 18
+        raw = stiffness * fr[k] + damping * rr[k] * vn  # Eq. 18 (with the damping onset)
         # weight w = L ω / h_ref; 0 out of contact or where the force would pull
         w_act = weight_scale * omega[k] * touch[k] if raw > 0.0 else 0.0
         tx = vx[k] - vn * nx[k]  # Eq. 17
@@ -495,11 +509,13 @@ def _point_jacobians(tab, n_k, stiffness, damping):
     c2r = tab[_C2]
     gvr = tab[_GV]
     musr = tab[_MUS]
+    rr = tab[_RAMP]
+    drr = tab[_DRAMP]
     for k in range(n_k):  # scalar factors
         sr = srr[k]
         cg = fr[k] * (dmur[k] / sr - 0.5 * mur[k] / (sr * sr * sr))
-        kdr[k] = wr[k] * stiffness * ddr[k]
-        wcr[k] = wr[k] * damping
+        kdr[k] = wr[k] * (stiffness * ddr[k] + damping * drr[k] * vnr[k])
+        wcr[k] = wr[k] * damping * rr[k]
         fmr[k] = fr[k] - hfr[k] * vnr[k]
         c2r[k] = -2.0 * vnr[k] * cg
         gvr[k] = 2.0 * cg
@@ -752,7 +768,7 @@ class FastKernel:
             1.0 / law.stribeck_velocity_m_per_s**2, law.regularisation_velocity_m_per_s**2,
             self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc,
             self.open_first, self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
-            NEWTON_ITERATIONS)
+            NEWTON_ITERATIONS, 1.0 / law.damping_onset_m if law.damping_onset_m > 0.0 else 0.0)
         if not jacobian:
             jq = jqt = None
         return force, jq, jqt, int(n_contact), float(max_pen)

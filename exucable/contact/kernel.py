@@ -32,7 +32,7 @@ from ..geometry.segments import Segments
 from .broadphase import candidates_all_pairs, candidates_all_segments, element_aabbs
 from .smooth import SmoothWall, refine_closest_points
 from .checkpoints import check_points, hermite_unit
-from .law import ContactLaw, friction_coefficient
+from .law import ContactLaw, damping_ramp, friction_coefficient
 
 __all__ = [
     "ContactKernel",
@@ -232,10 +232,12 @@ def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian):
     vt_ = v[touch]
     vn = np.sum(n * vt_, axis=1)  # Eq. 16
     dl = delta[touch]
-    raw = law.stiffness * dl**law.exponent + law.damping * vn  # Eq. 18
+    ramp, dramp = damping_ramp(law, dl)
+    raw = law.stiffness * dl**law.exponent + law.damping * ramp * vn  # Eq. 18 (with the onset)
     act = raw > 0.0
     idx = touch[act]
     n, vt_, vn, dl, dt, raw = n[act], vt_[act], vn[act], dl[act], dt[act], raw[act]
+    ramp, dramp = ramp[act], dramp[act]
     wt = w[idx]
     f = wt * raw
     tau = vt_ - vn[:, None] * n  # Eq. 17
@@ -258,9 +260,10 @@ def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian):
     mmat = (proj - nn) / dt[:, None, None]  # ∂n/∂P
     mv = np.einsum("kij,kj->ki", mmat, vt_)
     mt = np.einsum("kij,kj->ki", mmat, tau)
-    df_dp = wt[:, None] * (law.stiffness * law.exponent * dl[:, None] ** (law.exponent - 1.0) * n
-                           + law.damping * mv)
-    df_dv = (wt * law.damping)[:, None] * n
+    df_dp = wt[:, None] * ((law.stiffness * law.exponent * dl ** (law.exponent - 1.0)
+                            + law.damping * dramp * vn)[:, None] * n
+                           + (law.damping * ramp)[:, None] * mv)
+    df_dv = (wt * law.damping * ramp)[:, None] * n
     dtau_dp = -n[:, :, None] * mv[:, None, :] - vn[:, None, None] * mmat
     dtau_dv = eye - nn
     dg_dp = -2.0 * vn[:, None] * mt

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ContactLaw", "normal_force_magnitude", "friction_coefficient"]
+__all__ = ["ContactLaw", "normal_force_magnitude", "friction_coefficient", "damping_ramp"]
 
 
 @dataclass(frozen=True)
@@ -39,6 +39,10 @@ class ContactLaw:
     regularisation_velocity_m_per_s : float
         Friction regularisation velocity ε [m/s]: the friction direction is v_τ/√(|v_τ|² + ε²)
         instead of v_τ/|v_τ| (Eq. 20), so the force is smooth through zero sliding speed.
+    damping_onset_m : float
+        Penetration δ_d [m] over which the damping term grows from 0 to C_n δ̇:
+        f_n = K_n δ^e + C_n min(δ/δ_d, 1) δ̇. 0 (default) is the paper's Eq. 18, whose damping
+        force jumps to C_n δ̇ at first touch.
     """
 
     stiffness: float
@@ -48,6 +52,7 @@ class ContactLaw:
     static_friction: float | None = None
     stribeck_velocity_m_per_s: float = 1e-2
     regularisation_velocity_m_per_s: float = 1e-3
+    damping_onset_m: float = 0.0
 
     def __post_init__(self):
         # The kernel is below the scenario layer, which reports bad user input with its own
@@ -60,6 +65,7 @@ class ContactLaw:
             ("stribeck_velocity_m_per_s", self.stribeck_velocity_m_per_s > 0.0, "must be > 0"),
             ("regularisation_velocity_m_per_s", self.regularisation_velocity_m_per_s > 0.0,
              "must be > 0"),
+            ("damping_onset_m", self.damping_onset_m >= 0.0, "must be >= 0"),
         ]
         for name, ok, message in checks:
             value = getattr(self, name)
@@ -98,8 +104,18 @@ def normal_force_magnitude(law: ContactLaw, penetration_m, penetration_rate_m_pe
     delta = np.asarray(penetration_m, dtype=float)
     rate = np.asarray(penetration_rate_m_per_s, dtype=float)
     touching = delta > 0.0
-    raw = law.stiffness * np.where(touching, delta, 0.0) ** law.exponent + law.damping * rate
+    d = np.where(touching, delta, 0.0)
+    raw = law.stiffness * d ** law.exponent + law.damping * damping_ramp(law, d)[0] * rate
     return np.where(touching & (raw > 0.0), raw, 0.0)
+
+
+def damping_ramp(law: ContactLaw, penetration_m):
+    """(g, dg/dδ) of the damping onset g(δ) = min(δ/δ_d, 1); (1, 0) for the paper's law (δ_d = 0)."""
+    d = np.asarray(penetration_m, dtype=float)
+    if law.damping_onset_m <= 0.0:
+        return np.ones_like(d), np.zeros_like(d)
+    ramp = d < law.damping_onset_m
+    return np.where(ramp, d / law.damping_onset_m, 1.0), np.where(ramp, 1.0 / law.damping_onset_m, 0.0)
 
 
 def friction_coefficient(law: ContactLaw, sliding_speed_squared):

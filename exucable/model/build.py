@@ -15,7 +15,7 @@ from ..errors import ModelError
 from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, contact_offsets, lay_cable
-from .rig import Drive, Guide, add_drive, add_end_force, smooth_ramp
+from .rig import Drive, Guide, add_drive, add_end_force, add_tangential_drive, smooth_ramp
 
 __all__ = ["Model", "build_model", "pull_oriented_conduit"]
 
@@ -176,7 +176,10 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     else:
         applied = sc.pull.force_N
         add_end_force(mbs, cable.nodes[-1], applied * t_exit, factor)
-        trail_drive = add_drive(mbs, cable.nodes[0], t_entry, speed, ramp_time)
+        if ramp_time > 0.0:
+            trail_drive = add_drive(mbs, cable.nodes[0], t_entry, speed, ramp_time)
+        else:
+            trail_drive = add_tangential_drive(mbs, cable.nodes[0], t_entry, speed)
 
     model = Model(scenario=sc, system_container=SC, mbs=mbs, conduit=conduit, cable=cable, layout=layout,
                   properties=props, lead_drive=lead_drive, trail_drive=trail_drive,
@@ -187,7 +190,8 @@ def build_model(scenario, with_contact: bool = True) -> Model:
         ct = sc.contact
         law = ContactLaw(stiffness=ct.stiffness, damping=ct.damping, exponent=ct.exponent, friction=ct.friction,
                          static_friction=ct.static_friction, stribeck_velocity_m_per_s=ct.stribeck_velocity_m_per_s,
-                         regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s)
+                         regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s,
+                         damping_onset_m=ct.damping_onset_m)
         kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
                                ct.check_points_per_element, rule=ct.check_point_rule,
                                reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
