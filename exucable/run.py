@@ -16,7 +16,7 @@ from . import __version__
 from .errors import ExucableError
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
-from .solve import Progress, simulate
+from .solve import Progress, simulate, steady_quantity
 from .tension import detect_steady_state, tension_profile
 
 __all__ = ["run_scenario", "contact_profile", "add_arguments", "main"]
@@ -78,7 +78,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     out = simulate(model, progress=progress, steady_stop=steady_stop)
     h = out.history.arrays()
     sp = sc.solver
-    st = detect_steady_state(h["time_s"], h["pull_force_N"], sp.steady_window_s, sp.steady_tolerance)
+    st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
     i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
@@ -88,9 +88,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "name": sc.name,
         "status": out.status,
         "message": out.message,
-        "pull_force_N": st.mean_N,
-        "pull_force_std_N": st.std_N,
-        "pull_force_drift_N": st.drift_N,
+        "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+        "steady_quantity": steady_quantity(model),
+        "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
         "max_tension_N": float(np.max(h["max_tension_N"][i0:])) if len(h["time_s"]) else None,
         "steady": st.steady,
@@ -148,9 +149,12 @@ def main(args) -> int:
     print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
           f"(± {_f(s['pull_force_std_N'], '.2g')}), trailing tension {_f(s['trailing_tension_N'])} N, "
           f"max tension {_f(s['max_tension_N'])} N")
-    if rope is not None and s["pull_force_N"] is not None and np.isfinite(s["pull_force_N"]):
-        print(f"  rope reference: pulling force {rope:.6g} N "
-              f"({100 * (s['pull_force_N'] / rope - 1):+.3f} %)")
+    if s["steady_quantity"] == "trailing_tension_N":     # force-controlled: T2 is the result
+        ref, got, what = s.get("rope_trailing_tension_N"), s["trailing_tension_N"], "trailing tension"
+    else:
+        ref, got, what = rope, s["pull_force_N"], "pulling force"
+    if ref is not None and got is not None and np.isfinite(got):
+        print(f"  rope reference: {what} {ref:.6g} N ({100 * (got / ref - 1):+.3f} %)")
     print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
           f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")

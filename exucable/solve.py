@@ -17,7 +17,7 @@ import exudyn as exu
 
 from .tension import detect_steady_state, tension_at, tension_profile
 
-__all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "Progress"]
+__all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "Progress"]
 
 
 @dataclass
@@ -101,6 +101,12 @@ def solver_settings(solver_spec) -> exu.SimulationSettings:
     return s
 
 
+def steady_quantity(model) -> str:
+    """The history column whose steadiness ends a run: the pulling force, or for a
+    force-controlled pull (whose pulling force is given) the trailing tension."""
+    return "trailing_tension_N" if model.applied_pull_force_N is not None else "pull_force_N"
+
+
 def record_state(model, t: float, history: History) -> None:
     """Append the current pulling force, trailing tension and maximum tension to ``history``."""
     q, _ = model.coordinates()
@@ -138,8 +144,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
             if progress is not None:
                 progress.update(t, f"F = {history.pull_force_N[-1]:.4g} N")
             if steady_stop and t >= sp.steady_window_s:
-                st = detect_steady_state(history.time_s, history.pull_force_N, sp.steady_window_s,
-                                         sp.steady_tolerance)
+                st = detect_steady_state(history.time_s, getattr(history, steady_quantity(model)),
+                                         sp.steady_window_s, sp.steady_tolerance)
                 if st.steady:
                     stopped_steady[0] = True
                     return False

@@ -502,9 +502,11 @@ def test_paper_example_parameters():
     ex3 = load_scenario(SCENARIOS / "paper_ex3_helix.toml")
     assert ex3.gravity is None and ex3.pull.force_N == 40.0 and ex3.contact.friction == 0.1
     assert (ex3.cable.elements, ex3.contact.check_points_per_element) == (80, 500)
-    assert ex3.build_conduit().segments.count == 200
-    # helix length: 2 coils of sqrt((2 pi a)^2 + p^2), a = 1 m, p = 0.05 m
-    assert ex3.cable_length_m == pytest.approx(2 * math.hypot(2 * math.pi, 0.05), rel=1e-12)
+    assert ex3.build_conduit().segments.count == 200 + 1          # the helix's 200 + the lead-in
+    # lead-in 0.5 m + helix: 2 coils of sqrt((2 pi a)^2 + p^2), a = 1 m, p = 0.05 m
+    assert ex3.cable_length_m == pytest.approx(0.5 + 2 * math.hypot(2 * math.pi, 0.05), rel=1e-12)
+    # the lead-in is tangent-continuous with the helix
+    assert ex3.build_conduit().centreline.tangent_jumps_rad().max() < 1e-9
 
     ex4 = load_scenario(SCENARIOS / "paper_ex4_spatial.toml")
     kinds = [type(p).__name__ for p in ex4.conduit.path]
