@@ -38,7 +38,10 @@ def plot_pull_force(path, result) -> None:
         ax.axvspan(t0, h["time_s"][-1], color="g", alpha=0.08, label="steady window")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("force [N]")
-    ax.set_title(f"{s.get('name', '')}: pulling force {s.get('pull_force_N', float('nan')):.4g} N")
+    pull = s.get("pull_force_N")
+    status = "" if s.get("status") != "failed" else f" (FAILED at t = {s.get('failed_at_s', float('nan')):.4g} s)"
+    ax.set_title(f"{s.get('name', '')}: pulling force "
+                 f"{'n/a' if pull is None else format(pull, '.4g')} N{status}")
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     save_figure(fig, path)
