@@ -94,7 +94,7 @@ def test_zip_unset_and_set_build_fig12_cases():
     for n, case in enumerate(sw.cases, start=1):
         sc = case.scenario
         assert sc.pull.force_N is None and sc.pull.back_tension_N == 10.0
-        assert sc.conduit.path[1].turns == n and sc.cable.elements == 20 * n
+        assert sc.conduit.path[1].turns == n and sc.cable.elements == 30 * n
     full = load_sweep(ROOT / "scenarios" / "sweeps" / "paper_fig12_coils.toml")
     assert [c.scenario.conduit.path[1].turns for c in full.cases] == [1, 2, 3, 4, 5]
     ex2 = load_sweep(ROOT / "scenarios" / "sweeps" / "ex2_friction.toml")
