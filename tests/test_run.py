@@ -89,3 +89,14 @@ def test_cli_lists_every_subcommand():
     assert p.returncode == 0
     for cmd in ("route", "run", "validate", "sweep", "compare"):
         assert cmd in p.stdout
+
+
+@pytest.mark.parametrize("name", ["paper_ex1_incline", "paper_ex2_bend90", "paper_ex3_helix", "paper_ex4_spatial"])
+def test_route_draws_each_paper_scenario(name, tmp_path):
+    png = tmp_path / f"{name}.png"
+    p = subprocess.run([sys.executable, "-m", "exucable", "route", str(ROOT / "scenarios" / f"{name}.toml"),
+                        "-o", str(png)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert png.stat().st_size > 10000
+    for row in ("length", "turning", "segments", "bend radius"):
+        assert row in p.stdout.lower(), p.stdout
