@@ -189,16 +189,45 @@ def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, 
         a = pieces[pi, 12]
         h = pieces[pi, 13]
         big_phi = pieces[pi, 14]
-        for _ in range(n_newton):
+        if h == 0.0:
+            # a bend: the closest point is in the direction of P's projection, no iteration;
+            # the angle (for the range test only) unwrapped next to the chord's estimate
+            rho = math.sqrt(x1 * x1 + x2 * x2)
+            ang = math.atan2(x2, x1)
+            phi = phi + ((ang - phi + math.pi) % (2.0 * math.pi) - math.pi)
+            inside = 0.0 <= phi <= big_phi
+            if inside:
+                cs = x1 / rho
+                sn = x2 / rho
+                phic = phi
+            else:
+                phic = min(max(phi, 0.0), big_phi)
+                cs = math.cos(phic)
+                sn = math.sin(phic)
+        else:
+            # Newton on the helix angle; the steps are tiny (the chord's estimate is close), so
+            # cos/sin are carried along by rotating with the series of the step (error < 1e-14
+            # for |Δφ| < 1e-2) instead of being recomputed: 2 trigonometric calls per point
             cs = math.cos(phi)
             sn = math.sin(phi)
-            g = -(a * (-sn * x1 + cs * x2) + h * (xk - h * phi))
-            dg = a * (cs * x1 + sn * x2) + h * h
-            phi = phi - g / dg
-        inside = 0.0 <= phi <= big_phi
-        phic = min(max(phi, 0.0), big_phi)
-        cs = math.cos(phic)
-        sn = math.sin(phic)
+            for _ in range(n_newton):
+                g = -(a * (-sn * x1 + cs * x2) + h * (xk - h * phi))
+                dg = a * (cs * x1 + sn * x2) + h * h
+                dphi = -g / dg
+                phi = phi + dphi
+                if abs(dphi) < 1e-2:
+                    d2 = dphi * dphi
+                    c_d = 1.0 - d2 * (0.5 - d2 / 24.0)
+                    s_d = dphi * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0))
+                    cs, sn = cs * c_d - sn * s_d, sn * c_d + cs * s_d
+                else:
+                    cs = math.cos(phi)
+                    sn = math.sin(phi)
+            inside = 0.0 <= phi <= big_phi
+            phic = min(max(phi, 0.0), big_phi)
+            if not inside:
+                cs = math.cos(phic)
+                sn = math.sin(phic)
         w = math.sqrt(a * a + h * h)
         r1 = x1 - a * cs
         r2 = x2 - a * sn
