@@ -464,6 +464,24 @@ class Scenario:
 # --------------------------------------------------------------------------------------
 
 
+def read_toml(path: Path, what: str = "scenario") -> dict:
+    """Read a TOML file; every failure is a ScenarioError (key ``""``) naming the file."""
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except FileNotFoundError:
+        raise ScenarioError("", f"{what} file not found: {path}") from None
+    except IsADirectoryError:
+        raise ScenarioError("", f"{what} path is a directory, not a file: {path}") from None
+    except OSError as exc:
+        raise ScenarioError("", f"cannot read {what} file {path}: {exc.strerror or exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        # tomllib's message carries "(at line L, column C)"
+        raise ScenarioError("", f"{path}: TOML syntax error: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError("", f"{path}: not UTF-8 text: {exc}") from None
+
+
 def load_scenario(path) -> Scenario:
     """Read and validate a scenario TOML file.
 
@@ -483,20 +501,7 @@ def load_scenario(path) -> Scenario:
         Missing or unreadable file, TOML syntax error (key ``""``), or any invalid value.
     """
     path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except FileNotFoundError:
-        raise ScenarioError("", f"scenario file not found: {path}") from None
-    except IsADirectoryError:
-        raise ScenarioError("", f"scenario path is a directory, not a file: {path}") from None
-    except OSError as exc:
-        raise ScenarioError("", f"cannot read scenario file {path}: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        # tomllib's message carries "(at line L, column C)"
-        raise ScenarioError("", f"{path}: TOML syntax error: {exc}") from None
-    except UnicodeDecodeError as exc:
-        raise ScenarioError("", f"{path}: not UTF-8 text: {exc}") from None
+    data = read_toml(path, "scenario")
     scenario = parse_scenario(data, path.parent, default_name=path.stem)
     object.__setattr__(scenario, "source_path", path.resolve())
     return scenario

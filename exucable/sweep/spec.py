@@ -36,13 +36,12 @@ import difflib
 import hashlib
 import itertools
 import json
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
 from ..errors import ScenarioError
-from ..scenario import Scenario, parse_scenario
+from ..scenario import Scenario, parse_scenario, read_toml
 from .dotted import keys_overlap, parse_key, set_value, unset_value
 
 __all__ = ["Case", "Sweep", "MODES", "OUTPUTS", "load_sweep", "parse_sweep", "scenario_hash",
@@ -159,19 +158,7 @@ def load_sweep(path) -> Sweep:
         ``mode``, ...), before anything runs.
     """
     path = Path(path)
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except FileNotFoundError:
-        raise ScenarioError("", f"sweep file not found: {path}") from None
-    except IsADirectoryError:
-        raise ScenarioError("", f"sweep path is a directory, not a file: {path}") from None
-    except OSError as exc:
-        raise ScenarioError("", f"cannot read sweep file {path}: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError("", f"{path}: TOML syntax error: {exc}") from None
-    except UnicodeDecodeError as exc:
-        raise ScenarioError("", f"{path}: not UTF-8 text: {exc}") from None
+    data = read_toml(path, "sweep")
     sweep = parse_sweep(data, path.parent, default_name=path.stem)
     object.__setattr__(sweep, "source_path", path.resolve())
     return sweep
@@ -201,14 +188,9 @@ def _read_base(value, sweep_dir: Path) -> tuple[Path, dict]:
         raise ScenarioError("base", f"required: the base scenario file (relative to the sweep file), got {value!r}")
     path = (sweep_dir / value).resolve()
     try:
-        with open(path, "rb") as f:
-            return path, tomllib.load(f)
-    except FileNotFoundError:
-        raise ScenarioError("base", f"scenario file not found: {path}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError("base", f"cannot read {path}: {exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError("base", f"{path}: TOML syntax error: {exc}") from None
+        return path, read_toml(path, "scenario")
+    except ScenarioError as exc:
+        raise ScenarioError("base", exc.message) from None
 
 
 def parse_sweep(data: dict, base_dir, default_name: str = "sweep") -> Sweep:
