@@ -35,6 +35,20 @@ def cable_on_offset_curve(cond, s_nodes, offset_dir, distance, speed=0.1, rng=No
     return q, q_t
 
 
+def fd_jacobians(kernel, q, q_t, h_q=1e-8, h_v=1e-7):
+    """∂Q/∂q and ∂Q/∂q̇ by central differences (steps [m, -] and [m/s, 1/s])."""
+    n = q.size
+    jq = np.zeros((n, n))
+    jqt = np.zeros((n, n))
+    for i in range(n):
+        d = np.zeros(n)
+        d[i] = h_q
+        jq[:, i] = (kernel.evaluate(q + d, q_t).generalized_force - kernel.evaluate(q - d, q_t).generalized_force) / (2 * h_q)
+        d[i] = h_v
+        jqt[:, i] = (kernel.evaluate(q, q_t + d).generalized_force - kernel.evaluate(q, q_t - d).generalized_force) / (2 * h_v)
+    return jq, jqt
+
+
 def towards_centre(cond):
     def f(s, t):
         kn = cond.centreline.curvature_vector(s)
@@ -111,15 +125,7 @@ def test_smooth_wall_jacobians_match_finite_differences(kind):
     st = k.points(q, q_t)
     assert st.in_contact.all() and np.all(st.penetration_m > 1e-4)
     res = k.evaluate(q, q_t, jacobian=True)
-    n = q.size
-    jq_fd = np.zeros((n, n))
-    jqt_fd = np.zeros((n, n))
-    for i in range(n):
-        d = np.zeros(n)
-        d[i] = 1e-8
-        jq_fd[:, i] = (k.evaluate(q + d, q_t).generalized_force - k.evaluate(q - d, q_t).generalized_force) / 2e-8
-        d[i] = 1e-7
-        jqt_fd[:, i] = (k.evaluate(q, q_t + d).generalized_force - k.evaluate(q, q_t - d).generalized_force) / 2e-7
+    jq_fd, jqt_fd = fd_jacobians(k, q, q_t)
     jq = assemble_blocks_dense(res.jac_q_blocks)
     jqt = assemble_blocks_dense(res.jac_qt_blocks)
     assert np.abs(jq - jq_fd).max() < 1e-6 * np.abs(jq).max()
@@ -180,15 +186,7 @@ def test_damping_onset_jacobians_and_backends_agree():
     assert np.abs(a.generalized_force - b.generalized_force).max() <= 1e-11 * np.abs(a.generalized_force).max()
     assert np.abs(a.jac_q_blocks - b.jac_q_blocks).max() <= 1e-10 * np.abs(a.jac_q_blocks).max()
     k = ks["numpy"]
-    n = q.size
-    jq_fd = np.zeros((n, n))
-    jqt_fd = np.zeros((n, n))
-    for i in range(n):
-        d = np.zeros(n)
-        d[i] = 1e-8
-        jq_fd[:, i] = (k.evaluate(q + d, q_t).generalized_force - k.evaluate(q - d, q_t).generalized_force) / 2e-8
-        d[i] = 1e-7
-        jqt_fd[:, i] = (k.evaluate(q, q_t + d).generalized_force - k.evaluate(q, q_t - d).generalized_force) / 2e-7
+    jq_fd, jqt_fd = fd_jacobians(k, q, q_t)
     assert np.abs(assemble_blocks_dense(a.jac_q_blocks) - jq_fd).max() < 1e-6 * np.abs(jq_fd).max()
     assert np.abs(assemble_blocks_dense(a.jac_qt_blocks) - jqt_fd).max() < 1e-6 * np.abs(jqt_fd).max()
     # and the force is continuous at first touch: the damping term vanishes with δ
