@@ -10,7 +10,6 @@ import argparse
 import importlib
 import sys
 
-from . import __version__
 from .errors import ExucableError
 
 __all__ = ["main", "SUBCOMMANDS"]
@@ -34,12 +33,25 @@ def _load(module_name: str):
         raise
 
 
+class _VersionAction(argparse.Action):
+    """``--version``: imports Exudyn only when asked (it costs a second at start-up)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings=option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .versions import version_line
+        print(version_line())            # stdout, as argparse's own version action
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="exucable",
         description="Cable pulling tension through 3D conduits on the Exudyn multibody engine "
                     "(after Yang et al., Multibody Syst Dyn 30, 2013).")
-    parser.add_argument("--version", action="version", version=f"exucable {__version__}")
+    parser.add_argument("--version", action=_VersionAction,
+                        help="print exucable's and Exudyn's versions and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (module_name, help_text) in SUBCOMMANDS.items():
         mod = _load(module_name)

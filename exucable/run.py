@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from .versions import versions
 from .errors import ExucableError
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
@@ -50,14 +50,6 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
         p = np.array([p[g].mean() for g in groups])
         pen = np.array([pen[g].max() for g in groups])
     return {"s_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
-
-
-def _versions() -> dict:
-    import exudyn
-    import numpy
-    import platform
-    return {"exucable": __version__, "exudyn": exudyn.__version__, "numpy": numpy.__version__,
-            "python": platform.python_version()}
 
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
@@ -108,7 +100,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
         "scenario": sc.to_dict(),
-        "versions": _versions(),
+        "versions": versions(),
     }
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
