@@ -99,6 +99,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "rope_pull_force_N": rope.pull_force_N if rope is not None else None,
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        "rope_clearance_pull_force_N": clearance_rope_pull_force_N(sc, model.conduit),
         "scenario": sc.to_dict(),
         "versions": versions(),
     }
@@ -115,6 +116,29 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result
+
+
+def clearance_rope_pull_force_N(scenario, conduit) -> float | None:
+    """Pulling force of the rope with clearance (:mod:`exucable.rope_clearance`) for ``scenario`` [N].
+
+    The EJ → 0 limit of the cable in its clearance, beside the centreline rope; ``conduit`` is
+    pull-oriented (leading end at its end). None for force-controlled pulls and for cables that
+    run slack (which that reference does not model).
+    """
+    from .errors import ModelError
+    from .rope_clearance import solve_rope_with_clearance
+
+    sc = scenario
+    clearance = conduit.inner_radius_m - sc.cable.radius_m
+    if sc.pull.force_N is not None or clearance <= 0:
+        return None
+    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
+    try:
+        return solve_rope_with_clearance(conduit.centreline, clearance, sc.contact.friction,
+                                         sc.cable.mass_per_length_kg_per_m * g, sc.pull.back_tension_N,
+                                         cable_length_m=sc.cable_length_m).pull_force_N
+    except ModelError:
+        return None
 
 
 def add_arguments(p) -> None:
@@ -147,6 +171,9 @@ def main(args) -> int:
         ref, got, what = rope, s["pull_force_N"], "pulling force"
     if ref is not None and got is not None and np.isfinite(got):
         print(f"  rope reference: {what} {ref:.6g} N ({100 * (got / ref - 1):+.3f} %)")
+    ref_c = s.get("rope_clearance_pull_force_N")
+    if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
+        print(f"  rope with clearance: pulling force {ref_c:.6g} N ({100 * (got / ref_c - 1):+.3f} %)")
     print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
           f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
