@@ -77,6 +77,8 @@ class CableSpec:
         ``"reduced"`` or ``"full"`` (useReducedOrderIntegration 2, 1, 0).
     damping_time_s : float
         Kelvin–Voigt retardation time τ [s]; internal damping = τ × stiffness.
+    bending_stiffness_given_N_m2 : float or None
+        EJ [N m²] if the scenario gave it (stranded cables: not E π r⁴/4), else None.
     """
 
     radius_m: float
@@ -87,6 +89,7 @@ class CableSpec:
     length_m: float | None
     damping_time_s: float
     integration: str = "lobatto"
+    bending_stiffness_given_N_m2: float | None = None
 
     @property
     def area_m2(self) -> float:
@@ -100,7 +103,9 @@ class CableSpec:
 
     @property
     def bending_stiffness_N_m2(self) -> float:
-        """Bending stiffness EJ = E π r⁴ / 4 [N m²] (solid circular section)."""
+        """Bending stiffness EJ [N m²]: as given, else E π r⁴ / 4 (solid circular section)."""
+        if self.bending_stiffness_given_N_m2 is not None:
+            return self.bending_stiffness_given_N_m2
         return self.youngs_modulus_Pa * math.pi * self.radius_m**4 / 4.0
 
     @property
@@ -121,6 +126,8 @@ class CableSpec:
         else:
             d["mass_per_length"] = self.mass_per_length_kg_per_m
         d["youngs_modulus"] = self.youngs_modulus_Pa
+        if self.bending_stiffness_given_N_m2 is not None:
+            d["bending_stiffness"] = self.bending_stiffness_given_N_m2
         d["elements"] = self.elements
         if self.length_m is not None:
             d["length"] = self.length_m
@@ -735,7 +742,7 @@ def _parse_cable(data) -> CableSpec:
         data,
         "cable",
         {"radius", "density", "mass_per_length", "youngs_modulus", "elements", "length", "damping_time",
-         "integration"},
+         "integration", "bending_stiffness"},
     )
     radius = t.number("radius", "m", gt=0.0)
     if t.has("density") and t.has("mass_per_length"):
@@ -757,6 +764,7 @@ def _parse_cable(data) -> CableSpec:
         length_m=t.number("length", "m", default=None, gt=0.0),
         damping_time_s=t.number("damping_time", "s", default=_DEFAULT_DAMPING_TIME_S, ge=0.0),
         integration=t.choice("integration", ("lobatto", "reduced", "full"), default="lobatto"),
+        bending_stiffness_given_N_m2=t.number("bending_stiffness", "N m^2", default=None, gt=0.0),
     )
 
 

@@ -1,0 +1,209 @@
+"""What separates exucable from the rope: bending stiffness and the clearance (issue 10, item 6).
+
+On single bends the pulling force of exucable is compared with two flexible references:
+the centreline rope (``exucable.rope``: no bending stiffness, glued to the conduit's centreline)
+and the rope with clearance (``exucable.rope_clearance``: no bending stiffness, free to leave the
+wall and hang in free spans across the clearance). The sweep varies the bending length
+√(EJ/T) against the bend radius R (``cable.bending_stiffness``, at a fixed EA; the references do
+not depend on it) and the clearance c against R, with and without gravity:
+
+- ``hbend``: a horizontal 90° bend, R 3 m, between 2 m straights; the issue's 18 mm fibre cable
+  (0.21 kg/m, μ 0.5, 100 N back tension); without gravity and with it (then the cable rolls
+  from the floor of the straights to the bend's inner side: a 3D path);
+- ``upbend`` / ``downbend``: a 60° vertical bend, R 5 m, between a 5 m and a 3 m straight, the
+  issue's 1 kg/m cable (μ 0.3, 200 N back tension), gravity on.
+
+Both references are evaluated for the cable's extent at the mean time of the averaging window
+(the cable leaves the conduit at the pull speed, so the length inside shrinks). Each exucable
+run stops once steady (0.2 s window, 0.1 %); its scatter is the standard deviation there.
+
+    nice .venv/bin/python benchmarks/rope_difference_study.py            # the table (~15 min on 2 cores)
+    nice .venv/bin/python benchmarks/rope_difference_study.py --case upbend --clearance 0.01 --ej 7.9
+    nice .venv/bin/python benchmarks/rope_difference_study.py --figure reference/rope_difference.png
+
+Prints a Markdown table; ``--json FILE`` keeps the rows, ``--figure`` plots them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+CABLE_RADIUS_M = 0.009
+SPEED_M_PER_S = 0.2
+# The issue's fibre cable: EA = 1.3e5 N whatever EJ is (EJ is given on its own, as for a stranded
+# cable; deriving it from E would make a low-EJ cable axially soft, and its axial mode, 4L/√(EA/ρA)
+# ≈ 0.8 s with EJ = 0.079 N m² from E, then rang in the pulling force by ±0.5 %).
+YOUNGS_MODULUS_PA = 5e8
+G = 9.81
+
+CASES = {
+    "hbend": dict(path=[{"straight": 2.0}, {"bend": 90.0, "radius": 3.0, "turn": "left"}, {"straight": 2.0}],
+                  mass_kg_per_m=0.21, friction=0.5, back_tension_N=100.0, radius_m=3.0),
+    "upbend": dict(path=[{"straight": 5.0}, {"bend": 60.0, "radius": 5.0, "turn": "up"}, {"straight": 3.0}],
+                   mass_kg_per_m=1.0, friction=0.3, back_tension_N=200.0, radius_m=5.0),
+    "downbend": dict(path=[{"straight": 5.0}, {"bend": 60.0, "radius": 5.0, "turn": "down"}, {"straight": 3.0}],
+                     mass_kg_per_m=1.0, friction=0.3, back_tension_N=200.0, radius_m=5.0),
+}
+
+
+def scenario_dict(case: str, clearance_m: float, ej_N_m2: float, gravity: bool, element_length_m: float,
+                  check_spacing_m: float, end_time_s: float) -> dict:
+    c = CASES[case]
+    r = CABLE_RADIUS_M
+    area = math.pi * r * r
+    length = sum(p.get("straight", 0.0) + math.radians(p.get("bend", 0.0)) * p.get("radius", 0.0) for p in c["path"])
+    elements = int(math.ceil(length / element_length_m))
+    d = {
+        "name": f"{case}-c{clearance_m * 1e3:g}mm-EJ{ej_N_m2:g}{'-g' if gravity else ''}",
+        "cable": {"radius": r, "density": c["mass_kg_per_m"] / area, "youngs_modulus": YOUNGS_MODULUS_PA,
+                  "bending_stiffness": ej_N_m2, "elements": elements},
+        "conduit": {"inner_radius": r + clearance_m, "path": c["path"]},
+        "contact": {"friction": c["friction"],
+                    "check_points_per_element": max(4, int(round(length / elements / check_spacing_m)))},
+        "pull": {"speed": SPEED_M_PER_S, "back_tension": c["back_tension_N"]},
+        "solver": {"end_time": end_time_s, "step": 1e-2, "steady_stop": True},
+    }
+    if gravity:
+        d["gravity"] = {"g": G}
+    return d
+
+
+def run_one(case: str, clearance_m: float, ej_N_m2: float, gravity: bool, element_length_m: float = 0.1,
+            check_spacing_m: float = 0.005, end_time_s: float = 1.0) -> dict:
+    """One exucable run and both references at the cable's extent; a row of the table."""
+    from exucable.model.build import pull_oriented_conduit
+    from exucable.rope import solve_rope
+    from exucable.rope_clearance import solve_rope_with_clearance
+    from exucable.run import run_scenario
+    from exucable.scenario import parse_scenario
+
+    data = scenario_dict(case, clearance_m, ej_N_m2, gravity, element_length_m, check_spacing_m, end_time_s)
+    sc = parse_scenario(data, ROOT, default_name=data["name"])
+    t0 = time.perf_counter()
+    res = run_scenario(sc, None, quiet=True, plots=False, steady_stop=True)
+    wall = time.perf_counter() - t0
+    s, h = res.summary, res.history
+    t = np.asarray(h["time_s"])
+    from_s = s["steady_from_s"] if np.isfinite(s["steady_from_s"]) else t[0]
+    window = t >= from_s
+    t_mean = float(np.mean(t[window]))
+    inside = sc.cable_length_m - SPEED_M_PER_S * t_mean
+    centre = pull_oriented_conduit(sc).centreline
+    c = CASES[case]
+    w = c["mass_kg_per_m"] * G if gravity else 0.0
+    rope = solve_rope(centre, c["friction"], w, c["back_tension_N"], cable_length_m=inside).pull_force_N
+    clear = solve_rope_with_clearance(centre, clearance_m, c["friction"], w, c["back_tension_N"],
+                                      cable_length_m=inside).pull_force_N
+    F = s["pull_force_N"]
+    lam = math.sqrt(ej_N_m2 / rope)
+    return {"case": case, "gravity": gravity, "clearance_m": clearance_m, "EJ_N_m2": ej_N_m2,
+            "c_over_R": clearance_m / c["radius_m"], "bending_length_over_R": lam / c["radius_m"],
+            "elements": sc.cable.elements, "check_points_per_element": sc.contact.check_points_per_element,
+            "pull_force_N": F, "pull_force_std_N": s["pull_force_std_N"], "steady": s["steady"],
+            "status": s["status"], "window_mean_time_s": t_mean, "rope_N": rope, "rope_clearance_N": clear,
+            "vs_rope_pct": 100 * (F / rope - 1), "vs_rope_clearance_pct": 100 * (F / clear - 1),
+            "clearance_rope_vs_rope_pct": 100 * (clear / rope - 1), "wall_s": wall}
+
+
+def print_row(r: dict) -> None:
+    print(f"| {r['case']} | {'yes' if r['gravity'] else 'no'} | {r['clearance_m'] * 1e3:g} | {r['c_over_R']:.2g} | "
+          f"{r['EJ_N_m2']:g} | {r['bending_length_over_R']:.3g} | {r['elements']}×{r['check_points_per_element']} | "
+          f"{r['pull_force_N']:.3f} ± {r['pull_force_std_N']:.2g} | {r['rope_N']:.3f} | {r['rope_clearance_N']:.3f} | "
+          f"{r['vs_rope_pct']:+.3f} % | {r['vs_rope_clearance_pct']:+.3f} % | {r['clearance_rope_vs_rope_pct']:+.3f} % | "
+          f"{r['wall_s']:.0f} |", flush=True)
+
+
+HEADER = ("| case | gravity | c [mm] | c/R | EJ [N m²] | √(EJ/T)/R | mesh | exucable [N] | rope [N] | "
+          "rope with clearance [N] | vs rope | vs rope with clearance | clearance rope vs rope | wall [s] |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+
+# (case, gravity, clearance [m], EJ [N m²]): each line of the sweep moves one parameter toward zero.
+SWEEP = [
+    ("hbend", False, 0.0084, 7.9), ("hbend", False, 0.0084, 0.79), ("hbend", False, 0.0084, 0.079),
+    ("hbend", False, 0.002, 0.079), ("hbend", False, 0.0005, 0.079),
+    ("hbend", True, 0.0084, 0.79), ("hbend", True, 0.0084, 0.079), ("hbend", True, 0.002, 0.079),
+    ("upbend", True, 0.01, 7.9), ("upbend", True, 0.01, 0.79), ("upbend", True, 0.01, 0.079),
+    ("upbend", True, 0.002, 0.079), ("upbend", True, 0.0005, 0.079),
+    ("downbend", True, 0.01, 7.9), ("downbend", True, 0.01, 0.79), ("downbend", True, 0.01, 0.079),
+    ("downbend", True, 0.002, 0.079),
+]
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--case", choices=sorted(CASES))
+    p.add_argument("--clearance", type=float, help="clearance c [m]")
+    p.add_argument("--ej", type=float, help="bending stiffness EJ [N m²]")
+    p.add_argument("--no-gravity", action="store_true")
+    p.add_argument("--element-length", type=float, default=0.1, help="[m]")
+    p.add_argument("--check-spacing", type=float, default=0.005, help="[m]")
+    p.add_argument("--json", help="write the rows to this JSON file")
+    p.add_argument("--figure", help="plot the rows of --json (or of this run) to this PNG")
+    p.add_argument("--from-json", help="read rows from this JSON file instead of running")
+    a = p.parse_args(argv)
+    if a.from_json:
+        rows = json.loads(Path(a.from_json).read_text())
+        print(HEADER)
+        for r in rows:
+            print_row(r)
+    else:
+        if a.case:
+            plan = [(a.case, not a.no_gravity, a.clearance, a.ej)]
+        else:
+            plan = SWEEP
+        print(HEADER)
+        rows = []
+        for case, grav, c, ej in plan:
+            r = run_one(case, c, ej, grav, a.element_length, a.check_spacing)
+            rows.append(r)
+            print_row(r)
+            if a.json:
+                Path(a.json).write_text(json.dumps(rows, indent=1))
+    if a.figure:
+        plot(rows, a.figure)
+    return 0
+
+
+def plot(rows, path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for case, marker in (("hbend", "o"), ("upbend", "^"), ("downbend", "v")):
+        for grav in (False, True):
+            sel = [r for r in rows if r["case"] == case and r["gravity"] == grav]
+            if not sel:
+                continue
+            label = f"{case}{' + gravity' if grav else ''}"
+            big_c = [r for r in sel if r["clearance_m"] == max(x["clearance_m"] for x in sel)]
+            small_ej = [r for r in sel if r["EJ_N_m2"] == min(x["EJ_N_m2"] for x in sel)]
+            axes[0].semilogx([r["bending_length_over_R"] for r in big_c], [r["vs_rope_clearance_pct"] for r in big_c],
+                             marker=marker, label=label)
+            axes[1].semilogx([r["c_over_R"] for r in small_ej], [r["vs_rope_pct"] for r in small_ej],
+                             marker=marker, label=label)
+    axes[0].set_xlabel("bending length √(EJ/T) / R")
+    axes[0].set_ylabel("exucable vs rope with clearance [%]")
+    axes[0].set_title("EJ → 0 at the largest clearance")
+    axes[1].set_xlabel("clearance c / R")
+    axes[1].set_ylabel("exucable vs centreline rope [%]")
+    axes[1].set_title("c → 0 at the smallest EJ")
+    for ax in axes:
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
