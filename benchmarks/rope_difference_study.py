@@ -14,7 +14,8 @@ not depend on it) and the clearance c against R, with and without gravity:
   issue's 1 kg/m cable (μ 0.3, 200 N back tension), gravity on.
 
 Both references are evaluated for the cable's extent at the mean time of the averaging window
-(the cable leaves the conduit at the pull speed, so the length inside shrinks). Each exucable
+(``exucable.references``: the cable leaves the conduit at the pull speed, so the length inside
+shrinks and the part beyond the exit pulls along the exit line with its weight). Each exucable
 run stops once steady (0.2 s window, 0.1 %); its scatter is the standard deviation there.
 
     nice .venv/bin/python benchmarks/rope_difference_study.py            # the table (~15 min on 2 cores)
@@ -82,8 +83,7 @@ def run_one(case: str, clearance_m: float, ej_N_m2: float, gravity: bool, elemen
             check_spacing_m: float = 0.005, end_time_s: float = 1.0) -> dict:
     """One exucable run and both references at the cable's extent; a row of the table."""
     from exucable.model.build import pull_oriented_conduit
-    from exucable.rope import solve_rope
-    from exucable.rope_clearance import solve_rope_with_clearance
+    from exucable.references import pull_force_references_N
     from exucable.run import run_scenario
     from exucable.scenario import parse_scenario
 
@@ -97,13 +97,9 @@ def run_one(case: str, clearance_m: float, ej_N_m2: float, gravity: bool, elemen
     from_s = s["steady_from_s"] if np.isfinite(s["steady_from_s"]) else t[0]
     window = t >= from_s
     t_mean = float(np.mean(t[window]))
-    inside = sc.cable_length_m - SPEED_M_PER_S * t_mean
-    centre = pull_oriented_conduit(sc).centreline
+    refs = pull_force_references_N(sc, pull_oriented_conduit(sc), SPEED_M_PER_S * t_mean)
+    rope, clear = refs["rope_pull_force_N"], refs["rope_clearance_pull_force_N"]
     c = CASES[case]
-    w = c["mass_kg_per_m"] * G if gravity else 0.0
-    rope = solve_rope(centre, c["friction"], w, c["back_tension_N"], cable_length_m=inside).pull_force_N
-    clear = solve_rope_with_clearance(centre, clearance_m, c["friction"], w, c["back_tension_N"],
-                                      cable_length_m=inside).pull_force_N
     F = s["pull_force_N"]
     lam = math.sqrt(ej_N_m2 / rope)
     return {"case": case, "gravity": gravity, "clearance_m": clearance_m, "EJ_N_m2": ej_N_m2,
@@ -112,7 +108,63 @@ def run_one(case: str, clearance_m: float, ej_N_m2: float, gravity: bool, elemen
             "pull_force_N": F, "pull_force_std_N": s["pull_force_std_N"], "steady": s["steady"],
             "status": s["status"], "window_mean_time_s": t_mean, "rope_N": rope, "rope_clearance_N": clear,
             "vs_rope_pct": 100 * (F / rope - 1), "vs_rope_clearance_pct": 100 * (F / clear - 1),
-            "clearance_rope_vs_rope_pct": 100 * (clear / rope - 1), "wall_s": wall}
+            "clearance_rope_vs_rope_pct": 100 * (clear / rope - 1), "wall_s": wall,
+            "free_span_estimate_pct": 100 * free_span_estimate_N(case, clearance_m, gravity) / rope}
+
+
+def free_span_estimate_N(case: str, clearance_m: float, gravity: bool) -> float:
+    """Estimated difference rope with clearance − centreline rope [N] from the free spans (reference/README.md).
+
+    At each end of a bend the cable crosses the clearance in a free span of length a, whose weight
+    its tension carries (a catenary) instead of the floor of the straight. Over a straight the
+    centreline rope counts the floor's pressure w⊥ per length, the cable in its span nothing:
+
+    - vertical up-bend (the bend's pressure T/R opposes the weight): the span runs from the floor to
+      the bend's upper wall, a parabola of curvature w⊥/T landing tangentially on the arc:
+      a = 2 √(c (T/w⊥ − R)), and the weight the span does not put on the floor is put against T/R in
+      the bend, where the rope counted it with the opposite sign: ΔF = −2 μ w⊥ a;
+    - horizontal bend (T/R horizontal, the weight vertical): the span rises c from the floor,
+      a = √(2 c T / w), and its weight goes to the bend's wall, where it adds to T/R in quadrature
+      (at second order): ΔF = −μ w a;
+    - down-bend (T/R and the weight both press on the lower wall): no span, ΔF = 0.
+
+    A saving at the bend's entry grows through the bend by the capstan factor e^{μθ}. Tensions are
+    the centreline rope's at the bend's ends.
+    """
+    if not gravity:
+        return 0.0
+    c = CASES[case]
+    mu, R, Tb, w = c["friction"], c["radius_m"], c["back_tension_N"], c["mass_kg_per_m"] * G
+    bend = next(p for p in c["path"] if "bend" in p)
+    theta = math.radians(bend["angle_deg"] if "angle_deg" in bend else bend["bend"])
+    if case == "hbend":
+        T_in = Tb + mu * w * c["path"][0]["straight"]
+        T_out = T_in * math.cosh(mu * theta) + math.sinh(mu * theta) * math.hypot(T_in, w * R)
+        span = lambda T: math.sqrt(2 * clearance_m * T / w)  # noqa: E731
+        return -mu * w * (span(T_in) * math.exp(mu * theta) + span(T_out))
+    if case == "upbend":
+        T_in = Tb + mu * w * c["path"][0]["straight"]
+        T_out = T_in * math.exp(mu * theta)  # the weight's share changes it by ~1 %: enough for an estimate
+        w_out = w * math.cos(theta)
+        return -2 * mu * (w * 2 * math.sqrt(clearance_m * (T_in / w - R)) * math.exp(mu * theta)
+                          + w_out * 2 * math.sqrt(clearance_m * (T_out / w_out - R)))
+    return 0.0
+
+
+def rereference(r: dict) -> dict:
+    """Recompute a stored row's references (and differences) at its window's extent, without rerunning exucable."""
+    from exucable.model.build import pull_oriented_conduit
+    from exucable.references import pull_force_references_N
+    from exucable.scenario import parse_scenario
+
+    data = scenario_dict(r["case"], r["clearance_m"], r["EJ_N_m2"], r["gravity"], 0.1, 0.005, 1.0)
+    data["cable"]["elements"] = r["elements"]
+    sc = parse_scenario(data, ROOT, default_name=data["name"])
+    refs = pull_force_references_N(sc, pull_oriented_conduit(sc), SPEED_M_PER_S * r["window_mean_time_s"])
+    rope, clear, F = refs["rope_pull_force_N"], refs["rope_clearance_pull_force_N"], r["pull_force_N"]
+    return dict(r, rope_N=rope, rope_clearance_N=clear, vs_rope_pct=100 * (F / rope - 1),
+                vs_rope_clearance_pct=100 * (F / clear - 1), clearance_rope_vs_rope_pct=100 * (clear / rope - 1),
+                free_span_estimate_pct=100 * free_span_estimate_N(r["case"], r["clearance_m"], r["gravity"]) / rope)
 
 
 def print_row(r: dict) -> None:
@@ -120,12 +172,13 @@ def print_row(r: dict) -> None:
           f"{r['EJ_N_m2']:g} | {r['bending_length_over_R']:.3g} | {r['elements']}×{r['check_points_per_element']} | "
           f"{r['pull_force_N']:.3f} ± {r['pull_force_std_N']:.2g} | {r['rope_N']:.3f} | {r['rope_clearance_N']:.3f} | "
           f"{r['vs_rope_pct']:+.3f} % | {r['vs_rope_clearance_pct']:+.3f} % | {r['clearance_rope_vs_rope_pct']:+.3f} % | "
+          f"{r['free_span_estimate_pct']:+.3f} % | "
           f"{r['wall_s']:.0f} |", flush=True)
 
 
 HEADER = ("| case | gravity | c [mm] | c/R | EJ [N m²] | √(EJ/T)/R | mesh | exucable [N] | rope [N] | "
-          "rope with clearance [N] | vs rope | vs rope with clearance | clearance rope vs rope | wall [s] |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "rope with clearance [N] | vs rope | vs rope with clearance | clearance rope vs rope | free-span estimate | "
+          "wall [s] |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 
 # (case, gravity, clearance [m], EJ [N m²]): each line of the sweep moves one parameter toward zero.
 SWEEP = [
@@ -149,10 +202,11 @@ def main(argv=None) -> int:
     p.add_argument("--check-spacing", type=float, default=0.005, help="[m]")
     p.add_argument("--json", help="write the rows to this JSON file")
     p.add_argument("--figure", help="plot the rows of --json (or of this run) to this PNG")
-    p.add_argument("--from-json", help="read rows from this JSON file instead of running")
+    p.add_argument("--from-json", help="read exucable's rows from this JSON file instead of running (the "
+                   "references are recomputed)")
     a = p.parse_args(argv)
     if a.from_json:
-        rows = json.loads(Path(a.from_json).read_text())
+        rows = [rereference(r) for r in json.loads(Path(a.from_json).read_text())]
         print(HEADER)
         for r in rows:
             print_row(r)
