@@ -5,9 +5,7 @@ from this clean, import-only state, never from one that has run a model.
 """
 
 try:  # a failed import only costs start-up time in the workers; it must not kill the forkserver
-    import matplotlib
-
-    matplotlib.use("Agg")
+    import matplotlib.backends.backend_agg  # noqa: F401  (figures use their own Agg canvas)
     import exudyn  # noqa: F401
 
     import exucable.contact  # noqa: F401  (numba, imported lazily by model building)
