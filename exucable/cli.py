@@ -25,7 +25,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
 
 
 class _VersionAction(argparse.Action):
-    """``--version``: imports Exudyn only when asked (it costs a second at start-up)."""
+    """``--version``: prints exucable's and Exudyn's versions (read from the installed metadata)."""
 
     def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
         super().__init__(option_strings=option_strings, dest=dest, default=default, nargs=0, help=help)
