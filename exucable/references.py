@@ -24,10 +24,10 @@ from .errors import ModelError
 from .rope import solve_rope
 from .rope_clearance import solve_rope_with_clearance
 
-__all__ = ["pull_force_references_N"]
+__all__ = ["pull_force_references_N", "reference_drift_N_per_s"]
 
 
-def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0) -> dict:
+def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_clearance: bool = True) -> dict:
     """Pulling force of both flexible references once ``pulled_out_m`` of cable has left the conduit.
 
     Parameters
@@ -38,6 +38,8 @@ def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0) -> dic
         The scenario's conduit oriented so that the leading end is at its end.
     pulled_out_m : float
         Length of cable pulled out past the conduit's exit since the start [m], v·t.
+    with_clearance : bool
+        Also solve the rope with clearance (the costlier of the two).
 
     Returns
     -------
@@ -61,9 +63,28 @@ def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0) -> dic
     rope = solve_rope(centre, mu, w, back, cable_length_m=inside).pull_force_N + head
     clearance = conduit.inner_radius_m - sc.cable.radius_m
     clear = None
-    if clearance > 0.0:
+    if clearance > 0.0 and with_clearance:
         try:
             clear = solve_rope_with_clearance(centre, clearance, mu, w, back, cable_length_m=inside).pull_force_N + head
         except ModelError:
             clear = None
     return {"rope_pull_force_N": rope, "rope_clearance_pull_force_N": clear, "pulled_out_m": out}
+
+
+def reference_drift_N_per_s(scenario, conduit, duration_s: float) -> float:
+    """Rate at which the centreline rope's pulling force changes as the cable leaves its conduit [N/s].
+
+    The secant over ``duration_s`` [s] at the pull speed (exact while the tail stays on one straight
+    and the head on the exit line: the drift is then linear, (μ w_⊥ e^{μθ} ± w_∥) v at the tail plus
+    w (e_z·t_exit) v at the head). 0 for force-controlled pulls, without gravity, or when the cable
+    would leave the conduit within ``duration_s``.
+    """
+    sc = scenario
+    if sc.pull.force_N is not None or sc.gravity is None or sc.gravity.g_m_per_s2 == 0.0 or duration_s <= 0.0:
+        return 0.0
+    out = sc.pull.speed_m_per_s * duration_s
+    if out >= sc.cable_length_m:
+        return 0.0
+    f0 = pull_force_references_N(sc, conduit, 0.0, with_clearance=False)["rope_pull_force_N"]
+    f1 = pull_force_references_N(sc, conduit, out, with_clearance=False)["rope_pull_force_N"]
+    return (f1 - f0) / duration_s

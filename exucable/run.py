@@ -14,7 +14,7 @@ import numpy as np
 from .versions import versions
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
-from .solve import Progress, simulate, steady_quantity
+from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity
 from .tension import detect_steady_state, tension_profile
 
 __all__ = ["run_scenario", "contact_profile"]
@@ -68,8 +68,11 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     out = simulate(model, progress=progress, steady_stop=steady_stop)
     h = out.history.arrays()
     sp = sc.solver
-    st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
+    drift = expected_drift_N_per_s(model)
+    st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
+                             expected_drift_N_per_s=drift)
     i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
+    refs = window_references(sc, model, h["time_s"][i0:])
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
     cprof, peak_pressure = contact_profile(model)
@@ -79,7 +82,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "status": out.status,
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
-        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+        # scatter about the drift the cable's changing extent explains (none without gravity)
+        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
+        if len(h["time_s"]) else None,
+        "reference_drift_N_per_s": drift,
         "steady_quantity": steady_quantity(model),
         "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
@@ -94,10 +100,11 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "build_time_s": build_s,
         "kernel_time_s": model.coupling.kernel_time_s if model.coupling is not None else 0.0,
         "max_sidewall_pressure_N_per_m": peak_pressure,
-        "rope_pull_force_N": rope.pull_force_N if rope is not None else None,
+        "rope_pull_force_N": refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
-        "rope_clearance_pull_force_N": clearance_rope_pull_force_N(sc, model.conduit),
+        "rope_clearance_pull_force_N": refs.get("rope_clearance_pull_force_N"),
+        "reference_pulled_out_m": refs.get("pulled_out_m"),
         "scenario": sc.to_dict(),
         "versions": versions(),
     }
@@ -116,24 +123,16 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     return result
 
 
-def clearance_rope_pull_force_N(scenario, conduit) -> float | None:
-    """Pulling force of the rope with clearance (:mod:`exucable.rope_clearance`) for ``scenario`` [N].
-
-    The EJ → 0 limit of the cable in its clearance, beside the centreline rope; ``conduit`` is
-    pull-oriented (leading end at its end). None for force-controlled pulls and for cables that
-    run slack (which that reference does not model).
-    """
-    from .errors import ModelError
-    from .rope_clearance import solve_rope_with_clearance
+def window_references(scenario, model, window_time_s) -> dict:
+    """Both flexible references (:mod:`exucable.references`) for the cable's extent at the mean
+    time of the averaging window ``window_time_s`` [s] of a velocity-controlled pull; ``{}`` for a
+    force-controlled one (its references are the model's centreline rope)."""
+    from .model.rig import ramped_displacement
+    from .references import pull_force_references_N
 
     sc = scenario
-    clearance = conduit.inner_radius_m - sc.cable.radius_m
-    if sc.pull.force_N is not None or clearance <= 0:
-        return None
-    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
-    try:
-        return solve_rope_with_clearance(conduit.centreline, clearance, sc.contact.friction,
-                                         sc.cable.mass_per_length_kg_per_m * g, sc.pull.back_tension_N,
-                                         cable_length_m=sc.cable_length_m).pull_force_N
-    except ModelError:
-        return None
+    if sc.pull.force_N is not None or len(window_time_s) == 0:
+        return {}
+    t_mean = float(np.mean(window_time_s))
+    out = ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s)
+    return pull_force_references_N(sc, model.conduit, out)

@@ -13,6 +13,7 @@ import exudyn as exu
 
 from ..errors import ModelError
 from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
+from ..references import reference_drift_N_per_s
 from ..rope_clearance import solve_rope_with_clearance
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, contact_offsets, lay_cable
@@ -40,6 +41,8 @@ class Model:
     coupling: object | None = None
     kernel: object | None = None
     ode2_index: np.ndarray = field(default=None)
+    # how fast the flexible reference's pulling force moves as the cable leaves its conduit [N/s]
+    reference_drift_N_per_s: float = 0.0
 
     @property
     def axial_stiffness_N(self) -> float:
@@ -201,7 +204,8 @@ def build_model(scenario, with_contact: bool = True) -> Model:
 
     model = Model(scenario=sc, system_container=SC, mbs=mbs, conduit=conduit, cable=cable, layout=layout,
                   properties=props, lead_drive=lead_drive, trail_drive=trail_drive,
-                  applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope)
+                  applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope,
+                  reference_drift_N_per_s=reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s))
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
         from .coupling import ContactCoupling, StartupDamper
