@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
-           "read_summary", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
+           "read_summary", "json_safe", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
 HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N")
 PROFILE_COLUMNS = ("s_m", "tension_N")
@@ -63,9 +63,13 @@ def write_csv(path, columns, data: dict) -> None:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(columns)
-    arrays = [np.asarray(data[c], dtype=float) for c in columns]
+    # integer columns (node, element indices) stay integers; floats keep every digit (repr)
+    arrays = [np.asarray(data[c]) for c in columns]
+    arrays = [a if np.issubdtype(a.dtype, np.integer) else a.astype(float) for a in arrays]
+    fmt = [(lambda v: str(int(v))) if np.issubdtype(a.dtype, np.integer) else (lambda v: repr(float(v)))
+           for a in arrays]
     for row in zip(*arrays):
-        w.writerow([repr(float(v)) for v in row])
+        w.writerow([f(v) for f, v in zip(fmt, row)])
     atomic_write_text(path, buf.getvalue())
 
 
@@ -80,18 +84,19 @@ def read_csv(path) -> dict[str, np.ndarray]:
     return {h: body[:, i] for i, h in enumerate(header)}
 
 
-def _json_safe(obj):
+def json_safe(obj):
+    """``obj`` with numpy scalars/arrays as Python numbers/lists and non-finite floats as None."""
     if isinstance(obj, dict):
-        return {str(k): _json_safe(v) for k, v in obj.items()}
+        return {str(k): json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_json_safe(v) for v in obj]
+        return [json_safe(v) for v in obj]
     if isinstance(obj, (np.floating, float)):
         v = float(obj)
         return v if math.isfinite(v) else None
     if isinstance(obj, (np.integer,)):
         return int(obj)
     if isinstance(obj, np.ndarray):
-        return _json_safe(obj.tolist())
+        return json_safe(obj.tolist())
     if isinstance(obj, Path):
         return str(obj)
     return obj
@@ -107,6 +112,7 @@ class RunResult:
     contact_profile: dict | None = None
     rope_profile: dict | None = None
     extras: dict = field(default_factory=dict)
+    snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.snapshots)
 
 
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
@@ -125,6 +131,11 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     if result.rope_profile is not None:
         write_csv(out / "rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
         written.append(out / "rope_profile.csv")
+    if result.snapshots:
+        from .snapshots import SNAPSHOT_FILES
+        for name, data in result.snapshots.items():
+            write_csv(out / name, SNAPSHOT_FILES[name], data)
+            written.append(out / name)
     if plots:
         from .plots.results import plot_pull_force, plot_tension_profile
         plot_pull_force(out / "pull_force.png", result)
@@ -132,7 +143,7 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
         if result.tension_profile is not None:
             plot_tension_profile(out / "tension_profile.png", result)
             written.append(out / "tension_profile.png")
-    atomic_write_text(out / "summary.json", json.dumps(_json_safe(result.summary), indent=2) + "\n")
+    atomic_write_text(out / "summary.json", json.dumps(json_safe(result.summary), indent=2) + "\n")
     written.append(out / "summary.json")
     return written
 

@@ -67,7 +67,12 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     model = build_model(sc)
     build_s = time.perf_counter() - t_start
     progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
-    out = simulate(model, progress=progress, steady_stop=steady_stop)
+    snapshot_times = sc.output.times_s(sc.solver.end_time_s)
+    recorder = None
+    if snapshot_times:
+        from .snapshots import SnapshotRecorder
+        recorder = SnapshotRecorder(model, snapshot_times)
+    out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
     h = out.history.arrays()
     sp = sc.solver
     st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
@@ -104,6 +109,9 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     }
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
+    if recorder is not None:
+        summary["snapshots_s"] = recorder.recorded_s
+        summary["snapshots_not_reached_s"] = list(recorder.pending)
     rope_profile = None
     extras = {}
     if rope is not None:
@@ -111,7 +119,8 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                         "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m}
         extras["s_cable_m"] = rope.s_cable_m
     result = RunResult(summary=summary, history=h, tension_profile={"s_m": x, "tension_N": N},
-                       contact_profile=cprof, rope_profile=rope_profile, extras=extras)
+                       contact_profile=cprof, rope_profile=rope_profile, extras=extras,
+                       snapshots=recorder.tables() if recorder is not None else None)
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result

@@ -31,6 +31,7 @@ __all__ = [
     "ContactSpec",
     "PullSpec",
     "GravitySpec",
+    "OutputSpec",
     "SolverSpec",
     "Scenario",
     "load_scenario",
@@ -319,6 +320,37 @@ class GravitySpec:
 
 
 @dataclass(frozen=True)
+class OutputSpec:
+    """What is written besides the histories and final profiles.
+
+    Attributes
+    ----------
+    snapshots_s : tuple of float
+        Times at which the whole state is written (snapshot files) [s], sorted, each in
+        [0, solver.end_time].
+    snapshot_interval_s : float or None
+        Also a snapshot every this many seconds, at k·interval, k = 1, 2, … [s].
+    """
+
+    snapshots_s: tuple = ()
+    snapshot_interval_s: float | None = None
+
+    def times_s(self, end_time_s: float) -> tuple:
+        """All snapshot times up to ``end_time_s`` [s], sorted, duplicates merged."""
+        times = set(self.snapshots_s)
+        if self.snapshot_interval_s is not None:
+            n = int(math.floor(end_time_s / self.snapshot_interval_s * (1 + 1e-12)))
+            times.update(k * self.snapshot_interval_s for k in range(1, n + 1))
+        return tuple(sorted(t for t in times if t <= end_time_s))
+
+    def to_dict(self) -> dict:
+        d: dict[str, Any] = {"snapshots": list(self.snapshots_s)}
+        if self.snapshot_interval_s is not None:
+            d["snapshot_interval"] = self.snapshot_interval_s
+        return d
+
+
+@dataclass(frozen=True)
 class SolverSpec:
     """Time integration settings.
 
@@ -411,6 +443,7 @@ class Scenario:
     pull: PullSpec
     gravity: GravitySpec | None
     solver: SolverSpec
+    output: OutputSpec = field(default_factory=OutputSpec)
     source_path: Path | None = field(default=None, compare=False)
 
     def build_conduit(self):
@@ -456,6 +489,8 @@ class Scenario:
         if self.gravity is not None:
             d["gravity"] = self.gravity.to_dict()
         d["solver"] = self.solver.to_dict()
+        if self.output != OutputSpec():
+            d["output"] = self.output.to_dict()
         return d
 
 
@@ -529,7 +564,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     ScenarioError
         The first problem found, naming its full dotted key.
     """
-    top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver"})
+    top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver", "output"})
     name = top.string("name", default=default_name)
     if not name.strip():
         raise ScenarioError("name", "must be a non-empty string")
@@ -542,6 +577,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     gravity_data = top.table("gravity", default=None)
     gravity = None if gravity_data is None else _parse_gravity(gravity_data)
     solver = _parse_solver(top.table("solver"))
+    output = _parse_output(top.table("output", default={}), solver.end_time_s)
 
     scenario = Scenario(
         name=name,
@@ -552,6 +588,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
         pull=pull,
         gravity=gravity,
         solver=solver,
+        output=output,
     )
     conduit_length_m = _conduit_length_m(scenario.build_conduit())
     # A relative tolerance absorbs float round-off when the length is written as the sum
@@ -1032,6 +1069,21 @@ def _parse_pull(data) -> PullSpec:
 def _parse_gravity(data) -> GravitySpec:
     t = _Table(data, "gravity", {"g"})
     return GravitySpec(g_m_per_s2=t.number("g", "m/s^2", ge=0.0))
+
+
+def _parse_output(data, end_time_s: float) -> OutputSpec:
+    t = _Table(data, "output", {"snapshots", "snapshot_interval"})
+    raw, _ = t._get("snapshots", [])
+    if not isinstance(raw, list):
+        raise ScenarioError("output.snapshots", f"must be a list of times [s], got {_describe(raw)}")
+    times = []
+    for i, value in enumerate(raw):
+        key = f"output.snapshots[{i}]"
+        v = _as_float(key, value, "s")
+        _check_range(key, v, "s", ge=0.0, le=end_time_s)
+        times.append(v)
+    interval = t.number("snapshot_interval", "s", default=None, gt=0.0)
+    return OutputSpec(snapshots_s=tuple(sorted(set(times))), snapshot_interval_s=interval)
 
 
 def _parse_solver(data) -> SolverSpec:

@@ -1,0 +1,148 @@
+"""`exucable export` and snapshots: the discrete problem rebuilt from the files alone, snapshot
+times and equilibrium, and the worked cross-check of examples/crosscheck_reader.py."""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import json
+
+import jsonschema
+import numpy as np
+import pytest
+
+from exucable.errors import ScenarioError
+from exucable.export import EXPORT_FILES, export_problem, schema_of
+from exucable.model.build import build_model
+from exucable.results import read_csv
+from exucable.run import run_scenario
+from exucable.scenario import load_scenario, parse_scenario
+from exucable.snapshots import SNAPSHOT_FILES
+
+from conftest import ROOT
+
+_spec = importlib.util.spec_from_file_location("crosscheck_reader", ROOT / "examples" / "crosscheck_reader.py")
+reader = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(reader)
+
+EX2 = ROOT / "scenarios/fast/paper_ex2_bend90.toml"
+SNAPSHOTS_S = [0.1234567, 0.25, 0.3]
+
+
+def _rows(path):
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            yield {k: (int(v) if v.lstrip("-").isdigit() else float(v)) for k, v in row.items()}
+
+
+def _validate_dir(directory, names):
+    for name in names:
+        schema = schema_of(name)
+        jsonschema.Draft202012Validator.check_schema(schema)
+        validator = jsonschema.Draft202012Validator(schema)
+        if name.endswith(".json"):
+            validator.validate(json.loads((directory / name).read_text()))
+            continue
+        n = 0
+        for row in _rows(directory / name):
+            validator.validate(row)
+            n += 1
+        assert n > 0, name
+
+
+@pytest.fixture(scope="module")
+def ex2_run(tmp_path_factory):
+    """Fast Example 2 with snapshots, run and exported into one directory (as a user would)."""
+    out = tmp_path_factory.mktemp("ex2")
+    data = load_scenario(EX2).to_dict()
+    data["output"] = {"snapshots": SNAPSHOTS_S}
+    sc = parse_scenario(data, ROOT)
+    res = run_scenario(sc, out, quiet=True, plots=False)
+    export_problem(sc, out)
+    return out, res
+
+
+def test_export_files_follow_their_schemas(ex2_run):
+    out, _ = ex2_run
+    _validate_dir(out, list(EXPORT_FILES) + list(SNAPSHOT_FILES))
+    p = json.loads((out / "problem.json").read_text())
+    assert p["cable"]["axial_stiffness_N"] == pytest.approx(1e9 * np.pi * 0.0025**2, rel=1e-12)
+    assert p["versions"]["exudyn"].startswith("1.13")
+
+
+def test_schema_rejects_a_missing_column():
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate({"node": 0}, schema_of("nodes_initial.csv"))
+
+
+@pytest.mark.parametrize("name, rtol", [
+    ("paper_ex2_bend90", 1e-9), ("paper_ex4_spatial", 1e-9), ("paper_ex3_helix", 1e-9),
+    # Example 1's cable rests on a straight under its weight alone: δ ≈ 0.3 µm at coordinates up to
+    # 50 m, so the round-off of P − Pc (ε·50 m ≈ 1e-14 m) is 3e-8 of δ; no two codes agree closer
+    ("paper_ex1_incline", 1e-6),
+])
+def test_rebuilt_initial_state_gives_exucables_contact_forces(tmp_path, name, rtol):
+    sc = load_scenario(ROOT / f"scenarios/fast/{name}.toml")
+    export_problem(sc, tmp_path)
+    ex = reader.load_export(tmp_path)
+    q, v = reader.node_state(ex["nodes_initial"])
+    mine = reader.contact_forces(ex, q, v)["generalized_force"]
+    model = build_model(sc)
+    theirs = model.kernel.evaluate(model.layout.coordinates.reshape(-1), model.layout.velocities.reshape(-1))
+    Q = theirs.generalized_force
+    assert np.max(np.abs(Q)) > 0.1                       # the start is in contact
+    assert np.max(np.abs(mine - Q)) <= rtol * np.max(np.abs(Q))
+
+
+def test_snapshots_land_on_the_requested_times(ex2_run):
+    out, res = ex2_run
+    times = read_csv(out / "snapshot_times.csv")
+    assert np.max(np.abs(times["time_s"] - SNAPSHOTS_S)) <= 1e-12
+    assert np.all(times["step_start_s"] <= times["time_s"]) and np.all(times["time_s"] <= times["step_end_s"])
+    for name in ("snapshot_nodes.csv", "snapshot_tension.csv", "snapshot_contact.csv"):
+        t = read_csv(out / name)["time_s"]
+        assert set(t) == set(times["time_s"]), name
+    assert res.summary["snapshots_s"] == SNAPSHOTS_S and res.summary["snapshots_not_reached_s"] == []
+
+
+def test_snapshot_tension_integrates_to_the_pulling_force(ex2_run):
+    """At each snapshot of steady sliding: the tension at the leading end is the rig's pulling
+    force, and back tension + the friction along the cable (no gravity here) add up to it, both
+    within the run's own scatter of the pulling force (3 σ over its steady window)."""
+    out, res = ex2_run
+    s = res.summary
+    tol = 3.0 * s["pull_force_std_N"]
+    assert 0.0 < tol < 0.01 * s["pull_force_N"]
+    times = read_csv(out / "snapshot_times.csv")
+    T = read_csv(out / "snapshot_tension.csv")
+    C = read_csv(out / "snapshot_contact.csv")
+    checked = 0
+    for t, F in zip(times["time_s"], times["pull_force_N"]):
+        if t < s["steady_from_s"]:
+            continue
+        m = T["time_s"] == t
+        e, xi, N = T["element"][m], T["xi"][m], T["tension_N"][m]
+        lead = N[(e == e.max()) & (xi == 1.0)][0]
+        trail = N[(e == 0) & (xi == 0.0)][0]
+        friction = C["friction_force_N"][C["time_s"] == t].sum()
+        assert abs(lead - F) <= tol
+        assert abs(trail - 150.0) <= tol
+        assert abs(trail + friction - F) <= tol
+        checked += 1
+    assert checked >= 2
+
+
+def test_independent_reader_reproduces_the_snapshot_contact_forces(ex2_run):
+    out, _ = ex2_run
+    res = reader.first_snapshot_check(out)
+    assert res["time_s"] == SNAPSHOTS_S[0]
+    assert res["normal_force_N"] <= 1e-9 and res["friction_force_N"] <= 1e-9
+
+
+def test_snapshot_times_are_checked(scenario_factory):
+    with pytest.raises(ScenarioError, match=r"output\.snapshots\[1\]"):
+        scenario_factory(output={"snapshots": [0.1, 5.0]})
+    with pytest.raises(ScenarioError, match=r"output\.snapshot_interval"):
+        scenario_factory(output={"snapshot_interval": 0.0})
+    sc = scenario_factory(output={"snapshots": [0.05], "snapshot_interval": 0.1})
+    assert sc.output.times_s(sc.solver.end_time_s) == pytest.approx((0.05, 0.1, 0.2))
