@@ -8,9 +8,11 @@ Files
 -----
 ``summary.json``          scalars (forces [N], times [s]), status, scenario echoed back, versions
 ``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N``
-``tension_profile.csv``   ``s_m,tension_N`` at the final time (s from the trailing end)
-``contact_profile.csv``   ``s_m,normal_force_per_length_N_per_m,penetration_m`` (s along the conduit)
-``rope_profile.csv``      ``s_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+``tension_profile.csv``   ``x_m,tension_N`` at the final time (x: material coordinate from the trailing end)
+``contact_profile.csv``   ``s_conduit_m,normal_force_per_length_N_per_m,penetration_m`` (along the
+                          scenario's conduit from its start)
+``rope_profile.csv``      ``s_conduit_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+``snapshot_*.csv``        the state at ``[output] snapshots`` times (see :mod:`exucable.snapshots`)
 """
 
 from __future__ import annotations
@@ -27,12 +29,18 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
-           "read_summary", "json_safe", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
+           "read_summary", "json_safe", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "OLD_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
 HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N")
-PROFILE_COLUMNS = ("s_m", "tension_N")
-CONTACT_COLUMNS = ("s_m", "normal_force_per_length_N_per_m", "penetration_m")
-ROPE_COLUMNS = ("s_m", "tension_N", "sidewall_pressure_N_per_m")
+# Arc lengths, one convention in every file: x_m = material coordinate along the cable from its
+# trailing end; s_conduit_m = along the scenario's conduit from its start (whatever the pull direction)
+PROFILE_COLUMNS = ("x_m", "tension_N")
+CONTACT_COLUMNS = ("s_conduit_m", "normal_force_per_length_N_per_m", "penetration_m")
+ROPE_COLUMNS = ("s_conduit_m", "tension_N", "sidewall_pressure_N_per_m")
+#: column names written before the one convention (release 0.x); read by ``compare`` for one
+#: release, never written: file -> {old: new}
+OLD_COLUMNS = {"tension_profile.csv": {"s_m": "x_m"}, "contact_profile.csv": {"s_m": "s_conduit_m"},
+               "rope_profile.csv": {"s_m": "s_conduit_m"}}
 
 
 def atomic_write_bytes(path, data: bytes) -> None:
