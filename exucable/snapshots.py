@@ -20,10 +20,12 @@ Files (long format: one row per time and element or node):
 ``snapshot_times.csv``    ``time_s,step_start_s,step_end_s,pull_force_N``
 ``snapshot_nodes.csv``    ``time_s,node,x_m,pos_*_m,slope_*,vel_*_m_per_s,slope_rate_*_1_per_s``
 ``snapshot_tension.csv``  ``time_s,element,xi,x_m,tension_N``
-``snapshot_contact.csv``  ``time_s,element,x_mid_m,normal_force_N,friction_force_N,max_penetration_m,
-                          points_in_contact`` (sums over the element's check points of the weighted
-                          normal force w·f_n and of the friction force's magnitude [N]; the largest
-                          penetration δ of its check points, 0 without contact [m])
+``snapshot_contact.csv``  ``time_s,element,x_mid_m,normal_force_N,friction_force_N,
+                          normal_force_per_length_N_per_m,friction_force_per_length_N_per_m,
+                          max_penetration_m,points_in_contact`` (sums over the element's check points of
+                          the weighted normal force w·f_n and of the friction force's magnitude [N], the
+                          same over the element's reference length [N/m] to compare different meshes;
+                          the largest penetration δ of its check points, 0 without contact [m])
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ SNAPSHOT_FILES = {
     "snapshot_nodes.csv": ("time_s",) + tuple(c for c in NODE_COLUMNS if c != "s_conduit_m"),
     "snapshot_tension.csv": ("time_s", "element", "xi", "x_m", "tension_N"),
     "snapshot_contact.csv": ("time_s", "element", "x_mid_m", "normal_force_N", "friction_force_N",
+                             "normal_force_per_length_N_per_m", "friction_force_per_length_N_per_m",
                              "max_penetration_m", "points_in_contact"),
 }
 
@@ -133,10 +136,11 @@ class SnapshotRecorder:
         pen = np.nan_to_num(np.asarray(pts.penetration_m, dtype=float), nan=-np.inf)
         max_pen = np.full(n_el, -np.inf)
         np.maximum.at(max_pen, e, pen)
+        normal = np.bincount(e, pts.normal_force_N, n_el)
+        friction = np.bincount(e, pts.friction_force_N, n_el)
         self._append("snapshot_contact.csv", time_s=t, element=np.arange(n_el),
-                     x_mid_m=lay.node_x_m[:-1] + 0.5 * Le,
-                     normal_force_N=np.bincount(e, pts.normal_force_N, n_el),
-                     friction_force_N=np.bincount(e, pts.friction_force_N, n_el),
+                     x_mid_m=lay.node_x_m[:-1] + 0.5 * Le, normal_force_N=normal, friction_force_N=friction,
+                     normal_force_per_length_N_per_m=normal / Le, friction_force_per_length_N_per_m=friction / Le,
                      max_penetration_m=np.maximum(max_pen, 0.0),
                      points_in_contact=np.bincount(e, pts.in_contact.astype(float), n_el).astype(int))
 
