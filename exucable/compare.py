@@ -26,26 +26,27 @@ differences are reported, absolute (in the column's unit) and relative to max |A
 passes when ``max |B − A| <= atol + rtol · max |A|``; ``rtol`` and ``atol`` come from a tolerance
 file (``--tolerances tol.toml``: a ``[default]`` table and tables named by column, or by
 ``family.column``, each with ``rtol`` and/or ``atol``), else from ``--rtol``/``--atol``
-(defaults 1e-2 and 0). The exit status is 1 when any quantity fails. Input errors raise
-:class:`~exucable.errors.ExucableError` (the CLI prints the message without a traceback).
+(defaults 1e-2 and 0); ``passed`` is false when any quantity fails. Input errors raise
+:class:`~exucable.errors.ExucableError`.
+
+Use :func:`compare_results` from Python; :mod:`exucable.commands.compare` is the command-line face.
 """
 
 from __future__ import annotations
 
-import argparse
 import csv
 import math
-import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from exucable.errors import ExucableError
+from .errors import ExucableError
+from .io import new_figure, save_figure
 
 __all__ = ["compare_results", "write_overlay_plot", "write_overlay_plots", "format_report", "load_tolerances",
-           "add_arguments", "main", "DEFAULT_RTOL", "FAMILIES"]
+           "DEFAULT_RTOL", "FAMILIES", "unit_of"]
 
 #: Default threshold on the relative maximum difference [-] (1 %: the paper's own agreement with its closed forms
 #: is 0.39 %, and other multibody codes differ from exucable by their discretisation).
@@ -335,11 +336,7 @@ def format_report(result: dict) -> str:
 
 
 def _figure(rows: int):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(7.0, 3.6 * rows), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(7.0, 3.6 * rows), layout="constrained")
     axes = fig.subplots(2 * rows, 1, squeeze=False, height_ratios=[3, 1] * rows)[:, 0]
     return fig, axes
 
@@ -366,17 +363,6 @@ def _draw(c, ta, tb, top, bottom) -> None:
     bottom.set_xlabel(f"{c['abscissa']}")
 
 
-def _save(fig, out: Path) -> Path:
-    import io
-
-    from .results import atomic_write_bytes
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format=out.suffix.lstrip(".") or "png", dpi=120)
-    atomic_write_bytes(out, buf.getvalue())
-    return out
-
-
 def write_overlay_plot(result: dict, out) -> Path:
     """Every compared quantity in one figure (A, B, and B − A below), written atomically to ``out``."""
     tables_a, tables_b = _load(result["a"]), _load(result["b"])
@@ -384,7 +370,7 @@ def write_overlay_plot(result: dict, out) -> Path:
     fig, axes = _figure(len(comps))
     for i, c in enumerate(comps):
         _draw(c, tables_a[c["kind"]], tables_b[c["kind"]], axes[2 * i], axes[2 * i + 1])
-    return _save(fig, Path(out))
+    return save_figure(fig, out, dpi=120)
 
 
 def write_overlay_plots(result: dict, out_dir) -> list[Path]:
@@ -394,49 +380,5 @@ def write_overlay_plots(result: dict, out_dir) -> list[Path]:
     for c in result["comparisons"]:
         fig, axes = _figure(1)
         _draw(c, tables_a[c["kind"]], tables_b[c["kind"]], axes[0], axes[1])
-        written.append(_save(fig, Path(out_dir) / f"compare_{c['kind']}_{c['column']}.png"))
+        written.append(save_figure(fig, Path(out_dir) / f"compare_{c['kind']}_{c['column']}.png", dpi=120))
     return written
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add the ``compare`` subcommand's arguments to ``parser``."""
-    parser.add_argument("a", help="reference results: a result directory or one results CSV")
-    parser.add_argument("b", help="results to check, same kinds as A (interpolated onto A's abscissa)")
-    parser.add_argument("--rtol", type=float, default=DEFAULT_RTOL,
-                        help=f"relative tolerance on max |B-A|, relative to max |A| (default {DEFAULT_RTOL:g})")
-    parser.add_argument("--atol", type=float, default=0.0,
-                        help="absolute tolerance on max |B-A|, in each quantity's unit (default 0)")
-    parser.add_argument("--tolerances", default=None,
-                        help="TOML of per-quantity tolerances: [default], [pull_force_N], [snapshot_contact.normal_force_N], "
-                             "... each with rtol and/or atol (overrides --rtol/--atol)")
-    parser.add_argument("--out", default=None,
-                        help="overlay figures: a directory (one PNG per quantity) or a .png path (all in one)")
-
-
-def main(args: argparse.Namespace) -> int:
-    """Run ``exucable compare``; print the table, write the figures if asked; 1 if beyond a tolerance."""
-    for name in ("rtol", "atol"):
-        value = getattr(args, name)
-        if not (value >= 0.0 and math.isfinite(value)):
-            raise ExucableError(f"--{name} must be a finite number >= 0, got {value!r}")
-    tolerances = load_tolerances(args.tolerances) if args.tolerances else None
-    result = compare_results(args.a, args.b, rtol=args.rtol, atol=args.atol, tolerances=tolerances)
-    print(format_report(result))
-    if args.out:
-        out = Path(args.out)
-        if out.suffix.lower() == ".png":
-            print(f"overlay plot: {write_overlay_plot(result, out)}")
-        else:
-            paths = write_overlay_plots(result, out)
-            print(f"overlay plots: {len(paths)} in {out}/")
-    return 0 if result["passed"] else 1
-
-
-if __name__ == "__main__":  # python -m exucable.compare A B
-    _parser = argparse.ArgumentParser(prog="exucable compare", description=__doc__.splitlines()[0])
-    add_arguments(_parser)
-    try:
-        sys.exit(main(_parser.parse_args()))
-    except ExucableError as _exc:
-        print(f"error: {_exc}", file=sys.stderr)
-        sys.exit(2)

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .export import NODE_COLUMNS
+from .formats import SNAPSHOT_FILES
 from .tension import hermite_derivative_weights
 
 __all__ = ["SnapshotRecorder", "SNAPSHOT_FILES", "TENSION_XI", "hermite_in_time"]
@@ -40,14 +40,6 @@ __all__ = ["SnapshotRecorder", "SNAPSHOT_FILES", "TENSION_XI", "hermite_in_time"
 #: Element coordinates at which the snapshot tension is written [-].
 TENSION_XI = (0.0, 0.25, 0.5, 0.75, 1.0)
 
-SNAPSHOT_FILES = {
-    "snapshot_times.csv": ("time_s", "step_start_s", "step_end_s", "pull_force_N"),
-    "snapshot_nodes.csv": ("time_s",) + tuple(c for c in NODE_COLUMNS if c != "s_conduit_m"),
-    "snapshot_tension.csv": ("time_s", "element", "xi", "x_m", "tension_N"),
-    "snapshot_contact.csv": ("time_s", "element", "x_mid_m", "normal_force_N", "friction_force_N",
-                             "normal_force_per_length_N_per_m", "friction_force_per_length_N_per_m",
-                             "max_penetration_m", "points_in_contact"),
-}
 
 
 def hermite_in_time(t, t0, q0, v0, t1, q1, v1):

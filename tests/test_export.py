@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 
 from exucable.errors import ScenarioError
-from exucable.export import EXPORT_FILES, export_problem, schema_of
+from exucable.export import export_problem
+from exucable.formats import EXPORT_FILES, SNAPSHOT_FILES, schema_of
 from exucable.model.build import build_model
 from exucable.results import read_csv
 from exucable.run import run_scenario
 from exucable.scenario import load_scenario, parse_scenario
-from exucable.snapshots import SNAPSHOT_FILES
 
 from conftest import ROOT
 
