@@ -76,6 +76,9 @@ def test_schema_rejects_a_missing_column():
 
 
 @pytest.mark.parametrize("name, rtol", [
+    # measured 3e-12 and 3e-11; Example 3, 8.5e-10: at its worst point the penetration agrees to
+    # 4e-18 m, the rest is the damping term C·δ̇ with δ̇ = n·v, the small normal part of the 0.1 m/s
+    # sliding speed, where n's round-off ε|P|/(R − r) ≈ 4e-13 is multiplied by C|v| = 100 N·s/m·m/s
     ("paper_ex2_bend90", 1e-9), ("paper_ex4_spatial", 1e-9), ("paper_ex3_helix", 1e-9),
     # Example 1's cable rests on a straight under its weight alone: δ ≈ 0.3 µm at coordinates up to
     # 50 m, so the round-off of P − Pc (ε·50 m ≈ 1e-14 m) is 3e-8 of δ; no two codes agree closer
@@ -146,3 +149,32 @@ def test_snapshot_times_are_checked(scenario_factory):
         scenario_factory(output={"snapshot_interval": 0.0})
     sc = scenario_factory(output={"snapshots": [0.05], "snapshot_interval": 0.1})
     assert sc.output.times_s(sc.solver.end_time_s) == pytest.approx((0.05, 0.1, 0.2))
+
+
+def test_hermite_in_time_is_exact_for_a_cubic_and_at_step_ends():
+    from exucable.snapshots import hermite_in_time
+
+    def q(t):
+        return np.array([1.0 - 2.0 * t + 3.0 * t**2 - 0.5 * t**3, 4.0 * t**3])
+
+    def v(t):
+        return np.array([-2.0 + 6.0 * t - 1.5 * t**2, 12.0 * t**2])
+
+    t0, t1 = 0.3, 0.7
+    for t in (0.3, 0.41, 0.5, 0.7):
+        qi, vi = hermite_in_time(t, t0, q(t0), v(t0), t1, q(t1), v(t1))
+        assert np.allclose(qi, q(t), rtol=0, atol=1e-14) and np.allclose(vi, v(t), rtol=0, atol=1e-13)
+    q1, v1 = hermite_in_time(t1, t0, q(t0), v(t0), t1, q(t1), v(t1))
+    assert np.array_equal(q1, q(t1)) and np.array_equal(v1, v(t1))
+
+
+def test_export_command_writes_every_file_and_refuses_bad_input(tmp_path, capsys):
+    from exucable.cli import main
+
+    assert main(["export", str(EX2), str(tmp_path / "e")]) == 0
+    assert sorted(p.name for p in (tmp_path / "e").iterdir()) == sorted(EXPORT_FILES)
+    bad = tmp_path / "bad.toml"
+    bad.write_text(EX2.read_text() + "\n[output]\nsnapshots = [-1.0]\n")
+    assert main(["export", str(bad), str(tmp_path / "f")]) == 2
+    assert "output.snapshots[0]" in capsys.readouterr().err
+    assert not (tmp_path / "f").exists()
