@@ -83,10 +83,15 @@ def test_schema_rejects_a_missing_column():
     # Example 1's cable rests on a straight under its weight alone: δ ≈ 0.3 µm at coordinates up to
     # 50 m, so the round-off of P − Pc (ε·50 m ≈ 1e-14 m) is 3e-8 of δ; no two codes agree closer
     ("paper_ex1_incline", 1e-6),
+    ("paper_ex2_bend90:reverse", 1e-9),
 ])
 def test_rebuilt_initial_state_gives_exucables_contact_forces(tmp_path, name, rtol):
+    name, _, direction = name.partition(":")
     sc = load_scenario(ROOT / f"scenarios/fast/{name}.toml")
+    if direction:
+        sc = sc.replace(**{"pull.direction": direction})
     export_problem(sc, tmp_path)
+    _validate_dir(tmp_path, EXPORT_FILES)
     ex = reader.load_export(tmp_path)
     q, v = reader.node_state(ex["nodes_initial"])
     mine = reader.contact_forces(ex, q, v)["generalized_force"]
@@ -133,6 +138,16 @@ def test_snapshot_tension_integrates_to_the_pulling_force(ex2_run):
         assert abs(trail + friction - F) <= tol
         checked += 1
     assert checked >= 2
+
+
+def test_a_run_compared_with_itself_agrees_in_every_family(ex2_run):
+    from exucable.compare import FAMILIES, compare_results
+
+    out, _ = ex2_run
+    result = compare_results(out, out, rtol=0.0)
+    assert result["passed"] and result["notes"] == [] and result["skipped"] == []
+    assert {c["kind"] for c in result["comparisons"]} == set(FAMILIES)
+    assert all(c["max_abs"] == 0.0 for c in result["comparisons"])
 
 
 def test_independent_reader_reproduces_the_snapshot_contact_forces(ex2_run):
