@@ -58,3 +58,33 @@ def test_steady_detector_follows_an_expected_drift():
     assert st.steady and st.from_s == pytest.approx(0.01)
     assert st.mean_N == pytest.approx(np.mean(force), rel=1e-12)   # the force's own mean, at the mean time
     assert st.std_N == pytest.approx(np.std(wobble), rel=1e-9)
+
+
+def test_a_pull_starts_on_the_rope_with_clearance():
+    # The up-bend of the issue: the cable starts where the rope with clearance hangs, off the floor over
+    # its free span before the bend (the old start pressed it on the floor there, and it rang as the span
+    # formed), with that rope's tension.
+    from exucable.model.build import build_model
+    from exucable.rope_clearance import solve_rope_with_clearance
+
+    data = {
+        "cable": {"radius": 0.009, "mass_per_length": 1.0, "youngs_modulus": 5e8, "bending_stiffness": 0.079,
+                  "elements": 60},
+        "conduit": {"inner_radius": 0.019, "path": [{"straight": 5.0}, {"bend": 60.0, "radius": 5.0, "turn": "up"},
+                                                    {"straight": 3.0}]},
+        "contact": {"friction": 0.3},
+        "pull": {"speed": 0.2, "back_tension": 200.0},
+        "gravity": {"g": 9.81},
+        "solver": {"end_time": 0.5, "step": 1e-2},
+    }
+    sc = parse_scenario(data, ".")
+    model = build_model(sc)
+    centre = model.conduit.centreline
+    free = solve_rope_with_clearance(centre, 0.01, 0.3, 9.81, 200.0)
+    lay = model.layout
+    z_rope = np.interp(lay.node_s_m, free.s_conduit_m, free.position_m[:, 2])
+    span = (lay.node_s_m > 4.4) & (lay.node_s_m < 4.9)      # inside the free span (4.2 … 5.2 m)
+    assert np.any(span)
+    # off the floor (z = −0.01 m there) and within 0.5 mm of the rope with clearance's height
+    assert np.all(lay.position_m[span, 2] > -0.009)
+    np.testing.assert_allclose(lay.position_m[span, 2], z_rope[span], atol=5e-4)
