@@ -22,6 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .io import atomic_write_text
+
 __all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "markdown_table", "format_default",
            "readme_with_tables"]
 
@@ -317,7 +319,7 @@ def main(argv=None) -> int:
     old = path.read_text(encoding="utf-8")
     new = readme_with_tables(old)
     if new != old:
-        path.write_text(new, encoding="utf-8")
+        atomic_write_text(path, new)
         print(f"updated the key tables of {path}")
     else:
         print(f"{path} is up to date")

@@ -240,3 +240,21 @@ def test_readme_layout_table_matches_the_tree():
                 if (p.suffix == ".py" and p.name != "__init__.py" or (p / "__init__.py").is_file())
                 and f"exucable/{p.name}" not in named]
     assert unlisted == [], "modules and packages missing from README's layout table (add a row)"
+
+
+def test_one_atomic_writer():
+    """Files are written through exucable.io only (temporary file + os.replace). Not files of
+    results: the sweep's lock file (held open, flock'ed, see sweep/store.py); its case directories
+    are installed by a rename of a complete directory."""
+    lock_file = ("exucable/sweep/store.py", 'f = open(self.path, "a+")')
+    writes = re.compile(r"os\.replace\(|mkstemp\(|NamedTemporaryFile\(|\.write_text\(|\.write_bytes\(|"
+                        r"open\([^)]*['\"][wax]b?\+?['\"]")
+    offenders = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.name == "io.py" and path.parent == PACKAGE:
+            continue
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            if (writes.search(line) and not line.lstrip().startswith("#")
+                    and (str(path.relative_to(ROOT)), line.strip()) != lock_file):
+                offenders.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
+    assert offenders == []
