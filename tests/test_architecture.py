@@ -258,3 +258,14 @@ def test_one_atomic_writer():
                     and (str(path.relative_to(ROOT)), line.strip()) != lock_file):
                 offenders.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
     assert offenders == []
+
+
+def test_plots_import_nothing_above_them():
+    """Figures are drawn from data: plots/ may use the writer and the reference values, nothing
+    that runs, reads results or builds models."""
+    modules = _modules()
+    allowed = {"exucable.io", "exucable.reference", "exucable.data"}
+    for name in modules:
+        if name.startswith("exucable.plots"):
+            above = {m for m in _imports(name, modules) if not m.startswith("exucable.plots")} - allowed
+            assert above == set(), f"{name} imports {sorted(above)}"
