@@ -269,3 +269,24 @@ def test_plots_import_nothing_above_them():
         if name.startswith("exucable.plots"):
             above = {m for m in _imports(name, modules) if not m.startswith("exucable.plots")} - allowed
             assert above == set(), f"{name} imports {sorted(above)}"
+
+
+def test_only_the_command_line_prints_and_exits():
+    """Library code returns values and raises; printing and exit statuses belong to commands/,
+    cli.py and __main__.py (progress bars write to a stream they are given, not print)."""
+    command_line = {"exucable.cli", "exucable.__main__"}
+    offenders = []
+    for name, path in _modules().items():
+        if name in command_line or name.startswith("exucable.commands"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call):
+                f = node.func
+                called = f.id if isinstance(f, ast.Name) else f"{getattr(f.value, 'id', '?')}.{f.attr}" \
+                    if isinstance(f, ast.Attribute) else ""
+                if called in ("print", "exit", "quit", "sys.exit", "os._exit"):
+                    offenders.append(f"{name}:{node.lineno} {called}()")
+            elif isinstance(node, ast.Raise) and isinstance(node.exc, ast.Call) \
+                    and getattr(node.exc.func, "id", "") == "SystemExit":
+                offenders.append(f"{name}:{node.lineno} raise SystemExit")
+    assert offenders == []
