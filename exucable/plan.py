@@ -1,0 +1,459 @@
+"""Pull planning: both pull directions, section by section, with the limits checked.
+
+What the installation calculators (Polywater Pull-Planner, Southwire SIMpull, Cableizer, the CommScope
+and Southwire manuals' hand calculations) give for a route and a cable set, from exucable's rope
+reference (:mod:`exucable.rope`): for each direction the tension entering and leaving every section,
+the sidewall bearing pressure (SWBP) in every bend, the limit checks with margins, and the recommended
+direction (the lower maximum tension among the directions that violate no limit).
+
+Several cables per duct enter as the calculators have them (:mod:`exucable.engineering`): the weight of
+all cables W = n·w, and friction multiplied by the weight correction factor w_c, so that the rope
+equation gives T_out = T_in + w_c μ W L on a level straight and T_out = T_in e^{w_c μ θ} in a bend
+without weight (Polywater, "Weight Correction Factor in Pulling Tension Calculations"). The rope keeps
+gravity exactly on slopes and vertical bends, where the calculators use approximations.
+
+The scenario keys this module adds to the scenario file (read here, in one place, and stripped before
+:func:`exucable.scenario.parse_scenario` sees the rest): ``cable.count``, ``cable.arrangement``,
+``[limits]``, ``pull.feed_from_reel`` and ``[display] units``. Quantities may be written as numbers (SI,
+or imperial with ``units = "imperial"``) or as ``"value unit"`` strings (:mod:`exucable.units`).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from exucable import engineering as eng
+from exucable.errors import ExucableError, ScenarioError
+from exucable.geometry.centreline import Centreline
+from exucable.rope import sidewall_pressure_N_per_m, solve_rope
+from exucable.scenario import Scenario, parse_scenario, read_toml
+from exucable.units import SYSTEMS, to_si
+
+__all__ = ["LimitsSpec", "PlanSpec", "load_plan_scenario", "plan_pull", "ENGINES", "PLAN_KEYS"]
+
+ENGINES = ("rope", "steady", "dynamic")
+
+# Scenario keys read as quantities (dimension, cross-section length?) so that imperial numbers and
+# "value unit" strings are converted to SI before the scenario parser sees them.
+_SCENARIO_QUANTITIES = {
+    ("cable", "radius"): ("length", True),
+    ("cable", "mass_per_length"): ("mass_per_length", False),
+    ("cable", "length"): ("length", False),
+    ("conduit", "inner_radius"): ("length", True),
+    ("pull", "back_tension"): ("force", False),
+    ("pull", "force"): ("force", False),
+    ("pull", "speed"): ("speed", False),
+}
+_PATH_QUANTITIES = {"straight": ("length", False), "radius": ("length", False), "pitch": ("length", False)}
+
+# [limits] keys: name -> (dimension or None, cross-section?, what)
+_LIMIT_KEYS = {
+    "max_tension": ("force", False, "largest allowed pulling tension"),
+    "grip_limit": ("force", False, "rating of the pulling eye or grip"),
+    "max_sidewall_pressure": ("force_per_length", False, "largest allowed sidewall bearing pressure"),
+    "min_bend_radius_multiple": (None, False, "smallest bend radius as a multiple of the cable diameter"),
+    "min_clearance": ("length", True, "smallest clearance above the cables"),
+    "conductor_material": (None, False, "copper or aluminium"),
+    "conductor_area": ("area", False, "cross-section of one conductor"),
+    "conductors": (None, False, "conductors sharing the pull (all cables)"),
+    "conductor_rule": (None, False, "iec (N/mm^2) or us (lb/cmil)"),
+}
+PLAN_KEYS = ("cable.count", "cable.arrangement", "pull.feed_from_reel", "display.units",
+             *(f"limits.{k}" for k in _LIMIT_KEYS))
+
+
+@dataclass(frozen=True)
+class LimitsSpec:
+    """The cable's limits (all optional; SI).
+
+    Attributes
+    ----------
+    max_tension_N, grip_limit_N : float or None
+        Largest pulling tension given directly; rating of the pulling eye or grip [N].
+    conductor_tension_N : float or None
+        Largest tension on the conductors from material, area and count [N] (see
+        :func:`exucable.engineering.max_tension_from_conductors_N`).
+    max_sidewall_pressure_N_per_m : float or None
+        Largest sidewall bearing pressure [N/m].
+    min_bend_radius_multiple : float or None
+        Smallest bend radius as a multiple of the cable diameter [-].
+    min_clearance_m : float or None
+        Smallest clearance between the uppermost cable and the duct [m].
+    """
+
+    max_tension_N: float | None = None
+    grip_limit_N: float | None = None
+    conductor_tension_N: float | None = None
+    max_sidewall_pressure_N_per_m: float | None = None
+    min_bend_radius_multiple: float | None = None
+    min_clearance_m: float | None = None
+    given: dict = field(default_factory=dict, compare=False)
+
+
+@dataclass(frozen=True)
+class PlanSpec:
+    """Planning inputs beyond the simulation scenario.
+
+    Attributes
+    ----------
+    count : int
+        Cables of the described kind in the duct (1…4).
+    arrangement : str
+        ``"auto"`` or one of :data:`exucable.engineering.ARRANGEMENTS`.
+    units : str
+        ``"si"`` or ``"imperial"``: unit of bare numbers in the file and of the printed tables.
+    limits : LimitsSpec
+    feed_from_reel : bool
+        Also compute the pull-in history (tension at the rig against pulled length).
+    """
+
+    count: int = 1
+    arrangement: str = "auto"
+    units: str = "si"
+    limits: LimitsSpec = field(default_factory=LimitsSpec)
+    feed_from_reel: bool = False
+
+
+def _convert_scenario_quantities(data: dict, system: str) -> None:
+    """Convert the scenario's quantity keys in place to SI numbers."""
+    for (table, name), (dim, small) in _SCENARIO_QUANTITIES.items():
+        t = data.get(table)
+        if isinstance(t, dict) and name in t:
+            t[name] = to_si(f"{table}.{name}", t[name], dim, system, small)
+    path = data.get("conduit", {}).get("path") if isinstance(data.get("conduit"), dict) else None
+    if isinstance(path, list):
+        for i, item in enumerate(path):
+            if isinstance(item, dict):
+                for name, (dim, small) in _PATH_QUANTITIES.items():
+                    if name in item:
+                        item[name] = to_si(f"conduit.path[{i}].{name}", item[name], dim, system, small)
+
+
+def _read_limits(raw, system: str) -> LimitsSpec:
+    if raw is None:
+        return LimitsSpec()
+    if not isinstance(raw, dict):
+        raise ScenarioError("limits", "must be a table [limits]")
+    for k in raw:
+        if k not in _LIMIT_KEYS:
+            raise ScenarioError(f"limits.{k}", f"unknown key; allowed in [limits]: {', '.join(_LIMIT_KEYS)}")
+    vals: dict = {}
+    for k, (dim, small, _) in _LIMIT_KEYS.items():
+        if k not in raw or dim is None:
+            continue
+        v = to_si(f"limits.{k}", raw[k], dim, system, small)
+        if not v > 0.0:
+            raise ScenarioError(f"limits.{k}", f"must be > 0, got {raw[k]!r}")
+        vals[k] = v
+    mult = raw.get("min_bend_radius_multiple")
+    if mult is not None and (isinstance(mult, bool) or not isinstance(mult, (int, float)) or not mult > 0):
+        raise ScenarioError("limits.min_bend_radius_multiple", f"must be a number > 0 (a multiple of the cable diameter), got {mult!r}")
+    conductor_keys = [k for k in ("conductor_material", "conductor_area", "conductors") if k in raw]
+    conductor_N = None
+    if conductor_keys:
+        missing = [k for k in ("conductor_material", "conductor_area", "conductors") if k not in raw]
+        if missing:
+            raise ScenarioError(f"limits.{missing[0]}", "the conductor limit needs conductor_material, conductor_area "
+                                                        "and conductors together")
+        n = raw["conductors"]
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise ScenarioError("limits.conductors", f"must be an integer >= 1, got {n!r}")
+        rule = raw.get("conductor_rule", "us" if system == "imperial" else "iec")
+        conductor_N = eng.max_tension_from_conductors_N(raw["conductor_material"], vals["conductor_area"], n, rule)
+    elif "conductor_rule" in raw:
+        raise ScenarioError("limits.conductor_rule", "given without conductor_material, conductor_area and conductors")
+    return LimitsSpec(
+        max_tension_N=vals.get("max_tension"),
+        grip_limit_N=vals.get("grip_limit"),
+        conductor_tension_N=conductor_N,
+        max_sidewall_pressure_N_per_m=vals.get("max_sidewall_pressure"),
+        min_bend_radius_multiple=None if mult is None else float(mult),
+        min_clearance_m=vals.get("min_clearance"),
+        given=dict(raw),
+    )
+
+
+def parse_plan_scenario(data: dict, base_dir: Path, default_name: str = "scenario",
+                        units: str | None = None) -> tuple[Scenario, PlanSpec]:
+    """Split a scenario dict into the simulation scenario and the planning inputs.
+
+    Parameters
+    ----------
+    data : dict
+        Scenario tables as read from TOML (not modified).
+    base_dir : Path
+        Directory for relative paths in the scenario.
+    units : {"si", "imperial"} or None
+        Overrides ``display.units`` (the ``--units`` option).
+
+    Raises
+    ------
+    ScenarioError
+        Naming the dotted key of the first bad value.
+    """
+    data = copy.deepcopy(data)
+    display = data.pop("display", {})
+    if not isinstance(display, dict) or any(k != "units" for k in display):
+        raise ScenarioError("display", "must be a table with only units = \"si\" | \"imperial\"")
+    system = units or display.get("units", "si")
+    if system not in SYSTEMS:
+        raise ScenarioError("display.units", f"must be \"si\" or \"imperial\", got {system!r}")
+    cable = data.get("cable") if isinstance(data.get("cable"), dict) else {}
+    count = cable.pop("count", 1)
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 4:
+        raise ScenarioError("cable.count", f"must be an integer 1…4 (cables of the described kind in the duct), got {count!r}")
+    arrangement = cable.pop("arrangement", "auto")
+    if arrangement != "auto" and arrangement not in eng.ARRANGEMENTS:
+        raise ScenarioError("cable.arrangement", f"must be one of \"auto\", "
+                                                 f"{', '.join(repr(a) for a in eng.ARRANGEMENTS)}, got {arrangement!r}")
+    pull = data.get("pull") if isinstance(data.get("pull"), dict) else {}
+    feed = pull.pop("feed_from_reel", False)
+    if not isinstance(feed, bool):
+        raise ScenarioError("pull.feed_from_reel", f"must be true or false, got {feed!r}")
+    limits = _read_limits(data.pop("limits", None), system)
+    _convert_scenario_quantities(data, system)
+    scenario = parse_scenario(data, base_dir, default_name)
+    d = 2.0 * scenario.cable.radius_m
+    D = 2.0 * scenario.conduit.inner_radius_m
+    eng.check_fit(count, D, d)
+    if arrangement != "auto":
+        eng.weight_correction_factor(count, arrangement, D, d)  # refuses an arrangement of another count
+    return scenario, PlanSpec(count=count, arrangement=arrangement, units=system, limits=limits, feed_from_reel=feed)
+
+
+def load_plan_scenario(path, units: str | None = None) -> tuple[Scenario, PlanSpec]:
+    """Read a scenario file with its planning keys (see module docstring)."""
+    path = Path(path)
+    scenario, spec = parse_plan_scenario(read_toml(path, "scenario"), path.parent, path.stem, units)
+    object.__setattr__(scenario, "source_path", path.resolve())
+    return scenario, spec
+
+
+# ------------------------------------------------------------------------------------------ sections
+
+def _slope_deg(direction) -> float:
+    return math.degrees(math.asin(max(-1.0, min(1.0, float(direction[2])))))
+
+
+def _bend_plane(piece) -> str:
+    """horizontal / vertical up / vertical down / 3D, from the bend's axis and its change of height."""
+    if piece.kind == "helix":
+        return "helix"
+    axis_z = abs(float(piece.axis[2]))
+    if axis_z > 1.0 - 1e-9:
+        return "horizontal"
+    if axis_z < 1e-9:
+        dz = float(piece.end_tangent[2] - piece.direction[2])
+        return "vertical up" if dz > 0 else "vertical down"
+    return "3D"
+
+
+def _piece_samples(piece, n: int = 65) -> np.ndarray:
+    """Arc lengths inside a piece (kept off its ends, where the curvature of the neighbour begins)."""
+    eps = 1e-9 * piece.length_m
+    return np.linspace(piece.s_start_m + eps, piece.s_end_m - eps, n)
+
+
+def _sections(curve, rope, w_N_per_m: float, swbp_factor: float) -> list[dict]:
+    """Section table of one direction, in pull order, from the rope solution on ``curve``."""
+    rows = []
+    running_max = float(rope.trailing_tension_N)
+    for i, p in enumerate(curve.pieces):
+        s = _piece_samples(p)
+        tension = np.asarray(rope.tension_at(s - 0.0), dtype=float)
+        running_max = max(running_max, float(np.max(tension)))
+        row = {
+            "index": i + 1,
+            "kind": p.kind,
+            "length_m": float(p.length_m),
+            "tension_in_N": float(rope.tension_at(p.s_start_m)),
+            "tension_out_N": float(rope.tension_at(min(p.s_end_m, rope.cable_length_m))),
+            "sidewall_pressure_N_per_m": None,
+            "max_tension_so_far_N": running_max,
+            "s_start_m": float(p.s_start_m),
+        }
+        if p.is_curved:
+            pressure = sidewall_pressure_N_per_m(curve, s, tension, w_N_per_m)
+            row["sidewall_pressure_N_per_m"] = float(np.max(pressure)) * swbp_factor
+            row["plane"] = _bend_plane(p)
+            row["radius_m"] = float(p.coil_radius_m)
+            row["angle_deg"] = math.degrees(p.turning_angle_rad)
+        else:
+            row["plane"] = None
+            row["slope_deg"] = _slope_deg(p.direction)
+        rows.append(row)
+    return rows
+
+
+def _truncated(curve: Centreline, length_m: float) -> Centreline:
+    """The first ``length_m`` [m] of a centreline (the part of the route the cable's head has reached)."""
+    pieces = []
+    for p in curve.pieces:
+        if p.s_end_m < length_m - 1e-12:
+            pieces.append(p)
+        else:
+            pieces.append(replace(p, length_m=length_m - p.s_start_m))
+            break
+    return Centreline(pieces)
+
+
+def _pull_in_history(curve: Centreline, mu: float, w: float, back_tension_N: float, n: int = 121) -> dict:
+    """Tension at the cable's head while it advances from the entrance to the exit (rope, quasi-static).
+
+    The pulling line from the head to the rig is taken as free of friction, so the rig's force is the
+    head's tension. Grid: ``n`` uniform head positions plus every piece boundary.
+    """
+    L = curve.length_m
+    grid = np.unique(np.concatenate([np.linspace(L / n, L, n), [p.s_end_m for p in curve.pieces]]))
+    grid = grid[grid > 1e-9 * L]
+    force = []
+    for x in grid:
+        sub = curve if x >= L * (1 - 1e-12) else _truncated(curve, float(x))
+        force.append(solve_rope(sub, mu, w, back_tension_N, "forward", n_output=2).pull_force_N)
+    return {"pulled_length_m": grid.tolist(), "pull_force_N": force}
+
+
+def _check(name, value, limit, where, lower_is_better=True) -> dict:
+    if lower_is_better:
+        passed = value <= limit
+        margin = (limit - value) / limit
+    else:
+        passed = value >= limit
+        margin = (value - limit) / limit
+    return {"name": name, "passed": bool(passed), "value": float(value), "limit": float(limit),
+            "margin": float(margin), "where": where}
+
+
+def _label(row) -> str:
+    return f"section {row['index']} ({row['kind']})"
+
+
+def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: float, jam) -> list[dict]:
+    lim = spec.limits
+    rows = direction["sections"]
+    worst_t = max(rows, key=lambda r: r["max_tension_so_far_N"])
+    where_t = f"{_label(worst_t)} leaving end" if worst_t["tension_out_N"] >= worst_t["tension_in_N"] \
+        else f"{_label(worst_t)}"
+    t_max = direction["max_tension_N"]
+    out = []
+    for name, limit in (("max_tension", lim.max_tension_N), ("conductor_tension", lim.conductor_tension_N),
+                        ("grip_tension", lim.grip_limit_N)):
+        if limit is not None:
+            out.append(_check(name, t_max, limit, where_t))
+    bends = [r for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+    if lim.max_sidewall_pressure_N_per_m is not None and bends:
+        b = max(bends, key=lambda r: r["sidewall_pressure_N_per_m"])
+        out.append(_check("max_sidewall_pressure", b["sidewall_pressure_N_per_m"], lim.max_sidewall_pressure_N_per_m,
+                          _label(b)))
+    if lim.min_bend_radius_multiple is not None and bends:
+        b = min(bends, key=lambda r: r["radius_m"])
+        out.append(_check("min_bend_radius", b["radius_m"],
+                          lim.min_bend_radius_multiple * 2.0 * scenario.cable.radius_m, _label(b),
+                          lower_is_better=False))
+    if lim.min_clearance_m is not None:
+        out.append(_check("min_clearance", clearance, lim.min_clearance_m, "duct cross-section", lower_is_better=False))
+    if jam.risk != "not applicable":
+        # A number to compare with: the jam band 2.6 ≤ JR < 2.9 is "significant" (Cableizer JR_p).
+        passed = jam.risk != "significant"
+        out.append({"name": "jam_ratio", "passed": passed, "value": jam.jam_ratio, "limit": None,
+                    "margin": None, "where": f"jam risk {jam.risk} (significant for 2.6 <= 1.05 D/d < 2.9)"})
+    return out
+
+
+def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
+    """Plan a pull in both directions.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Route, cable (one of the ``spec.count`` identical cables), friction, back tension, gravity.
+    spec : PlanSpec
+    engine : {"rope", "steady", "dynamic"}
+        Only ``"rope"`` is available in this version (see Raises).
+
+    Returns
+    -------
+    dict
+        The content of ``plan.json`` (SI): ``engine``, ``directions.forward`` / ``.reverse`` (each with
+        ``pull_force_N``, ``max_tension_N``, ``max_sidewall_pressure_N_per_m``, ``sections``, ``checks``,
+        ``passed`` and, if asked, ``pull_in``), ``recommended_direction``, ``weight_correction_factor``,
+        ``jam_ratio``, ``jam_risk``, ``clearance_m``, ``arrangement``, ``count``, ``checks`` (those of the
+        recommended direction), ``passed``, ``inputs``.
+
+    Raises
+    ------
+    ExucableError
+        ``engine`` other than ``"rope"``: the multibody engines are not wired into planning yet.
+    """
+    if engine not in ENGINES:
+        raise ExucableError(f"--engine: must be one of {', '.join(ENGINES)}, got {engine!r}")
+    if engine != "rope":
+        raise ExucableError(
+            f"--engine {engine}: planning with the multibody model is not available in this version "
+            "(the steady solver is being built; the dynamic one is not wired into `plan` yet); use --engine rope")
+    d = 2.0 * scenario.cable.radius_m
+    D = 2.0 * scenario.conduit.inner_radius_m
+    arrangement = eng.auto_arrangement(spec.count, D, d) if spec.arrangement == "auto" else spec.arrangement
+    wc = eng.weight_correction_factor(spec.count, arrangement, D, d)
+    swbp_factor = eng.sidewall_pressure_factor(spec.count, arrangement, wc)
+    jam = eng.jam_risk(spec.count, D, d)
+    clearance = eng.clearance_m(spec.count, arrangement, D, d)
+    g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
+    w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
+    mu_eff = wc * scenario.contact.friction
+    back = scenario.pull.back_tension_N
+    centreline = scenario.build_conduit().centreline
+
+    directions = {}
+    for name in ("forward", "reverse"):
+        curve = centreline if name == "forward" else centreline.reversed()
+        rope = solve_rope(centreline, mu_eff, w_total, back, name)
+        rows = _sections(curve, rope, w_total, swbp_factor)
+        bends = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+        entry = {
+            "pull_force_N": rope.pull_force_N,
+            "max_tension_N": max(rope.max_tension_N, max(r["max_tension_so_far_N"] for r in rows)),
+            "max_sidewall_pressure_N_per_m": max(bends) if bends else None,
+            "slack": rope.slack,
+            "sections": rows,
+            "profile": {"s_m": (rope.s_cable_m).tolist(), "tension_N": rope.tension_N.tolist()},
+        }
+        entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
+        entry["passed"] = all(c["passed"] for c in entry["checks"])
+        if spec.feed_from_reel:
+            entry["pull_in"] = _pull_in_history(curve, mu_eff, w_total, back)
+        directions[name] = entry
+
+    ok = [n for n in directions if directions[n]["passed"]]
+    pool = ok or list(directions)
+    recommended = min(pool, key=lambda n: directions[n]["max_tension_N"])
+    return {
+        "engine": engine,
+        "directions": directions,
+        "recommended_direction": recommended,
+        "weight_correction_factor": wc,
+        "sidewall_pressure_factor": swbp_factor,
+        "jam_ratio": jam.jam_ratio,
+        "jam_risk": jam.risk,
+        "clearance_m": clearance,
+        "arrangement": arrangement,
+        "count": spec.count,
+        "checks": directions[recommended]["checks"],
+        "passed": bool(ok),
+        "inputs": {
+            "scenario": scenario.name,
+            "cable_diameter_m": d,
+            "duct_inner_diameter_m": D,
+            "weight_per_length_one_cable_N_per_m": scenario.cable.mass_per_length_kg_per_m * g,
+            "friction": scenario.contact.friction,
+            "back_tension_N": back,
+            "route_length_m": centreline.length_m,
+            "units": spec.units,
+            "limits": {k: v for k, v in spec.limits.given.items()},
+        },
+    }
