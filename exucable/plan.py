@@ -237,7 +237,7 @@ def load_plan_scenario(path, units: str | None = None) -> tuple[Scenario, PlanSp
 # ------------------------------------------------------------------------------------------ sections
 
 def _slope_deg(direction) -> float:
-    return math.degrees(math.asin(max(-1.0, min(1.0, float(direction[2])))))
+    return math.degrees(math.asin(max(-1.0, min(1.0, float(direction[2]))))) + 0.0  # no "-0"
 
 
 def _bend_plane(piece) -> str:
@@ -318,7 +318,7 @@ def _pull_in_history(curve: Centreline, mu: float, w: float, back_tension_N: flo
     return {"pulled_length_m": grid.tolist(), "pull_force_N": force}
 
 
-def _check(name, value, limit, where, lower_is_better=True) -> dict:
+def _check(name, value, limit, where, quantity, lower_is_better=True) -> dict:
     if lower_is_better:
         passed = value <= limit
         margin = (limit - value) / limit
@@ -326,7 +326,7 @@ def _check(name, value, limit, where, lower_is_better=True) -> dict:
         passed = value >= limit
         margin = (value - limit) / limit
     return {"name": name, "passed": bool(passed), "value": float(value), "limit": float(limit),
-            "margin": float(margin), "where": where}
+            "margin": float(margin), "where": where, "quantity": quantity}
 
 
 def _label(row) -> str:
@@ -344,24 +344,25 @@ def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: floa
     for name, limit in (("max_tension", lim.max_tension_N), ("conductor_tension", lim.conductor_tension_N),
                         ("grip_tension", lim.grip_limit_N)):
         if limit is not None:
-            out.append(_check(name, t_max, limit, where_t))
+            out.append(_check(name, t_max, limit, where_t, "force"))
     bends = [r for r in rows if r["sidewall_pressure_N_per_m"] is not None]
     if lim.max_sidewall_pressure_N_per_m is not None and bends:
         b = max(bends, key=lambda r: r["sidewall_pressure_N_per_m"])
         out.append(_check("max_sidewall_pressure", b["sidewall_pressure_N_per_m"], lim.max_sidewall_pressure_N_per_m,
-                          _label(b)))
+                          _label(b), "force_per_length"))
     if lim.min_bend_radius_multiple is not None and bends:
         b = min(bends, key=lambda r: r["radius_m"])
         out.append(_check("min_bend_radius", b["radius_m"],
                           lim.min_bend_radius_multiple * 2.0 * scenario.cable.radius_m, _label(b),
-                          lower_is_better=False))
+                          "length", lower_is_better=False))
     if lim.min_clearance_m is not None:
-        out.append(_check("min_clearance", clearance, lim.min_clearance_m, "duct cross-section", lower_is_better=False))
+        out.append(_check("min_clearance", clearance, lim.min_clearance_m, "duct cross-section", "small_length",
+                          lower_is_better=False))
     if jam.risk != "not applicable":
         # A number to compare with: the jam band 2.6 ≤ JR < 2.9 is "significant" (Cableizer JR_p).
         passed = jam.risk != "significant"
         out.append({"name": "jam_ratio", "passed": passed, "value": jam.jam_ratio, "limit": None,
-                    "margin": None, "where": f"jam risk {jam.risk} (significant for 2.6 <= 1.05 D/d < 2.9)"})
+                    "margin": None, "quantity": None, "where": f"jam risk {jam.risk} (significant for 2.6 <= 1.05 D/d < 2.9)"})
     return out
 
 

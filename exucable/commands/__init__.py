@@ -1,0 +1,1 @@
+"""One module per subcommand: argument parsing and printing (``exucable/cli.py`` is the table)."""
