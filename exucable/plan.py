@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -290,32 +290,19 @@ def _sections(curve, rope, w_N_per_m: float, swbp_factor: float) -> list[dict]:
     return rows
 
 
-def _truncated(curve: Centreline, length_m: float) -> Centreline:
-    """The first ``length_m`` [m] of a centreline (the part of the route the cable's head has reached)."""
-    pieces = []
-    for p in curve.pieces:
-        if p.s_end_m < length_m - 1e-12:
-            pieces.append(p)
-        else:
-            pieces.append(replace(p, length_m=length_m - p.s_start_m))
-            break
-    return Centreline(pieces)
-
-
-def _pull_in_history(curve: Centreline, mu: float, w: float, back_tension_N: float, n: int = 121) -> dict:
+def _pull_in_history(curve: Centreline, rope, n: int = 201) -> dict:
     """Tension at the cable's head while it advances from the entrance to the exit (rope, quasi-static).
 
-    The pulling line from the head to the rig is taken as free of friction, so the rig's force is the
-    head's tension. Grid: ``n`` uniform head positions plus every piece boundary.
+    While the head is at distance x along the route, the cable fills [0, x] with the reel's back tension
+    at its tail; the rope equation integrates from the tail, so the head's tension is the full pull's
+    tension profile T(x): one solution gives the whole history. The pulling line from the head to the rig
+    is taken as free of friction, so the rig's force is the head's tension. Grid: ``n`` uniform head
+    positions plus every piece boundary.
     """
     L = curve.length_m
-    grid = np.unique(np.concatenate([np.linspace(L / n, L, n), [p.s_end_m for p in curve.pieces]]))
-    grid = grid[grid > 1e-9 * L]
-    force = []
-    for x in grid:
-        sub = curve if x >= L * (1 - 1e-12) else _truncated(curve, float(x))
-        force.append(solve_rope(sub, mu, w, back_tension_N, "forward", n_output=2).pull_force_N)
-    return {"pulled_length_m": grid.tolist(), "pull_force_N": force}
+    grid = np.unique(np.concatenate([np.linspace(0.0, L, n), [p.s_end_m for p in curve.pieces]]))
+    grid = np.clip(grid, 0.0, rope.cable_length_m)
+    return {"pulled_length_m": grid.tolist(), "pull_force_N": np.asarray(rope.tension_at(grid)).tolist()}
 
 
 def _check(name, value, limit, where, quantity, lower_is_better=True) -> dict:
@@ -427,7 +414,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
         entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
         entry["passed"] = all(c["passed"] for c in entry["checks"])
         if spec.feed_from_reel:
-            entry["pull_in"] = _pull_in_history(curve, mu_eff, w_total, back)
+            entry["pull_in"] = _pull_in_history(curve, rope)
         directions[name] = entry
 
     ok = [n for n in directions if directions[n]["passed"]]
