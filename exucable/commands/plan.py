@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from pathlib import Path
 
 from exucable.plan import ENGINES, load_plan_scenario, plan_pull
-from exucable.results import _json_safe, atomic_write_text, write_csv
+from exucable.io import atomic_write_text, write_csv, write_json
 from exucable.units import SYSTEMS
 
 __all__ = ["add_arguments", "main", "write_plan"]
@@ -69,7 +68,7 @@ def write_plan(out_dir, plan: dict, scenario, units: str) -> list[Path]:
     page = plan_report_html(plan, scenario.name, route_png.read_bytes(), units)
     atomic_write_text(out / "report.html", page)
     written.append(out / "report.html")
-    atomic_write_text(out / "plan.json", json.dumps(_json_safe(plan), indent=1))
+    write_json(out / "plan.json", plan, indent=1)
     written.append(out / "plan.json")
     return written
 

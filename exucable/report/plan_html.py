@@ -13,9 +13,7 @@ import html
 import io
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
-
+from exucable.io import new_figure
 from exucable.units import display_unit, from_si
 
 __all__ = ["plan_report_html", "section_rows", "check_in_units"]
@@ -92,8 +90,7 @@ def _table(header, rows, left=(1, 2)) -> str:
 
 
 def _tension_figure(plan: dict, units: str) -> str:
-    fig = Figure(figsize=(9.0, 4.0), dpi=100)
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(9.0, 4.0), dpi=100)
     ax = fig.add_subplot(111)
     for name, style in (("forward", "-"), ("reverse", "--")):
         prof = plan["directions"][name]["profile"]
@@ -109,8 +106,7 @@ def _tension_figure(plan: dict, units: str) -> str:
 
 
 def _swbp_figure(plan: dict, units: str, limit_N_per_m) -> str | None:
-    fig = Figure(figsize=(9.0, 3.6), dpi=100)
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(9.0, 3.6), dpi=100)
     ax = fig.add_subplot(111)
     any_bend = False
     width = 0.38
@@ -137,8 +133,7 @@ def _swbp_figure(plan: dict, units: str, limit_N_per_m) -> str | None:
 def _pull_in_figure(plan: dict, units: str) -> str | None:
     if "pull_in" not in plan["directions"]["forward"]:
         return None
-    fig = Figure(figsize=(9.0, 3.6), dpi=100)
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(9.0, 3.6), dpi=100)
     ax = fig.add_subplot(111)
     for name, style in (("forward", "-"), ("reverse", "--")):
         h = plan["directions"][name]["pull_in"]
