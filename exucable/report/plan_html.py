@@ -120,6 +120,9 @@ def _swbp_figure(plan: dict, units: str, limit_N_per_m) -> str | None:
         ax.bar(x, y, width, label=f"{name} (bends in pull order)")
     if not any_bend:
         return None
+    n = max(sum(r["sidewall_pressure_N_per_m"] is not None for r in plan["directions"][d]["sections"])
+            for d in ("forward", "reverse"))
+    ax.set_xticks(range(n), [f"B{i + 1}" for i in range(n)])
     if limit_N_per_m is not None:
         ax.axhline(from_si(limit_N_per_m, "force_per_length", units), color="tab:red", lw=1.5, label="limit")
     ax.set_xlabel("bend, in pull order")
