@@ -24,7 +24,7 @@ from exucable.errors import ScenarioError
 
 __all__ = [
     "ARRANGEMENTS", "CONDUCTOR_STRESS_IEC_Pa", "CONDUCTOR_STRESS_US_LB_PER_CMIL",
-    "auto_arrangement", "check_fit", "weight_correction_factor", "sidewall_pressure_factor",
+    "auto_arrangement", "check_arrangement", "check_fit", "weight_correction_factor", "sidewall_pressure_factor",
     "jam_ratio", "jam_risk", "clearance_m", "max_tension_from_conductors_N", "JamAssessment",
 ]
 
@@ -86,7 +86,8 @@ def auto_arrangement(count: int, duct_inner_diameter_m: float, cable_diameter_m:
     return "diamond" if ratio < 3.0 else "cradled"
 
 
-def _check_arrangement(count: int, arrangement: str) -> None:
+def check_arrangement(count: int, arrangement: str) -> None:
+    """Refuse an arrangement that is not one of ``count`` cables (key ``cable.arrangement``)."""
     if arrangement not in ARRANGEMENTS:
         raise ScenarioError("cable.arrangement", f"must be one of \"auto\", {', '.join(repr(a) for a in ARRANGEMENTS)}, "
                                                  f"got {arrangement!r}")
@@ -111,7 +112,7 @@ def weight_correction_factor(count: int, arrangement: str, duct_inner_diameter_m
     Pulling Tension Calculations").
     """
     check_fit(count, duct_inner_diameter_m, cable_diameter_m)
-    _check_arrangement(count, arrangement)
+    check_arrangement(count, arrangement)
     x = _ratio(duct_inner_diameter_m, cable_diameter_m)
     if arrangement == "single":
         return 1.0
@@ -132,7 +133,7 @@ def sidewall_pressure_factor(count: int, arrangement: str, weight_correction: fl
     (w_c − 1) for the diamond instead; we follow f_rad and record the disagreement in
     ``reference/engineering.toml``.)
     """
-    _check_arrangement(count, arrangement)
+    check_arrangement(count, arrangement)
     if arrangement == "single":
         return 1.0
     if arrangement == "cradled":
@@ -194,7 +195,7 @@ def clearance_m(count: int, arrangement: str, duct_inner_diameter_m: float, cabl
     * 4 diamond: D − d − 2d²/(D − d).
     """
     check_fit(count, duct_inner_diameter_m, cable_diameter_m)
-    _check_arrangement(count, arrangement)
+    check_arrangement(count, arrangement)
     D, d = duct_inner_diameter_m, cable_diameter_m
     x = _ratio(D, d)
     if count == 1:

@@ -12,15 +12,14 @@ equation gives T_out = T_in + w_c μ W L on a level straight and T_out = T_in e^
 without weight (Polywater, "Weight Correction Factor in Pulling Tension Calculations"). The rope keeps
 gravity exactly on slopes and vertical bends, where the calculators use approximations.
 
-The scenario keys this module adds to the scenario file (read here, in one place, and stripped before
-:func:`exucable.scenario.parse_scenario` sees the rest): ``cable.count``, ``cable.arrangement``,
-``[limits]``, ``pull.feed_from_reel`` and ``[display] units``. Quantities may be written as numbers (SI,
-or imperial with ``units = "imperial"``) or as ``"value unit"`` strings (:mod:`exucable.units`).
+The scenario keys used here beyond the simulation's: ``cable.count``, ``cable.arrangement``,
+``[limits]``, ``pull.feed_from_reel`` and ``[display] units`` (rows of
+:data:`exucable.scenario_fields.FIELDS`; quantities may be ``"value unit"`` strings, and bare numbers are
+imperial with ``display.units = "imperial"``, converted to SI when the file is read).
 """
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,59 +30,20 @@ from exucable import engineering as eng
 from exucable.errors import ExucableError, ScenarioError
 from exucable.geometry.centreline import Centreline
 from exucable.rope import sidewall_pressure_N_per_m, solve_rope
-from exucable.scenario import Scenario, parse_scenario, read_toml
-from exucable.units import SYSTEMS, to_si
+from exucable.scenario import Scenario, load_scenario, parse_scenario
+from exucable.units import SYSTEMS
 
-__all__ = ["LimitsSpec", "PlanSpec", "load_plan_scenario", "plan_pull", "ENGINES", "PLAN_KEYS"]
+__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES"]
 
 ENGINES = ("rope", "steady", "dynamic")
 
-# Scenario keys read as quantities (dimension, cross-section length?) so that imperial numbers and
-# "value unit" strings are converted to SI before the scenario parser sees them.
-_SCENARIO_QUANTITIES = {
-    ("cable", "radius"): ("length", True),
-    ("cable", "mass_per_length"): ("mass_per_length", False),
-    ("cable", "length"): ("length", False),
-    ("conduit", "inner_radius"): ("length", True),
-    ("pull", "back_tension"): ("force", False),
-    ("pull", "force"): ("force", False),
-    ("pull", "speed"): ("speed", False),
-}
-_PATH_QUANTITIES = {"straight": ("length", False), "radius": ("length", False), "pitch": ("length", False)}
-
-# [limits] keys: name -> (dimension or None, cross-section?, what)
-_LIMIT_KEYS = {
-    "max_tension": ("force", False, "largest allowed pulling tension"),
-    "grip_limit": ("force", False, "rating of the pulling eye or grip"),
-    "max_sidewall_pressure": ("force_per_length", False, "largest allowed sidewall bearing pressure"),
-    "min_bend_radius_multiple": (None, False, "smallest bend radius as a multiple of the cable diameter"),
-    "min_clearance": ("length", True, "smallest clearance above the cables"),
-    "conductor_material": (None, False, "copper or aluminium"),
-    "conductor_area": ("area", False, "cross-section of one conductor"),
-    "conductors": (None, False, "conductors sharing the pull (all cables)"),
-    "conductor_rule": (None, False, "iec (N/mm^2) or us (lb/cmil)"),
-}
-PLAN_KEYS = ("cable.count", "cable.arrangement", "pull.feed_from_reel", "display.units",
-             *(f"limits.{k}" for k in _LIMIT_KEYS))
-
 
 @dataclass(frozen=True)
-class LimitsSpec:
-    """The cable's limits (all optional; SI).
+class PlanLimits:
+    """The limits in force, SI (None: not given). See :class:`exucable.scenario.LimitsSpec`.
 
-    Attributes
-    ----------
-    max_tension_N, grip_limit_N : float or None
-        Largest pulling tension given directly; rating of the pulling eye or grip [N].
-    conductor_tension_N : float or None
-        Largest tension on the conductors from material, area and count [N] (see
-        :func:`exucable.engineering.max_tension_from_conductors_N`).
-    max_sidewall_pressure_N_per_m : float or None
-        Largest sidewall bearing pressure [N/m].
-    min_bend_radius_multiple : float or None
-        Smallest bend radius as a multiple of the cable diameter [-].
-    min_clearance_m : float or None
-        Smallest clearance between the uppermost cable and the duct [m].
+    ``conductor_tension_N`` is computed from ``limits.conductor_*`` by
+    :func:`exucable.engineering.max_tension_from_conductors_N`.
     """
 
     max_tension_N: float | None = None
@@ -92,146 +52,62 @@ class LimitsSpec:
     max_sidewall_pressure_N_per_m: float | None = None
     min_bend_radius_multiple: float | None = None
     min_clearance_m: float | None = None
-    given: dict = field(default_factory=dict, compare=False)
 
 
 @dataclass(frozen=True)
 class PlanSpec:
-    """Planning inputs beyond the simulation scenario.
+    """Planning inputs taken from a scenario.
 
     Attributes
     ----------
     count : int
-        Cables of the described kind in the duct (1…4).
+        Cables of the described kind in the duct (``cable.count``).
     arrangement : str
-        ``"auto"`` or one of :data:`exucable.engineering.ARRANGEMENTS`.
+        ``cable.arrangement`` (``"auto"`` or an arrangement).
     units : str
-        ``"si"`` or ``"imperial"``: unit of bare numbers in the file and of the printed tables.
-    limits : LimitsSpec
+        ``"si"`` or ``"imperial"``: units of the printed tables and the report.
+    limits : PlanLimits
     feed_from_reel : bool
-        Also compute the pull-in history (tension at the rig against pulled length).
+        Also compute the pull-in history (``pull.feed_from_reel``).
     """
 
     count: int = 1
     arrangement: str = "auto"
     units: str = "si"
-    limits: LimitsSpec = field(default_factory=LimitsSpec)
+    limits: PlanLimits = field(default_factory=PlanLimits)
     feed_from_reel: bool = False
 
 
-def _convert_scenario_quantities(data: dict, system: str) -> None:
-    """Convert the scenario's quantity keys in place to SI numbers."""
-    for (table, name), (dim, small) in _SCENARIO_QUANTITIES.items():
-        t = data.get(table)
-        if isinstance(t, dict) and name in t:
-            t[name] = to_si(f"{table}.{name}", t[name], dim, system, small)
-    path = data.get("conduit", {}).get("path") if isinstance(data.get("conduit"), dict) else None
-    if isinstance(path, list):
-        for i, item in enumerate(path):
-            if isinstance(item, dict):
-                for name, (dim, small) in _PATH_QUANTITIES.items():
-                    if name in item:
-                        item[name] = to_si(f"conduit.path[{i}].{name}", item[name], dim, system, small)
-
-
-def _read_limits(raw, system: str) -> LimitsSpec:
-    if raw is None:
-        return LimitsSpec()
-    if not isinstance(raw, dict):
-        raise ScenarioError("limits", "must be a table [limits]")
-    for k in raw:
-        if k not in _LIMIT_KEYS:
-            raise ScenarioError(f"limits.{k}", f"unknown key; allowed in [limits]: {', '.join(_LIMIT_KEYS)}")
-    vals: dict = {}
-    for k, (dim, small, _) in _LIMIT_KEYS.items():
-        if k not in raw or dim is None:
-            continue
-        v = to_si(f"limits.{k}", raw[k], dim, system, small)
-        if not v > 0.0:
-            raise ScenarioError(f"limits.{k}", f"must be > 0, got {raw[k]!r}")
-        vals[k] = v
-    mult = raw.get("min_bend_radius_multiple")
-    if mult is not None and (isinstance(mult, bool) or not isinstance(mult, (int, float)) or not mult > 0):
-        raise ScenarioError("limits.min_bend_radius_multiple", f"must be a number > 0 (a multiple of the cable diameter), got {mult!r}")
-    conductor_keys = [k for k in ("conductor_material", "conductor_area", "conductors") if k in raw]
-    conductor_N = None
-    if conductor_keys:
-        missing = [k for k in ("conductor_material", "conductor_area", "conductors") if k not in raw]
-        if missing:
-            raise ScenarioError(f"limits.{missing[0]}", "the conductor limit needs conductor_material, conductor_area "
-                                                        "and conductors together")
-        n = raw["conductors"]
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-            raise ScenarioError("limits.conductors", f"must be an integer >= 1, got {n!r}")
-        rule = raw.get("conductor_rule", "us" if system == "imperial" else "iec")
-        conductor_N = eng.max_tension_from_conductors_N(raw["conductor_material"], vals["conductor_area"], n, rule)
-    elif "conductor_rule" in raw:
-        raise ScenarioError("limits.conductor_rule", "given without conductor_material, conductor_area and conductors")
-    return LimitsSpec(
-        max_tension_N=vals.get("max_tension"),
-        grip_limit_N=vals.get("grip_limit"),
-        conductor_tension_N=conductor_N,
-        max_sidewall_pressure_N_per_m=vals.get("max_sidewall_pressure"),
-        min_bend_radius_multiple=None if mult is None else float(mult),
-        min_clearance_m=vals.get("min_clearance"),
-        given=dict(raw),
-    )
+def plan_spec(scenario: Scenario, units: str | None = None) -> PlanSpec:
+    """The planning inputs of a scenario; ``units`` overrides the display units of the output only."""
+    lim = scenario.limits
+    conductor = None
+    if lim.conductor_material is not None:
+        rule = lim.conductor_rule or ("us" if scenario.display.units == "imperial" else "iec")
+        conductor = eng.max_tension_from_conductors_N(lim.conductor_material, lim.conductor_area_m2,
+                                                      lim.conductors, rule)
+    limits = PlanLimits(max_tension_N=lim.max_tension_N, grip_limit_N=lim.grip_limit_N,
+                        conductor_tension_N=conductor,
+                        max_sidewall_pressure_N_per_m=lim.max_sidewall_pressure_N_per_m,
+                        min_bend_radius_multiple=lim.min_bend_radius_multiple, min_clearance_m=lim.min_clearance_m)
+    if units is not None and units not in SYSTEMS:
+        raise ExucableError(f"--units: must be one of {', '.join(SYSTEMS)}, got {units!r}")
+    return PlanSpec(count=scenario.cable.count, arrangement=scenario.cable.arrangement,
+                    units=units or scenario.display.units, limits=limits,
+                    feed_from_reel=scenario.pull.feed_from_reel)
 
 
 def parse_plan_scenario(data: dict, base_dir: Path, default_name: str = "scenario",
                         units: str | None = None) -> tuple[Scenario, PlanSpec]:
-    """Split a scenario dict into the simulation scenario and the planning inputs.
-
-    Parameters
-    ----------
-    data : dict
-        Scenario tables as read from TOML (not modified).
-    base_dir : Path
-        Directory for relative paths in the scenario.
-    units : {"si", "imperial"} or None
-        Overrides ``display.units`` (the ``--units`` option).
-
-    Raises
-    ------
-    ScenarioError
-        Naming the dotted key of the first bad value.
-    """
-    data = copy.deepcopy(data)
-    display = data.pop("display", {})
-    if not isinstance(display, dict) or any(k != "units" for k in display):
-        raise ScenarioError("display", "must be a table with only units = \"si\" | \"imperial\"")
-    system = units or display.get("units", "si")
-    if system not in SYSTEMS:
-        raise ScenarioError("display.units", f"must be \"si\" or \"imperial\", got {system!r}")
-    cable = data.get("cable") if isinstance(data.get("cable"), dict) else {}
-    count = cable.pop("count", 1)
-    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 4:
-        raise ScenarioError("cable.count", f"must be an integer 1…4 (cables of the described kind in the duct), got {count!r}")
-    arrangement = cable.pop("arrangement", "auto")
-    if arrangement != "auto" and arrangement not in eng.ARRANGEMENTS:
-        raise ScenarioError("cable.arrangement", f"must be one of \"auto\", "
-                                                 f"{', '.join(repr(a) for a in eng.ARRANGEMENTS)}, got {arrangement!r}")
-    pull = data.get("pull") if isinstance(data.get("pull"), dict) else {}
-    feed = pull.pop("feed_from_reel", False)
-    if not isinstance(feed, bool):
-        raise ScenarioError("pull.feed_from_reel", f"must be true or false, got {feed!r}")
-    limits = _read_limits(data.pop("limits", None), system)
-    _convert_scenario_quantities(data, system)
+    """A scenario dict (as read from TOML) and its planning inputs; ``units``: display units of the output."""
     scenario = parse_scenario(data, base_dir, default_name)
-    d = 2.0 * scenario.cable.radius_m
-    D = 2.0 * scenario.conduit.inner_radius_m
-    eng.check_fit(count, D, d)
-    if arrangement != "auto":
-        eng.weight_correction_factor(count, arrangement, D, d)  # refuses an arrangement of another count
-    return scenario, PlanSpec(count=count, arrangement=arrangement, units=system, limits=limits, feed_from_reel=feed)
+    return scenario, plan_spec(scenario, units)
 
 
 def load_plan_scenario(path, units: str | None = None) -> tuple[Scenario, PlanSpec]:
-    """Read a scenario file with its planning keys (see module docstring)."""
-    path = Path(path)
-    scenario, spec = parse_plan_scenario(read_toml(path, "scenario"), path.parent, path.stem, units)
-    object.__setattr__(scenario, "source_path", path.resolve())
-    return scenario, spec
+    """Read a scenario file and its planning inputs (``units`` overrides the output's display units)."""
+    scenario = load_scenario(path)
+    return scenario, plan_spec(scenario, units)
 
 
 # ------------------------------------------------------------------------------------------ sections
@@ -442,6 +318,6 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
             "back_tension_N": back,
             "route_length_m": centreline.length_m,
             "units": spec.units,
-            "limits": {k: v for k, v in spec.limits.given.items()},
+            "limits": scenario.limits.to_dict(),
         },
     }

@@ -30,8 +30,8 @@ def add_arguments(p) -> None:
     p.add_argument("--engine", choices=ENGINES, default="rope",
                    help="rope (default, instant); steady or dynamic: the multibody model (not available yet)")
     p.add_argument("--units", choices=SYSTEMS, default=None,
-                   help="unit system of bare numbers in the scenario and of the printed tables "
-                        "(default: the scenario's display.units, else si)")
+                   help="units of the printed tables and the report (default: the scenario's display.units); "
+                        "the file's bare numbers are always read in its own display.units")
 
 
 def _text_csv(columns, rows) -> str:
