@@ -762,13 +762,11 @@ class Scenario:
         if self.gravity is not None:
             d["gravity"] = self.gravity.to_dict()
         d["solver"] = self.solver.to_dict()
-        limits = self.limits.to_dict()
-        if limits:
-            d["limits"] = limits
+        d["limits"] = self.limits.to_dict()
         if self.display.units != "si":
             # Bare numbers would be read back in the display system: echo the quantities with their SI unit.
             d = _quantities_as_si_strings(d)
-            d["display"] = self.display.to_dict()
+        d["display"] = self.display.to_dict()
         return d
 
     def replace(self, **changes) -> "Scenario":
