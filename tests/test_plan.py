@@ -215,8 +215,8 @@ def test_cli_writes_plan_json_csv_and_a_self_contained_page(tmp_path, capsys):
     assert next(c for c in plan["checks"] if c["name"] == "conductor_tension")["limit"] == pytest.approx(14250.0)
     page = _Page()
     page.feed((out / "report.html").read_text())
-    assert {"verdict", "recommended", "sections-forward", "sections-reverse", "checks-forward"} <= page.ids
-    assert len(page.imgs) >= 4 and all(src.startswith("data:image/png;base64,") for src in page.imgs)
+    assert {"verdict", "recommended", "sections-forward", "sections-reverse", "checks-forward", "pull-in"} <= page.ids
+    assert len(page.imgs) == 3 and all(src.startswith("data:image/png;base64,") for src in page.imgs)
     assert page.external == [] and page.tables >= 4
 
 
