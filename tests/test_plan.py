@@ -232,3 +232,15 @@ def test_cli_names_the_key_of_a_bad_limit(tmp_path, capsys):
     assert cli_main(["plan", str(sc), "--out", str(tmp_path / "o")]) == 2
     assert "limits.max_sidewall_pressure" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_imperial_file_reads_the_manuals_numbers():
+    from exucable.plan import load_plan_scenario
+
+    scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml")
+    plan = plan_pull(scenario, spec)
+    lbf, ft = 4.4482216152605, 0.3048
+    assert spec.units == "imperial"
+    assert plan["inputs"]["weight_per_length_one_cable_N_per_m"] / (lbf / ft) == pytest.approx(0.144, rel=1e-12)
+    assert scenario.limits.max_tension_N / lbf == pytest.approx(340.0, rel=1e-12)
+    assert plan["directions"]["forward"]["sections"][0]["length_m"] / ft == pytest.approx(100.0, rel=1e-12)
