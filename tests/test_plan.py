@@ -244,3 +244,12 @@ def test_imperial_file_reads_the_manuals_numbers():
     assert plan["inputs"]["weight_per_length_one_cable_N_per_m"] / (lbf / ft) == pytest.approx(0.144, rel=1e-12)
     assert scenario.limits.max_tension_N / lbf == pytest.approx(340.0, rel=1e-12)
     assert plan["directions"]["forward"]["sections"][0]["length_m"] / ft == pytest.approx(100.0, rel=1e-12)
+
+
+def test_3d_bends_and_helices_are_named_and_get_a_pressure():
+    plan = _plan(conduit__path=[{"straight": 5.0}, {"bend": 60.0, "radius": 3.0, "axis": [0.0, 1.0, 1.0]},
+                                {"straight": 5.0}, {"helix_turns": 1.0, "radius": 2.0, "pitch": 0.5}])
+    rows = plan["directions"]["forward"]["sections"]
+    assert [r["kind"] for r in rows] == ["straight", "bend", "straight", "helix"]
+    assert rows[1]["plane"] == "3D" and rows[3]["plane"] == "helix"
+    assert all(r["sidewall_pressure_N_per_m"] > 0 for r in rows if r["kind"] != "straight")
