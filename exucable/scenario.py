@@ -40,6 +40,7 @@ __all__ = [
     "ContactSpec",
     "PullSpec",
     "GravitySpec",
+    "OutputSpec",
     "SolverSpec",
     "LimitsSpec",
     "DisplaySpec",
@@ -482,6 +483,45 @@ class GravitySpec(_Spec):
 
 
 @dataclass(frozen=True)
+class OutputSpec(_Spec):
+    """What is written besides the histories and final profiles.
+
+    Attributes
+    ----------
+    snapshots_s : tuple of float
+        Times at which the whole state is written (snapshot files) [s], sorted, each >= 0 (and
+        <= ``solver.end_time``, checked by the scenario).
+    snapshot_interval_s : float or None
+        Also a snapshot every this many seconds, at k·interval, k = 1, 2, … [s].
+    """
+
+    _SECTION: ClassVar[str] = "output"
+
+    snapshots_s: tuple = ()
+    snapshot_interval_s: float | None = None
+
+    def _check(self) -> None:
+        raw = self.snapshots_s
+        if not isinstance(raw, (list, tuple)):
+            raise ScenarioError("output.snapshots", f"must be an array of times [s], got {_describe(raw)}")
+        times = []
+        for i, value in enumerate(raw):
+            key = f"output.snapshots[{i}]"
+            v = _as_float(key, value, "s")
+            _check_range(key, v, "s", ge=0.0)
+            times.append(v)
+        object.__setattr__(self, "snapshots_s", tuple(sorted(set(times))))
+
+    def times_s(self, end_time_s: float) -> tuple:
+        """All snapshot times up to ``end_time_s`` [s], sorted, duplicates merged."""
+        times = set(self.snapshots_s)
+        if self.snapshot_interval_s is not None:
+            n = int(math.floor(end_time_s / self.snapshot_interval_s * (1 + 1e-12)))
+            times.update(k * self.snapshot_interval_s for k in range(1, n + 1))
+        return tuple(sorted(t for t in times if t <= end_time_s))
+
+
+@dataclass(frozen=True)
 class SolverSpec(_Spec):
     """Time integration settings.
 
@@ -644,6 +684,8 @@ class Scenario:
     gravity : GravitySpec or None
         None: no gravity.
     solver : SolverSpec
+    output : OutputSpec
+        Snapshot times (default: none).
     limits : LimitsSpec
         Installation limits checked by ``exucable plan`` (default: none).
     display : DisplaySpec
@@ -662,6 +704,7 @@ class Scenario:
     pull: PullSpec | None = None
     gravity: GravitySpec | None = None
     solver: SolverSpec | None = None
+    output: OutputSpec = field(default_factory=OutputSpec)
     limits: LimitsSpec = field(default_factory=LimitsSpec)
     display: DisplaySpec = field(default_factory=DisplaySpec)
     source_path: Path | None = field(default=None, compare=False)
@@ -690,6 +733,13 @@ class Scenario:
                 raise ScenarioError(part, f"required: give the [{part}] table, or {part}={how} in Python")
             if not isinstance(value, cls):
                 raise ScenarioError(part, f"must be a {cls.__name__} ({how}), got {_describe(value)}")
+        if not isinstance(self.output, OutputSpec):
+            raise ScenarioError("output", f"must be an OutputSpec, got {_describe(self.output)}")
+        late = [t for t in self.output.snapshots_s if t > self.solver.end_time_s]
+        if late:
+            i = self.output.snapshots_s.index(late[0])
+            raise ScenarioError(f"output.snapshots[{i}]", f"must be <= solver.end_time = "
+                                f"{self.solver.end_time_s!r} s, got {late[0]!r}")
         for part, cls in (("limits", LimitsSpec), ("display", DisplaySpec)):
             if not isinstance(getattr(self, part), cls):
                 raise ScenarioError(part, f"must be a {cls.__name__}, got {_describe(getattr(self, part))}")
@@ -762,6 +812,7 @@ class Scenario:
         if self.gravity is not None:
             d["gravity"] = self.gravity.to_dict()
         d["solver"] = self.solver.to_dict()
+        d["output"] = self.output.to_dict()
         d["limits"] = self.limits.to_dict()
         if self.display.units != "si":
             # Bare numbers would be read back in the display system: echo the quantities with their SI unit.
@@ -879,7 +930,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
         The first problem found, naming its full dotted key.
     """
     top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver",
-                            "limits", "display"})
+                            "output", "limits", "display"})
     display = _parse_table("display", top.table("display", default={}), DisplaySpec)
     data = _quantities_to_si(data, display.units)
     top = _Table(data, "", set(data))
@@ -895,6 +946,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     gravity_data = top.table("gravity", default=None)
     gravity = None if gravity_data is None else _parse_gravity(gravity_data)
     solver = _parse_solver(top.table("solver"))
+    output = _parse_output(top.table("output", default={}))
     limits = _parse_table("limits", top.table("limits", default={}), LimitsSpec)
     # Cross-section rules (inner radius > cable radius, cable length <= conduit length),
     # the route build and the default mesh are the Scenario's own checks.
@@ -907,6 +959,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
         pull=pull,
         gravity=gravity,
         solver=solver,
+        output=output,
         limits=limits,
         display=display,
     )
@@ -1185,6 +1238,10 @@ def _parse_solver(data) -> SolverSpec:
     return _parse_table("solver", data, SolverSpec)
 
 
+def _parse_output(data) -> OutputSpec:
+    return _parse_table("output", data, OutputSpec)
+
+
 _PATH_KINDS: dict[str, set[str]] = {
     "straight": {"straight"},
     "bend": {"bend", "radius", "turn", "axis"},
@@ -1265,6 +1322,7 @@ _PARSERS = {
     "pull": _parse_pull,
     "gravity": _parse_gravity,
     "solver": _parse_solver,
+    "output": _parse_output,
     "limits": lambda data: _parse_table("limits", data, LimitsSpec),
     "display": lambda data: _parse_table("display", data, DisplaySpec),
 }
