@@ -260,6 +260,9 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
         raise ExucableError(
             f"--engine {engine}: planning with the multibody model is not available in this version "
             "(the steady solver is being built; the dynamic one is not wired into `plan` yet); use --engine rope")
+    if scenario.pull.force_N is not None:
+        raise ScenarioError("pull.force", "exucable plan computes the pulling force from the back tension; give "
+                                          "pull.back_tension (the reel's) instead of a prescribed pull.force")
     d = 2.0 * scenario.cable.radius_m
     D = 2.0 * scenario.conduit.inner_radius_m
     arrangement = eng.auto_arrangement(spec.count, D, d) if spec.arrangement == "auto" else spec.arrangement

@@ -253,3 +253,15 @@ def test_3d_bends_and_helices_are_named_and_get_a_pressure():
     assert [r["kind"] for r in rows] == ["straight", "bend", "straight", "helix"]
     assert rows[1]["plane"] == "3D" and rows[3]["plane"] == "helix"
     assert all(r["sidewall_pressure_N_per_m"] > 0 for r in rows if r["kind"] != "straight")
+
+
+def test_a_prescribed_pull_force_is_refused_and_slack_is_reported():
+    scenario, spec = parse_plan_scenario(_data(pull={"speed": 0.1, "force": 500.0}), ROOT)
+    with pytest.raises(ScenarioError) as exc:
+        plan_pull(scenario, spec)
+    assert exc.value.key == "pull.force"
+    # 30 deg down a straight with mu 0.3 < tan 30 deg: the reverse pull runs slack (tension 0, not negative).
+    plan = _plan(conduit__heading=[math.cos(math.radians(30)), 0.0, math.sin(math.radians(30))],
+                 conduit__path=[{"straight": 20.0}], pull__back_tension=0.0)
+    assert plan["directions"]["reverse"]["slack"] and plan["directions"]["reverse"]["pull_force_N"] == 0.0
+    assert not plan["directions"]["forward"]["slack"]

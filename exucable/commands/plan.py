@@ -102,6 +102,9 @@ def main(args) -> int:
         print(f"\n{name} pull: pull force {from_si(d['pull_force_N'], 'force', units):.4g} {f}, "
               f"max tension {from_si(d['max_tension_N'], 'force', units):.4g} {f}")
         _print_table(*section_rows(d, units))
+        if d["slack"]:
+            print("  note: the cable runs slack somewhere (a downhill stretch steeper than the friction angle): "
+                  "tension 0 there")
         for c in d["checks"]:
             value, limit, unit = check_in_units(c, units)
             margin = "" if c["margin"] is None else f", margin {100 * c['margin']:.1f} %"

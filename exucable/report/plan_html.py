@@ -198,7 +198,8 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
         parts += [f"<h2>Sections, {name} pull</h2>",
                   f"<p>Pull force {from_si(d['pull_force_N'], 'force', units):.4g} {f}; max tension "
                   f"{from_si(d['max_tension_N'], 'force', units):.4g} {f}; "
-                  f"{'all checks pass' if d['passed'] else 'a check fails'}.</p>",
+                  f"{'all checks pass' if d['passed'] else 'a check fails'}"
+                  f"{'; the cable runs slack somewhere (a downhill stretch steeper than the friction angle)' if d['slack'] else ''}.</p>",
                   f"<div id='sections-{name}'>" + _table(header, rows) + "</div>"]
     for name in ("forward", "reverse"):
         checks = plan["directions"][name]["checks"]
