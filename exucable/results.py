@@ -1,8 +1,8 @@
 """Results of one run and their files (the documented results format, see README).
 
 Every file is written atomically (a temporary file in the same directory, then ``os.replace``),
-so a crash or a kill never leaves a half-written file, and ``summary.json`` is written last:
-its presence marks a complete result directory.
+so a crash or a kill never leaves a half-written file, and ``summary.json`` is written after the
+data files: its presence marks complete results. The figures (optional) follow it.
 
 Files
 -----
@@ -110,7 +110,8 @@ class RunResult:
 
 
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
-    """Write ``result`` into ``out_dir`` (created if needed); ``summary.json`` last. Returns the paths."""
+    """Write ``result`` into ``out_dir`` (created if needed): the CSV files, then ``summary.json``,
+    then (unless ``plots`` is false) the figures. Returns the paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -125,6 +126,10 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     if result.rope_profile is not None:
         write_csv(out / "rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
         written.append(out / "rope_profile.csv")
+    atomic_write_text(out / "summary.json", json.dumps(_json_safe(result.summary), indent=2) + "\n")
+    written.append(out / "summary.json")
+    # the figures come after the numbers: they cost about half a second of matplotlib, and a
+    # failure to draw must not hold back (or lose) a result already computed
     if plots:
         from .plots.results import plot_pull_force, plot_tension_profile
         plot_pull_force(out / "pull_force.png", result)
@@ -132,8 +137,6 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
         if result.tension_profile is not None:
             plot_tension_profile(out / "tension_profile.png", result)
             written.append(out / "tension_profile.png")
-    atomic_write_text(out / "summary.json", json.dumps(_json_safe(result.summary), indent=2) + "\n")
-    written.append(out / "summary.json")
     return written
 
 
