@@ -97,7 +97,8 @@ def test_cli_imports_only_the_chosen_subcommand():
     their help still works."""
     code = ("import sys\nfrom exucable.cli import build_parser, _command_in\n"
             "build_parser(only=_command_in(['run', 'x.toml']))\n"
-            "print(sorted(m for m in ('exucable.sweep', 'exucable.validate', 'exucable.compare', "
+            "print(sorted(m for m in ('exucable.commands.sweep', 'exucable.commands.validate', "
+            "'exucable.commands.compare', 'exucable.sweep', 'exucable.validate', "
             "'matplotlib') if m in sys.modules))")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
