@@ -7,7 +7,8 @@ its presence marks a complete result directory.
 Files
 -----
 ``summary.json``          scalars (forces [N], times [s]), status, scenario echoed back, versions
-``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N``
+``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N`` and, with contact,
+                          ``max_penetration_m,max_axis_offset_m,max_axis_offset_s_m``
 ``tension_profile.csv``   ``s_m,tension_N`` at the final time (s from the trailing end)
 ``contact_profile.csv``   ``s_m,normal_force_per_length_N_per_m,penetration_m`` (s along the conduit)
 ``rope_profile.csv``      ``s_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
@@ -29,7 +30,8 @@ import numpy as np
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
            "read_summary", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
-HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N")
+HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N", "max_penetration_m",
+                   "max_axis_offset_m", "max_axis_offset_s_m")
 PROFILE_COLUMNS = ("s_m", "tension_N")
 CONTACT_COLUMNS = ("s_m", "normal_force_per_length_N_per_m", "penetration_m")
 ROPE_COLUMNS = ("s_m", "tension_N", "sidewall_pressure_N_per_m")
@@ -114,7 +116,7 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
-    write_csv(out / "history.csv", HISTORY_COLUMNS, result.history)
+    write_csv(out / "history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
     written.append(out / "history.csv")
     if result.tension_profile is not None:
         write_csv(out / "tension_profile.csv", PROFILE_COLUMNS, result.tension_profile)

@@ -18,6 +18,7 @@ from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
 from .solve import Progress, simulate, steady_quantity
 from .tension import detect_steady_state, tension_profile
+from .trust import DYNAMIC_LIMIT, PENETRATION_LIMIT, TRUSTED_STATUSES, assess, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile", "add_arguments", "main"]
 
@@ -52,6 +53,35 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
     return {"s_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
 
 
+def _assess(model, out, st, h, pull_force_N):
+    """Status and flags of a finished run (see :mod:`exucable.trust`)."""
+    sc = model.scenario
+    c = sc.cable
+    pen = np.nan_to_num(h.get("max_penetration_m", np.zeros(0)), nan=-np.inf)
+    off = np.nan_to_num(h.get("max_axis_offset_m", np.zeros(0)), nan=-np.inf)
+    t = h["time_s"]
+    ip = int(np.argmax(pen)) if pen.size else None
+    io = int(np.argmax(off)) if off.size else None
+    R_in = model.conduit.inner_radius_m
+    clearance = R_in - c.radius_m
+    # the kernel's check points give the penetration; points far outside have no candidate segment,
+    # so the cable axis's offset beyond the clearance bounds it from below
+    pen_max = max(float(pen[ip]) if ip is not None else -np.inf, float(off[io]) - clearance if io is not None else -np.inf)
+    ip_use = io if (io is not None and (ip is None or float(off[io]) - clearance >= float(pen[ip]))) else ip
+    return assess(
+        failed=out.status == "failed", steady=bool(st.steady),
+        max_penetration_m=pen_max, max_penetration_time_s=float(t[ip_use]) if ip_use is not None else float("nan"),
+        max_penetration_s_m=float(h["max_axis_offset_s_m"][ip_use]) if ip_use is not None else float("nan"),
+        max_axis_offset_m=float(off[io]) if io is not None else -np.inf,
+        max_axis_offset_time_s=float(t[io]) if io is not None else float("nan"),
+        max_axis_offset_s_m=float(h["max_axis_offset_s_m"][io]) if io is not None else float("nan"),
+        clearance_m=clearance, cable_radius_m=c.radius_m, inner_radius_m=R_in,
+        mass_per_length_kg_per_m=c.mass_per_length_kg_per_m, speed_m_per_s=sc.pull.speed_m_per_s,
+        pull_force_N=pull_force_N if pull_force_N is not None else float("nan"),
+        steady_window_s=sc.solver.steady_window_s, steady_tolerance=sc.solver.steady_tolerance,
+        end_time_s=out.end_time_s, base_status=out.status)
+
+
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
                  steady_stop: bool | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
@@ -72,6 +102,8 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     sp = sc.solver
     st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
     i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
+    pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"], st.from_s if np.isfinite(st.from_s) else 0.0) \
+        if len(h["time_s"]) else None
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
     cprof, peak_pressure = contact_profile(model)
@@ -82,6 +114,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
         "pull_force_std_N": float(np.std(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+        "pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
+        "pull_force_drift_N_per_s": pf.drift_N_per_s if pf else None,
+        "pull_force_uncertainty": ({"mean_over_periods_N": pf.mean_N, "periods": pf.periods, "period_s": pf.period_s,
+                                    "window_s": list(pf.window_s), "method": pf.method} if pf else None),
         "steady_quantity": steady_quantity(model),
         "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
@@ -99,11 +135,19 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "rope_pull_force_N": rope.pull_force_N if rope is not None else None,
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        "mesh": model.mesh.to_dict() if model.mesh is not None else None,
+        "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
         "scenario": sc.to_dict(),
         "versions": versions(),
     }
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
+    summary["status"], summary["flags"] = _assess(model, out, st, h, summary["pull_force_N"])
+    summary["trust_limits"] = {"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
+                               "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
+                               "outside": "cable axis farther from the conduit axis than its inner radius"}
+    if summary["flags"] and not summary["message"]:
+        summary["message"] = "; ".join(f["message"] for f in summary["flags"])
     rope_profile = None
     extras = {}
     if rope is not None:
@@ -139,7 +183,8 @@ def main(args) -> int:
     s = res.summary
     rope = s.get("rope_pull_force_N")
     print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
-          f"(± {_f(s['pull_force_std_N'], '.2g')}), trailing tension {_f(s['trailing_tension_N'])} N, "
+          f"(± {_f(s['pull_force_uncertainty_N'], '.2g')} N, sd {_f(s['pull_force_std_N'], '.2g')} N, "
+          f"drift {_f(s['pull_force_drift_N_per_s'], '.2g')} N/s), trailing tension {_f(s['trailing_tension_N'])} N, "
           f"max tension {_f(s['max_tension_N'])} N")
     if s["steady_quantity"] == "trailing_tension_N":     # force-controlled: T2 is the result
         ref, got, what = s.get("rope_trailing_tension_N"), s["trailing_tension_N"], "trailing tension"
@@ -150,8 +195,19 @@ def main(args) -> int:
     print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
           f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
+    m = s.get("mesh") or {}
+    if m:
+        print(f"  mesh: {m['elements']} elements of {m['element_length_m']:.4g} m ({m['source']}; rule "
+              f"{m['rule_element_length_m']:.4g} m), {m['check_points_per_element']} check points per element")
+    for w in s.get("warnings", []):
+        print(f"  warning: {w}", file=sys.stderr)
     if s["status"] == "failed":
         print(f"  FAILED: {s['message']} (at t = {_f(s.get('failed_at_s'))} s); "
               f"the results recorded until then are in {out_dir}/", file=sys.stderr)
+        return 1
+    if s["status"] not in TRUSTED_STATUSES:
+        for f in s["flags"]:
+            print(f"  NOT TRUSTED ({f['flag']}): {f['message']}", file=sys.stderr)
+        print(f"  status {s['status']}: do not use this result; what was computed is in {out_dir}/", file=sys.stderr)
         return 1
     return 0

@@ -68,8 +68,10 @@ class CableSpec:
         Density ρ [kg/m³] if the scenario gave it, else None (``mass_per_length`` was given).
     youngs_modulus_Pa : float
         Young's modulus E [Pa].
-    elements : int
-        Number of cable finite elements.
+    elements : int or None
+        Number of cable finite elements (an override of the mesh rule, exucable.mesh), or None.
+    element_length_m : float or None
+        Element length [m] (an override of the mesh rule), or None; not with ``elements``.
     length_m : float or None
         Cable length [m]; None means the conduit's centreline length.
     integration : str
@@ -83,10 +85,11 @@ class CableSpec:
     mass_per_length_kg_per_m: float
     density_kg_per_m3: float | None
     youngs_modulus_Pa: float
-    elements: int
+    elements: int | None
     length_m: float | None
     damping_time_s: float
     integration: str = "lobatto"
+    element_length_m: float | None = None
 
     @property
     def area_m2(self) -> float:
@@ -121,7 +124,10 @@ class CableSpec:
         else:
             d["mass_per_length"] = self.mass_per_length_kg_per_m
         d["youngs_modulus"] = self.youngs_modulus_Pa
-        d["elements"] = self.elements
+        if self.elements is not None:
+            d["elements"] = self.elements
+        if self.element_length_m is not None:
+            d["element_length"] = self.element_length_m
         if self.length_m is not None:
             d["length"] = self.length_m
         d["damping_time"] = self.damping_time_s
@@ -211,8 +217,8 @@ class ContactSpec:
         Decay velocity of the static-to-kinetic transition [m/s].
     friction_regularisation_velocity_m_per_s : float
         Sliding speed below which friction is regularised (linear in velocity) [m/s].
-    check_points_per_element : int
-        Contact check points per cable element.
+    check_points_per_element : int or None
+        Contact check points per cable element; None: the mesh rule's (exucable.mesh).
     check_point_rule : str
         ``"gauss"`` or ``"uniform"`` placement of check points along an element.
     reference_spacing_m : float
@@ -234,7 +240,7 @@ class ContactSpec:
     static_friction: float | None
     stribeck_velocity_m_per_s: float
     friction_regularisation_velocity_m_per_s: float
-    check_points_per_element: int
+    check_points_per_element: int | None
     check_point_rule: str
     reference_spacing_m: float
     broad_phase: str
@@ -254,13 +260,14 @@ class ContactSpec:
         d.update(
             stribeck_velocity=self.stribeck_velocity_m_per_s,
             friction_regularisation_velocity=self.friction_regularisation_velocity_m_per_s,
-            check_points_per_element=self.check_points_per_element,
             check_point_rule=self.check_point_rule,
             reference_spacing=self.reference_spacing_m,
             broad_phase=self.broad_phase,
             surface=self.surface,
             damping_onset=self.damping_onset_m,
         )
+        if self.check_points_per_element is not None:
+            d["check_points_per_element"] = self.check_points_per_element
         return d
 
 
@@ -734,8 +741,8 @@ def _parse_cable(data) -> CableSpec:
     t = _Table(
         data,
         "cable",
-        {"radius", "density", "mass_per_length", "youngs_modulus", "elements", "length", "damping_time",
-         "integration"},
+        {"radius", "density", "mass_per_length", "youngs_modulus", "elements", "element_length", "length",
+         "damping_time", "integration"},
     )
     radius = t.number("radius", "m", gt=0.0)
     if t.has("density") and t.has("mass_per_length"):
@@ -748,12 +755,16 @@ def _parse_cable(data) -> CableSpec:
     else:
         density = None
         mass_per_length = t.number("mass_per_length", "kg/m", gt=0.0)
+    if t.has("elements") and t.has("element_length"):
+        raise ScenarioError("cable.element_length", "give either elements or element_length, not both "
+                            "(or neither: the mesh rule then chooses, see scenarios/README.md)")
     return CableSpec(
         radius_m=radius,
         mass_per_length_kg_per_m=mass_per_length,
         density_kg_per_m3=density,
         youngs_modulus_Pa=t.number("youngs_modulus", "Pa", gt=0.0),
-        elements=t.integer("elements", ge=1),
+        elements=t.integer("elements", default=None, ge=1),
+        element_length_m=t.number("element_length", "m", default=None, gt=0.0),
         length_m=t.number("length", "m", default=None, gt=0.0),
         damping_time_s=t.number("damping_time", "s", default=_DEFAULT_DAMPING_TIME_S, ge=0.0),
         integration=t.choice("integration", ("lobatto", "reduced", "full"), default="lobatto"),
@@ -999,7 +1010,7 @@ def _parse_contact(data) -> ContactSpec:
         friction_regularisation_velocity_m_per_s=t.number(
             "friction_regularisation_velocity", "m/s", default=1.0e-3, gt=0.0
         ),
-        check_points_per_element=t.integer("check_points_per_element", default=20, ge=1),
+        check_points_per_element=t.integer("check_points_per_element", default=None, ge=1),
         check_point_rule=t.choice("check_point_rule", ("gauss", "uniform"), default="gauss"),
         reference_spacing_m=t.number("reference_spacing", "m", default=1.0e-3, gt=0.0),
         broad_phase=t.choice("broad_phase", ("aabb", "none"), default="aabb"),
