@@ -21,6 +21,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "validate": ("exucable.validate", "run the paper's examples against their references"),
     "sweep": ("exucable.sweep", "run a parameter sweep (local pool or Dask)"),
     "compare": ("exucable.compare", "compare two result sets (yours and ours)"),
+    "converge": ("exucable.commands.converge", "run a scenario on refined meshes and extrapolate its result"),
 }
 
 

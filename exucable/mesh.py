@@ -138,11 +138,12 @@ def plan_mesh(centreline, clearance_m: float, cable_length_m: float, bending_sti
     rule_L = rule_element_length_m(centreline, clearance_m, L)
     lam = bending_length_m(bending_stiffness_N_m2, max_tension_N)
     if elements is not None:
-        n, source = int(math.ceil(elements * refine - 1e-9)), "cable.elements"
+        n0, source = int(elements), "cable.elements"
     elif element_length_m is not None:
-        n, source = max(1, int(math.ceil(L / element_length_m * refine - 1e-9))), "cable.element_length"
+        n0, source = max(1, int(math.ceil(L / element_length_m - 1e-9))), "cable.element_length"
     else:
-        n, source = max(1, int(math.ceil(L / rule_L * refine - 1e-9))), "rule"
+        n0, source = max(1, int(math.ceil(L / rule_L - 1e-9))), "rule"
+    n = int(math.ceil(n0 * refine - 1e-9))   # refine the count, so levels keep the exact ratio
     L_e = L / n
     key = "cable.element_length" if source == "cable.element_length" else "cable.elements"
     n_rule = int(math.ceil(L / rule_L - 1e-9))

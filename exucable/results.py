@@ -12,6 +12,9 @@ Files
 ``tension_profile.csv``   ``s_m,tension_N`` at the final time (s from the trailing end)
 ``contact_profile.csv``   ``s_m,normal_force_per_length_N_per_m,penetration_m`` (s along the conduit)
 ``rope_profile.csv``      ``s_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+``bends.csv``             one row per bend: tensions in/out, windowed pressure mean/peak, point loads
+                          (columns ``exucable.pressure.BEND_COLUMNS``)
+``pressure_profile.csv``  ``s_m,windowed_pressure_N_per_m,rope_windowed_pressure_N_per_m``
 """
 
 from __future__ import annotations
@@ -109,6 +112,8 @@ class RunResult:
     contact_profile: dict | None = None
     rope_profile: dict | None = None
     extras: dict = field(default_factory=dict)
+    bends: list | None = None                # BEND_COLUMNS rows (exucable.pressure)
+    pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
 
 
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
@@ -127,13 +132,24 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     if result.rope_profile is not None:
         write_csv(out / "rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
         written.append(out / "rope_profile.csv")
+    if result.bends:
+        from .pressure import BEND_COLUMNS
+        write_csv(out / "bends.csv", BEND_COLUMNS, {c: [row[c] for row in result.bends] for c in BEND_COLUMNS})
+        written.append(out / "bends.csv")
+    if result.pressure_profile is not None:
+        from .pressure import PRESSURE_COLUMNS
+        write_csv(out / "pressure_profile.csv", PRESSURE_COLUMNS, result.pressure_profile)
+        written.append(out / "pressure_profile.csv")
     if plots:
-        from .plots.results import plot_pull_force, plot_tension_profile
+        from .plots.results import plot_pressure, plot_pull_force, plot_tension_profile
         plot_pull_force(out / "pull_force.png", result)
         written.append(out / "pull_force.png")
         if result.tension_profile is not None:
             plot_tension_profile(out / "tension_profile.png", result)
             written.append(out / "tension_profile.png")
+        if result.pressure_profile is not None:
+            plot_pressure(out / "pressure.png", result)
+            written.append(out / "pressure.png")
     atomic_write_text(out / "summary.json", json.dumps(_json_safe(result.summary), indent=2) + "\n")
     written.append(out / "summary.json")
     return written

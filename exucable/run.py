@@ -17,22 +17,20 @@ from .errors import ExucableError
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
 from .solve import Progress, simulate, steady_quantity
-from .tension import detect_steady_state, tension_profile
-from .trust import DYNAMIC_LIMIT, PENETRATION_LIMIT, TRUSTED_STATUSES, assess, pull_force_uncertainty
+from .pressure import bend_table, default_window_m, pressure_profile
+from .tension import detect_steady_state, tension_at, tension_profile
+from .trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, TRUSTED_STATUSES, assess, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile", "add_arguments", "main"]
 
 
-def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
-    """Sidewall bearing pressure along the conduit at the current state.
-
-    One row per check point in contact order of ``s`` along the scenario's conduit (normal force
-    per unit length [N/m] = the point's force over its share of the element, penetration [m]);
-    beyond ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
-    penetration: max). Also returns the largest per-point pressure [N/m].
-    """
+def check_point_loads(model) -> dict | None:
+    """Every check point at the current state, ordered by its place along the scenario's conduit:
+    ``s_m`` [m], ``normal_force_N`` (weighted, what the wall pushes with) [N],
+    ``normal_force_per_length_N_per_m`` (over the point's share of its element) [N/m],
+    ``penetration_m`` [m]. None without contact."""
     if model.kernel is None:
-        return None, 0.0
+        return None
     q, v = model.coordinates()
     pts = model.kernel.points(q.reshape(-1), v.reshape(-1))
     L = model.conduit.centreline.length_m
@@ -41,9 +39,23 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
     if model.scenario.pull.direction == "reverse":
         s = L - s   # report along the scenario's own conduit
     order = np.argsort(s[keep])
-    s = s[keep][order]
-    p = np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order]
-    pen = np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)
+    return {"s_m": s[keep][order],
+            "normal_force_N": np.asarray(pts.normal_force_N, dtype=float)[keep][order],
+            "normal_force_per_length_N_per_m": np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order],
+            "penetration_m": np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)}
+
+
+def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | None, float]:
+    """Sidewall bearing pressure along the conduit from :func:`check_point_loads`.
+
+    One row per check point in order of ``s`` along the scenario's conduit (normal force per unit
+    length [N/m] = the point's force over its share of the element, penetration [m]); beyond
+    ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
+    penetration: max). Also returns the largest per-point pressure [N/m].
+    """
+    if points is None:
+        return None, 0.0
+    s, p, pen = points["s_m"], points["normal_force_per_length_N_per_m"], points["penetration_m"]
     peak = float(p.max()) if p.size else 0.0
     if s.size > max_rows:
         groups = np.array_split(np.arange(s.size), max_rows)
@@ -51,6 +63,39 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
         p = np.array([p[g].mean() for g in groups])
         pen = np.array([pen[g].max() for g in groups])
     return {"s_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
+
+
+def cable_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
+    """The cable's tension at its nodes [N] and their places along the scenario's conduit [m]."""
+    q, _ = model.coordinates()
+    Le = model.layout.element_length_m
+    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
+    T = tension_at(q, Le, model.axial_stiffness_N, x_nodes)
+    _, s = AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)(q[:, :3])
+    if model.scenario.pull.direction == "reverse":
+        s = model.conduit.centreline.length_m - s
+    return s, T
+
+
+def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
+    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.pressure)."""
+    if points is None or rope is None:
+        return {}, [], None
+    centre = model.scenario.build_conduit().centreline
+    w = default_window_m(centre)
+    rope_p = rope.sidewall_pressure_N_per_m
+    prof = pressure_profile(points["s_m"], points["normal_force_N"], rope.s_conduit_m, rope_p, w, centre.length_m)
+    s_c, T_c = cable_tension_along_conduit(model)
+    lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
+    bends = bend_table(centre.pieces, points["s_m"], points["normal_force_N"], s_c, T_c, rope.s_conduit_m,
+                       rope.tension_N, rope_p, w, lam, model.scenario.pull.direction)
+    i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
+    info = {"pressure_window_m": w,
+            "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
+            "max_windowed_sidewall_pressure_N_per_m": float(prof["windowed_pressure_N_per_m"][i]),
+            "max_windowed_sidewall_pressure_s_m": float(prof["s_m"][i]),
+            "rope_max_windowed_sidewall_pressure_N_per_m": float(np.max(prof["rope_windowed_pressure_N_per_m"]))}
+    return info, bends, prof
 
 
 def _assess(model, out, st, h, pull_force_N):
@@ -83,18 +128,21 @@ def _assess(model, out, st, h, pull_force_N):
 
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
-                 steady_stop: bool | None = None) -> RunResult:
+                 steady_stop: bool | None = None, refine: float = 1.0,
+                 check_points_per_element: int | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
     message and the simulated time where it happened, and everything recorded until then is
     written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
+    ``refine`` divides the mesh's element length and ``check_points_per_element`` overrides the
+    scenario's (``exucable converge``).
     """
     from .model.build import build_model
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     t_start = time.perf_counter()
-    model = build_model(sc)
+    model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element)
     build_s = time.perf_counter() - t_start
     progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
     out = simulate(model, progress=progress, steady_stop=steady_stop)
@@ -106,8 +154,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         if len(h["time_s"]) else None
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
-    cprof, peak_pressure = contact_profile(model)
+    points = check_point_loads(model)
+    cprof, peak_pressure = contact_profile(points)
     rope = model.rope
+    pressure_info, bends, pressure_prof = _pressure(model, points, rope)
     summary = {
         "name": sc.name,
         "status": out.status,
@@ -135,6 +185,8 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "rope_pull_force_N": rope.pull_force_N if rope is not None else None,
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        **pressure_info,
+        "bends": bends,
         "mesh": model.mesh.to_dict() if model.mesh is not None else None,
         "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
         "scenario": sc.to_dict(),
@@ -155,7 +207,8 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                         "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m}
         extras["s_cable_m"] = rope.s_cable_m
     result = RunResult(summary=summary, history=h, tension_profile={"s_m": x, "tension_N": N},
-                       contact_profile=cprof, rope_profile=rope_profile, extras=extras)
+                       contact_profile=cprof, rope_profile=rope_profile, extras=extras,
+                       bends=bends, pressure_profile=pressure_prof)
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result
