@@ -132,8 +132,10 @@ def record_state(model, t: float, history: History, gauge=None) -> None:
         pen = float(model.kernel.evaluate(q.reshape(-1), v.reshape(-1)).max_penetration_m)
         if gauge is not None:
             d, s = gauge(cable_sample_points(q, model.layout.element_length_m))
+            # beyond the conduit's ends the cable is free (feed, pulling line): not the wall's business
+            d = np.where((s >= 0.0) & (s <= gauge.length_m), d, -np.inf)
             i = int(np.argmax(d))
-            offset = float(d[i])
+            offset = float(d[i]) if np.isfinite(d[i]) else float("nan")
             s_off = float(s[i]) if model.scenario.pull.direction != "reverse" else float(gauge.length_m - s[i])
     history.max_penetration_m.append(pen)
     history.max_axis_offset_m.append(offset)

@@ -98,11 +98,12 @@ class PullForceEstimate:
     mean_N : float
         Mean over whole oscillation periods in the window (the whole window if fewer than 2).
     uncertainty_N : float
-        √(u_scatter² + u_drift²): u_scatter the standard error of the per-period means (the
-        standard deviation of the force when fewer than 3 periods), u_drift half the change
-        of the least-squares line across the window.
+        √(u_scatter² + u_drift²): u_scatter the standard error of the per-period means about
+        their trend (the standard deviation of the force when fewer than 3 periods), u_drift half
+        the change of the drift line across the window.
     drift_N_per_s : float
-        Slope of the least-squares line over the window [N/s].
+        Slope of the least-squares line through the per-period means (through the samples when
+        fewer than 3 periods) [N/s].
     periods : int
         Whole oscillation periods found (crossings of the trend line upwards).
     period_s : float
@@ -140,6 +141,11 @@ def pull_force_uncertainty(time_s, force_N, from_s: float) -> PullForceEstimate:
     if up.size >= 3:
         means = np.array([f[a:b].mean() for a, b in zip(up[:-1], up[1:])])
         n = means.size
+        if n >= 3:   # a line through an oscillation's partial periods tilts; one through period means does not
+            centres = np.array([t[a:b].mean() for a, b in zip(up[:-1], up[1:])])
+            slope = float(np.polyfit(centres - centres[0], means, 1)[0])
+            u_drift = 0.5 * abs(slope) * (t[-1] - t[0])
+            means = means - slope * (centres - centres.mean())   # scatter about the trend
         mean = float(f[up[0]:up[-1]].mean())
         u_scatter = float(means.std(ddof=1) / math.sqrt(n)) if n >= 3 else float(np.std(f))
         how = (f"mean over {n} whole periods (upward crossings of the trend line); scatter: "
