@@ -75,6 +75,7 @@ BAD = [
     ("elements-and-length", with_(base(), ("cable", "element_length"), 0.1), "cable.element_length", "not both"),
     ("element-length-zero", with_(with_(base(), ("cable", "elements"), _DELETE), ("cable", "element_length"), 0.0),
      "cable.element_length", "> 0"),
+    ("elements-float-zero", with_(base(), ("cable", "elements"), 0.0), "cable.elements", "integer"),
     ("no-speed", with_(base(), ("pull", "speed"), _DELETE), "pull.speed", "required"),
     ("no-end-time", with_(base(), ("solver", "end_time"), _DELETE), "solver.end_time", "required"),
     ("no-inner-radius", with_(base(), ("conduit", "inner_radius"), _DELETE), "conduit.inner_radius", "required"),

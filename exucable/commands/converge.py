@@ -10,14 +10,13 @@ atomically. Exits 1 when a level's result is not trusted (its status names why) 
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from ..convergence import extrapolate
-from ..results import atomic_write_text, write_csv
+from ..io import write_csv, write_json
 from ..run import run_scenario
 from ..scenario import load_scenario
 from ..trust import TRUSTED_STATUSES
@@ -70,8 +69,7 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
         report.update(extrapolated_N=None, error_N=None, observed_order=None, method=str(exc))
     write_csv(out / "converge.csv", CONVERGE_COLUMNS, {c: [r[c] if r[c] is not None else np.nan for r in rows]
                                                        for c in CONVERGE_COLUMNS})
-    from ..results import _json_safe
-    atomic_write_text(out / "converge.json", json.dumps(_json_safe(report), indent=2) + "\n")
+    write_json(out / "converge.json", report)
     return report
 
 

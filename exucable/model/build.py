@@ -95,7 +95,8 @@ def plan_cable_mesh(scenario, conduit, rope: RopeSolution, refine: float = 1.0,
     k = check_points_per_element if check_points_per_element is not None else scenario.contact.check_points_per_element
     return plan_mesh(conduit.centreline, conduit.inner_radius_m - c.radius_m, scenario.cable_length_m,
                      c.bending_stiffness_N_m2, float(np.max(rope.tension_N)) if rope is not None else 0.0,
-                     elements=c.elements, element_length_m=c.element_length_m,
+                     elements=None if "elements" in c.derived_keys else c.elements,
+                     element_length_m=c.element_length_m,
                      check_points_per_element=k, refine=refine)
 
 
