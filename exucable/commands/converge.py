@@ -53,7 +53,9 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
                      "value_N": s[q] if s[q] is not None else float("nan"),
                      "uncertainty_N": s["pull_force_uncertainty_N"] if q == "pull_force_N" else s.get("pull_force_std_N"),
                      "drift_N_per_s": s["pull_force_drift_N_per_s"], "wall_time_s": s["wall_time_s"],
-                     "status": s["status"]})
+                     "status": s["status"],
+                     "bends": [{k: b[k] for k in ("bend", "mean_pressure_vs_rope", "entry_point_load_N",
+                                                  "exit_point_load_N")} for b in s.get("bends", [])]})
         statuses.append(s["status"])
         if progress is not None:
             progress(level, s)
@@ -107,6 +109,13 @@ def main(args) -> int:
     for r in rep["levels"]:
         print(f"{r['level']:>5} {r['elements']:>8} {r['element_length_m']:>9.4g} {r['check_points_per_element']:>9} "
               f"{_f(r['value_N'], '.8g'):>22} {_f(r['uncertainty_N'], '.2g'):>9} {r['status']:>10}")
+    for i, b in enumerate(rep["levels"][0]["bends"]):
+        cells = [(r["bends"][i]["mean_pressure_vs_rope"], r["bends"][i]["entry_point_load_N"],
+                  r["bends"][i]["exit_point_load_N"]) for r in rep["levels"]]
+        print(f"bend {b['bend']}: windowed pressure in the body vs the rope's T/R "
+              + " / ".join(f"{100 * c[0]:+.2f} %" for c in cells) + "; point loads entry "
+              + " / ".join(f"{c[1]:.3g}" for c in cells) + " N, exit " + " / ".join(f"{c[2]:.3g}" for c in cells)
+              + " N (levels 0 …)")
     print(f"extrapolated: {_f(rep['extrapolated_N'], '.8g')} ± {_f(rep['error_N'], '.2g')} N "
           f"(observed order {_f(rep['observed_order'], '.3g')}; {rep['method']})")
     if rep.get("default_vs_extrapolated") is not None:
