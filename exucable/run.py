@@ -120,7 +120,10 @@ def _assess(model, out, st, h, pull_force_N):
         max_axis_offset_s_m=float(h["max_axis_offset_s_m"][io]) if io is not None else float("nan"),
         clearance_m=clearance, cable_radius_m=c.radius_m, inner_radius_m=R_in,
         mass_per_length_kg_per_m=c.mass_per_length_kg_per_m, speed_m_per_s=sc.pull.speed_m_per_s,
-        pull_force_N=pull_force_N if pull_force_N is not None else float("nan"),
+        # the quasi-static expectation (the rope's) is the scale ρA·v² is measured against; a run
+        # thrown about by inertia can report any pulling force, even a negative one
+        pull_force_N=(model.rope.pull_force_N if model.rope is not None
+                      else pull_force_N if pull_force_N is not None else float("nan")),
         steady_window_s=sc.solver.steady_window_s, steady_tolerance=sc.solver.steady_tolerance,
         end_time_s=out.end_time_s, base_status=out.status)
 

@@ -15,7 +15,7 @@ contact is too soft for the route (the cable no longer rides on the wall but in 
 friction acts on a different path).
 Outside — the cable's axis farther from the conduit's axis than the inner radius R_in: at least half
 the cable is outside its conduit.
-``DYNAMIC_LIMIT`` — ρA·v² / pulling force above this: the quasi-static capstan relation on which the
+``DYNAMIC_LIMIT`` — ρA·v² / pulling force (the rope's, when there is one) above this: the quasi-static capstan relation on which the
 pull rests shifts by about ρA·v²(e^{μθ}−1) (the centrifugal load ρA·v²·κ offsets T·κ on the wall).
 Not steady — no window of ``solver.steady_window`` in which drift and scatter stay within
 ``solver.steady_tolerance``.
