@@ -22,6 +22,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "sweep": ("exucable.commands.sweep", "run a parameter sweep (local pool or Dask)"),
     "compare": ("exucable.commands.compare", "compare two result sets (yours and ours)"),
     "converge": ("exucable.commands.converge", "run a scenario on refined meshes and extrapolate its result"),
+    "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
 }
 
 

@@ -29,11 +29,11 @@ import numpy as np
 __all__ = ["BEND_COLUMNS", "PRESSURE_COLUMNS", "default_window_m", "windowed_load", "bend_table",
            "pressure_profile"]
 
-BEND_COLUMNS = ("bend", "s_start_m", "s_end_m", "radius_m", "angle_deg", "tension_in_N", "tension_out_N",
+BEND_COLUMNS = ("bend", "s_conduit_start_m", "s_conduit_end_m", "radius_m", "angle_deg", "tension_in_N", "tension_out_N",
                 "rope_tension_in_N", "rope_tension_out_N", "mean_pressure_N_per_m", "peak_pressure_N_per_m",
                 "rope_mean_pressure_N_per_m", "rope_peak_pressure_N_per_m", "mean_pressure_vs_rope",
-                "entry_point_load_N", "entry_s_m", "exit_point_load_N", "exit_s_m")
-PRESSURE_COLUMNS = ("s_m", "windowed_pressure_N_per_m", "rope_windowed_pressure_N_per_m")
+                "entry_point_load_N", "entry_s_conduit_m", "exit_point_load_N", "exit_s_conduit_m")
+PRESSURE_COLUMNS = ("s_conduit_m", "windowed_pressure_N_per_m", "rope_windowed_pressure_N_per_m")
 
 
 def default_window_m(centreline) -> float:
@@ -78,7 +78,7 @@ def pressure_profile(s_m, force_N, rope_s_m, rope_pressure_N_per_m, window_m: fl
     grid = np.linspace(0.0, length_m, max(21, int(np.ceil(10 * length_m / window_m)) + 1))
     rs, rc = _rope_cumulative(rope_s_m, rope_pressure_N_per_m)
     lo, hi = np.clip(grid - window_m / 2, 0.0, length_m), np.clip(grid + window_m / 2, 0.0, length_m)
-    return {"s_m": grid, "windowed_pressure_N_per_m": windowed_load(s_m, force_N, window_m, grid),
+    return {"s_conduit_m": grid, "windowed_pressure_N_per_m": windowed_load(s_m, force_N, window_m, grid),
             "rope_windowed_pressure_N_per_m": _rope_between(rs, rc, lo, hi) / window_m}
 
 
@@ -141,13 +141,13 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
         entry, exit_ = ("start", "end") if direction == "forward" else ("end", "start")
         flip = (lambda x: x) if direction == "forward" else (lambda x: x[::-1])
         rows.append({
-            "bend": k, "s_start_m": b.s0, "s_end_m": b.s1, "radius_m": b.radius, "angle_deg": b.angle_deg,
+            "bend": k, "s_conduit_start_m": b.s0, "s_conduit_end_m": b.s1, "radius_m": b.radius, "angle_deg": b.angle_deg,
             "tension_in_N": flip(t_start)[0], "tension_out_N": flip(t_start)[1],
             "rope_tension_in_N": flip(r_start)[0], "rope_tension_out_N": flip(r_start)[1],
             "mean_pressure_N_per_m": mean, "peak_pressure_N_per_m": float(np.max(p_w)),
             "rope_mean_pressure_N_per_m": rope_mean, "rope_peak_pressure_N_per_m": float(np.max(r_w)),
             "mean_pressure_vs_rope": mean / rope_mean - 1.0 if rope_mean > 0 else float("nan"),
-            "entry_point_load_N": ends[entry][0], "entry_s_m": ends[entry][1],
-            "exit_point_load_N": ends[exit_][0], "exit_s_m": ends[exit_][1],
+            "entry_point_load_N": ends[entry][0], "entry_s_conduit_m": ends[entry][1],
+            "exit_point_load_N": ends[exit_][0], "exit_s_conduit_m": ends[exit_][1],
         })
     return rows

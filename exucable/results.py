@@ -8,13 +8,15 @@ Files
 -----
 ``summary.json``          scalars (forces [N], times [s]), status, scenario echoed back, versions
 ``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N`` and, with contact,
-                          ``max_penetration_m,max_axis_offset_m,max_axis_offset_s_m``
-``tension_profile.csv``   ``s_m,tension_N`` at the final time (s from the trailing end)
-``contact_profile.csv``   ``s_m,normal_force_per_length_N_per_m,penetration_m`` (s along the conduit)
-``rope_profile.csv``      ``s_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+                          ``max_penetration_m,max_axis_offset_m,max_axis_offset_s_conduit_m``
+``tension_profile.csv``   ``x_m,tension_N`` at the final time (x: material coordinate from the trailing end)
+``contact_profile.csv``   ``s_conduit_m,normal_force_per_length_N_per_m,penetration_m`` (along the
+                          scenario's conduit from its start)
+``rope_profile.csv``      ``s_conduit_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+``snapshot_*.csv``        the state at ``[output] snapshots`` times (see :mod:`exucable.snapshots`)
 ``bends.csv``             one row per bend: tensions in/out, windowed pressure mean/peak, point loads
                           (columns ``exucable.pressure.BEND_COLUMNS``)
-``pressure_profile.csv``  ``s_m,windowed_pressure_N_per_m,rope_windowed_pressure_N_per_m``
+``pressure_profile.csv``  ``s_conduit_m,windowed_pressure_N_per_m,rope_windowed_pressure_N_per_m``
 """
 
 from __future__ import annotations
@@ -32,10 +34,13 @@ __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", 
            "read_summary", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
 HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N", "max_penetration_m",
-                   "max_axis_offset_m", "max_axis_offset_s_m")
-PROFILE_COLUMNS = ("s_m", "tension_N")
-CONTACT_COLUMNS = ("s_m", "normal_force_per_length_N_per_m", "penetration_m")
-ROPE_COLUMNS = ("s_m", "tension_N", "sidewall_pressure_N_per_m")
+                   "max_axis_offset_m", "max_axis_offset_s_conduit_m")
+# Arc lengths, one convention in every file: x_m = material coordinate along the cable from its
+# trailing end; s_conduit_m = along the scenario's conduit from its start (whatever the pull direction)
+PROFILE_COLUMNS = ("x_m", "tension_N")
+CONTACT_COLUMNS = ("s_conduit_m", "normal_force_per_length_N_per_m", "penetration_m")
+ROPE_COLUMNS = ("s_conduit_m", "tension_N", "sidewall_pressure_N_per_m")
+# (the old name s_m is still read by ``compare`` for one release: exucable.compare.FAMILIES)
 
 
 @dataclass
@@ -50,6 +55,7 @@ class RunResult:
     extras: dict = field(default_factory=dict)
     bends: list | None = None                # BEND_COLUMNS rows (exucable.pressure)
     pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
+    snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.snapshots)
 
 
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
@@ -74,6 +80,11 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     if result.pressure_profile is not None:
         write_csv(out / "pressure_profile.csv", PRESSURE_COLUMNS, result.pressure_profile)
         written.append(out / "pressure_profile.csv")
+    if result.snapshots:
+        from .formats import SNAPSHOT_FILES
+        for name, data in result.snapshots.items():
+            write_csv(out / name, SNAPSHOT_FILES[name], data)
+            written.append(out / name)
     if plots:
         plot_pull_force(out / "pull_force.png", result)
         written.append(out / "pull_force.png")

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .versions import versions
+from .export import conduit_s
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
 from .solve import Progress, simulate, steady_quantity
@@ -24,7 +25,7 @@ __all__ = ["run_scenario", "contact_profile"]
 
 def check_point_loads(model) -> dict | None:
     """Every check point at the current state, ordered by its place along the scenario's conduit:
-    ``s_m`` [m], ``normal_force_N`` (weighted, what the wall pushes with) [N],
+    ``s_conduit_m`` [m], ``normal_force_N`` (weighted, what the wall pushes with) [N],
     ``normal_force_per_length_N_per_m`` (over the point's share of its element) [N/m],
     ``penetration_m`` [m]. None without contact."""
     if model.kernel is None:
@@ -34,10 +35,9 @@ def check_point_loads(model) -> dict | None:
     L = model.conduit.centreline.length_m
     s = np.asarray(pts.s_conduit_m, dtype=float)
     keep = np.isfinite(s) & (s >= 0.0) & (s <= L)
-    if model.scenario.pull.direction == "reverse":
-        s = L - s   # report along the scenario's own conduit
+    s = conduit_s(model, s)   # along the scenario's own conduit, not the pull-oriented one
     order = np.argsort(s[keep])
-    return {"s_m": s[keep][order],
+    return {"s_conduit_m": s[keep][order],
             "normal_force_N": np.asarray(pts.normal_force_N, dtype=float)[keep][order],
             "normal_force_per_length_N_per_m": np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order],
             "penetration_m": np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)}
@@ -46,21 +46,21 @@ def check_point_loads(model) -> dict | None:
 def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | None, float]:
     """Sidewall bearing pressure along the conduit from :func:`check_point_loads`.
 
-    One row per check point in order of ``s`` along the scenario's conduit (normal force per unit
+    One row per check point in order of ``s_conduit_m`` along the scenario's conduit (normal force per unit
     length [N/m] = the point's force over its share of the element, penetration [m]); beyond
     ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
     penetration: max). Also returns the largest per-point pressure [N/m].
     """
     if points is None:
         return None, 0.0
-    s, p, pen = points["s_m"], points["normal_force_per_length_N_per_m"], points["penetration_m"]
+    s, p, pen = points["s_conduit_m"], points["normal_force_per_length_N_per_m"], points["penetration_m"]
     peak = float(p.max()) if p.size else 0.0
     if s.size > max_rows:
         groups = np.array_split(np.arange(s.size), max_rows)
         s = np.array([s[g].mean() for g in groups])
         p = np.array([p[g].mean() for g in groups])
         pen = np.array([pen[g].max() for g in groups])
-    return {"s_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
+    return {"s_conduit_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
 
 
 def cable_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
@@ -70,9 +70,7 @@ def cable_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
     x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
     T = tension_at(q, Le, model.axial_stiffness_N, x_nodes)
     _, s = AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)(q[:, :3])
-    if model.scenario.pull.direction == "reverse":
-        s = model.conduit.centreline.length_m - s
-    return s, T
+    return conduit_s(model, s), T
 
 
 def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
@@ -82,16 +80,17 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
     centre = model.scenario.build_conduit().centreline
     w = default_window_m(centre)
     rope_p = rope.sidewall_pressure_N_per_m
-    prof = pressure_profile(points["s_m"], points["normal_force_N"], rope.s_conduit_m, rope_p, w, centre.length_m)
+    rope_s = conduit_s(model, rope.s_conduit_m)     # the rope is solved on the pull-oriented conduit
+    prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m)
     s_c, T_c = cable_tension_along_conduit(model)
     lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
-    bends = bend_table(centre.pieces, points["s_m"], points["normal_force_N"], s_c, T_c, rope.s_conduit_m,
+    bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
                        rope.tension_N, rope_p, w, lam, model.scenario.pull.direction)
     i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
     info = {"pressure_window_m": w,
             "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
             "max_windowed_sidewall_pressure_N_per_m": float(prof["windowed_pressure_N_per_m"][i]),
-            "max_windowed_sidewall_pressure_s_m": float(prof["s_m"][i]),
+            "max_windowed_sidewall_pressure_s_conduit_m": float(prof["s_conduit_m"][i]),
             "rope_max_windowed_sidewall_pressure_N_per_m": float(np.max(prof["rope_windowed_pressure_N_per_m"]))}
     return info, bends, prof
 
@@ -114,10 +113,10 @@ def _assess(model, out, st, h, pull_force_N):
     return assess(
         failed=out.status == "failed", steady=bool(st.steady),
         max_penetration_m=pen_max, max_penetration_time_s=float(t[ip_use]) if ip_use is not None else float("nan"),
-        max_penetration_s_m=float(h["max_axis_offset_s_m"][ip_use]) if ip_use is not None else float("nan"),
+        max_penetration_s_conduit_m=float(h["max_axis_offset_s_conduit_m"][ip_use]) if ip_use is not None else float("nan"),
         max_axis_offset_m=float(off[io]) if io is not None else -np.inf,
         max_axis_offset_time_s=float(t[io]) if io is not None else float("nan"),
-        max_axis_offset_s_m=float(h["max_axis_offset_s_m"][io]) if io is not None else float("nan"),
+        max_axis_offset_s_conduit_m=float(h["max_axis_offset_s_conduit_m"][io]) if io is not None else float("nan"),
         clearance_m=clearance, cable_radius_m=c.radius_m, inner_radius_m=R_in,
         mass_per_length_kg_per_m=c.mass_per_length_kg_per_m, speed_m_per_s=sc.pull.speed_m_per_s,
         # the quasi-static expectation (the rope's) is the scale ρA·v² is measured against; a run
@@ -146,7 +145,12 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element)
     build_s = time.perf_counter() - t_start
     progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
-    out = simulate(model, progress=progress, steady_stop=steady_stop)
+    snapshot_times = sc.output.times_s(sc.solver.end_time_s)
+    recorder = None
+    if snapshot_times:
+        from .snapshots import SnapshotRecorder
+        recorder = SnapshotRecorder(model, snapshot_times)
+    out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
     h = out.history.arrays()
     sp = sc.solver
     st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
@@ -201,14 +205,22 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                                "outside": "cable axis farther from the conduit axis than its inner radius"}
     if summary["flags"] and not summary["message"]:
         summary["message"] = "; ".join(f["message"] for f in summary["flags"])
+    if recorder is not None:
+        summary["snapshots_s"] = recorder.recorded_s
+        summary["snapshots_not_reached_s"] = list(recorder.pending)
     rope_profile = None
     extras = {}
     if rope is not None:
-        rope_profile = {"s_m": rope.s_conduit_m, "tension_N": rope.tension_N,
-                        "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m}
-        extras["s_cable_m"] = rope.s_cable_m
-    result = RunResult(summary=summary, history=h, tension_profile={"s_m": x, "tension_N": N},
+        # the rope is solved on the pull-oriented conduit, trailing end first; written along the
+        # scenario's conduit in increasing s_conduit_m, as the contact profile
+        order = slice(None, None, -1) if sc.pull.direction == "reverse" else slice(None)
+        rope_profile = {"s_conduit_m": conduit_s(model, rope.s_conduit_m)[order],
+                        "tension_N": rope.tension_N[order],
+                        "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m[order]}
+        extras["x_m"] = rope.s_cable_m[order]
+    result = RunResult(summary=summary, history=h, tension_profile={"x_m": x, "tension_N": N},
                        contact_profile=cprof, rope_profile=rope_profile, extras=extras,
+                       snapshots=recorder.tables() if recorder is not None else None,
                        bends=bends, pressure_profile=pressure_prof)
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)

@@ -31,7 +31,7 @@ class History:
     max_tension_N: list = field(default_factory=list)
     max_penetration_m: list = field(default_factory=list)
     max_axis_offset_m: list = field(default_factory=list)
-    max_axis_offset_s_m: list = field(default_factory=list)
+    max_axis_offset_s_conduit_m: list = field(default_factory=list)
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {k: np.asarray(v, dtype=float) for k, v in self.__dict__.items()}
@@ -139,11 +139,15 @@ def record_state(model, t: float, history: History, gauge=None) -> None:
             s_off = float(s[i]) if model.scenario.pull.direction != "reverse" else float(gauge.length_m - s[i])
     history.max_penetration_m.append(pen)
     history.max_axis_offset_m.append(offset)
-    history.max_axis_offset_s_m.append(s_off)
+    history.max_axis_offset_s_conduit_m.append(s_off)
 
 
-def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None) -> SolveOutcome:
+def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None,
+             snapshots=None) -> SolveOutcome:
     """Integrate ``model`` to the scenario's end time (or to a steady pulling force).
+
+    ``snapshots`` (an :class:`exucable.snapshots.SnapshotRecorder`, optional) is fed the state at
+    the end of every step.
 
     Never raises for a diverging run: the outcome has ``status == "failed"``, the simulated time
     where it happened, and the history recorded until then.
@@ -160,6 +164,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     next_out[0] = out_dt
 
     def post_step(mbs, t):
+        if snapshots is not None:
+            snapshots.step(t, model.pull_force_N(t))
         if t >= next_out[0] - 1e-12 * max(1.0, t):
             record_state(model, t, history, gauge)
             next_out[0] = (np.floor(t / out_dt + 1e-9) + 1.0) * out_dt

@@ -160,8 +160,8 @@ def pull_force_uncertainty(time_s, force_N, from_s: float) -> PullForceEstimate:
 
 
 def assess(*, failed: bool, steady: bool, max_penetration_m: float, max_penetration_time_s: float,
-           max_penetration_s_m: float, max_axis_offset_m: float, max_axis_offset_time_s: float,
-           max_axis_offset_s_m: float, clearance_m: float, cable_radius_m: float, inner_radius_m: float,
+           max_penetration_s_conduit_m: float, max_axis_offset_m: float, max_axis_offset_time_s: float,
+           max_axis_offset_s_conduit_m: float, clearance_m: float, cable_radius_m: float, inner_radius_m: float,
            mass_per_length_kg_per_m: float, speed_m_per_s: float, pull_force_N: float,
            steady_window_s: float, steady_tolerance: float, end_time_s: float,
            base_status: str) -> tuple[str, list[dict]]:
@@ -174,24 +174,24 @@ def assess(*, failed: bool, steady: bool, max_penetration_m: float, max_penetrat
         flag's name: ``"failed"``, ``"outside_conduit"``, ``"penetration"``, ``"dynamic"``,
         ``"not_steady"``.
     flags : list of dict
-        Each with ``flag``, ``message``, and where known ``time_s`` and ``s_m`` (along the
+        Each with ``flag``, ``message``, and where known ``time_s`` and ``s_conduit_m`` (along the
         scenario's conduit).
     """
     flags = []
     if max_axis_offset_m > inner_radius_m:
-        flags.append({"flag": "outside_conduit", "time_s": max_axis_offset_time_s, "s_m": max_axis_offset_s_m,
+        flags.append({"flag": "outside_conduit", "time_s": max_axis_offset_time_s, "s_conduit_m": max_axis_offset_s_conduit_m,
                       "value_m": max_axis_offset_m,
                       "message": f"the cable's axis is {1e3 * max_axis_offset_m:.3g} mm from the conduit's axis "
                                  f"(inner radius {1e3 * inner_radius_m:.3g} mm), "
                                  f"{1e3 * (max_axis_offset_m - inner_radius_m):.3g} mm beyond the wall, at "
-                                 f"s = {max_axis_offset_s_m:.4g} m, t = {max_axis_offset_time_s:.4g} s: the contact "
+                                 f"s = {max_axis_offset_s_conduit_m:.4g} m, t = {max_axis_offset_time_s:.4g} s: the contact "
                                  f"is far too soft (raise contact.stiffness)"})
     limit = PENETRATION_LIMIT * min(clearance_m, cable_radius_m)
     if max_penetration_m > limit:
-        flags.append({"flag": "penetration", "time_s": max_penetration_time_s, "s_m": max_penetration_s_m,
+        flags.append({"flag": "penetration", "time_s": max_penetration_time_s, "s_conduit_m": max_penetration_s_conduit_m,
                       "value_m": max_penetration_m, "limit_m": limit,
                       "message": f"penetration {1e3 * max_penetration_m:.3g} mm > {PENETRATION_LIMIT:g} × "
-                                 f"min(clearance, cable radius) = {1e3 * limit:.3g} mm at s = {max_penetration_s_m:.4g} m, "
+                                 f"min(clearance, cable radius) = {1e3 * limit:.3g} mm at s = {max_penetration_s_conduit_m:.4g} m, "
                                  f"t = {max_penetration_time_s:.4g} s (raise contact.stiffness)"})
     ratio = mass_per_length_kg_per_m * speed_m_per_s**2 / max(abs(pull_force_N), 1e-12) \
         if np.isfinite(pull_force_N) else float("nan")

@@ -44,7 +44,7 @@ def test_bend_table_recovers_a_known_distribution():
     assert len(rows) == 1
     b = rows[0]
     assert abs(b["mean_pressure_vs_rope"]) < 1e-3
-    assert b["entry_point_load_N"] == pytest.approx(2.0, abs=0.05) and b["entry_s_m"] == pytest.approx(1.0)
+    assert b["entry_point_load_N"] == pytest.approx(2.0, abs=0.05) and b["entry_s_conduit_m"] == pytest.approx(1.0)
     assert b["exit_point_load_N"] == pytest.approx(3.0, abs=0.05)
     assert b["tension_in_N"] == pytest.approx(150.0, rel=1e-3)
     assert b["tension_out_N"] == pytest.approx(150 * np.exp(0.1 * np.pi), rel=1e-3)
@@ -74,6 +74,6 @@ def test_windowed_pressure_matches_T_over_R_in_the_bend_body(ex2_rule_mesh):
     assert abs(b["entry_point_load_N"]) < 5.0 and abs(b["exit_point_load_N"]) < 5.0
     table = read_csv(out / "bends.csv")
     assert list(table) == list(BEND_COLUMNS) and len(table["bend"]) == 1
-    assert list(read_csv(out / "pressure_profile.csv")) == ["s_m", "windowed_pressure_N_per_m",
+    assert list(read_csv(out / "pressure_profile.csv")) == ["s_conduit_m", "windowed_pressure_N_per_m",
                                                             "rope_windowed_pressure_N_per_m"]
     assert (out / "pressure.png").stat().st_size > 5000

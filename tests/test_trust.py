@@ -71,7 +71,7 @@ def test_untrustworthy_runs_are_flagged_with_place_and_time(change, status, tmp_
     flag = next(f for f in s["flags"] if f["flag"] == status)
     assert flag["message"]
     if status in ("outside_conduit", "penetration"):
-        assert 0.0 <= flag["s_m"] <= 1.8 and 0.0 < flag["time_s"] <= 0.3
+        assert 0.0 <= flag["s_conduit_m"] <= 1.8 and 0.0 < flag["time_s"] <= 0.3
     assert json.loads((tmp_path / "summary.json").read_text())["status"] == s["status"]   # written, kept
 
 
@@ -111,8 +111,8 @@ def test_the_issue_s_50_m_per_s_pull_is_dynamic():
     """Paper Example 2 at 50 m/s: ρA v² = 49 N against ~205 N; the issue's run reported "ok"."""
     rhoA = 1000 * np.pi * 0.0025**2
     status, flags = assess(failed=False, steady=True, max_penetration_m=1e-5, max_penetration_time_s=0.1,
-                           max_penetration_s_m=1.0, max_axis_offset_m=0.0012, max_axis_offset_time_s=0.1,
-                           max_axis_offset_s_m=1.0, clearance_m=0.001, cable_radius_m=0.0025,
+                           max_penetration_s_conduit_m=1.0, max_axis_offset_m=0.0012, max_axis_offset_time_s=0.1,
+                           max_axis_offset_s_conduit_m=1.0, clearance_m=0.001, cable_radius_m=0.0025,
                            inner_radius_m=0.0035, mass_per_length_kg_per_m=rhoA, speed_m_per_s=50.0,
                            pull_force_N=205.0, steady_window_s=0.2, steady_tolerance=1e-3, end_time_s=1.0,
                            base_status="steady")

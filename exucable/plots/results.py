@@ -42,11 +42,11 @@ def plot_tension_profile(path, result) -> None:
     p = result.tension_profile
     fig = new_figure(figsize=(7, 4))
     ax = fig.subplots()
-    ax.plot(p["s_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
+    ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
     rp = result.rope_profile
-    if rp is not None and "s_cable_m" in result.extras:
-        ax.plot(result.extras["s_cable_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
-    ax.set_xlabel("arc length from the trailing end [m]")
+    if rp is not None and "x_m" in result.extras:
+        ax.plot(result.extras["x_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
+    ax.set_xlabel("x: material coordinate from the trailing end [m]")
     ax.set_ylabel("tension [N]")
     ax.set_title(f"{result.summary.get('name', '')}: tension along the cable")
     ax.grid(alpha=0.3)
@@ -62,18 +62,18 @@ def plot_pressure(path, result) -> None:
     ax = fig.subplots()
     cp = result.contact_profile
     if cp is not None:
-        ax.plot(cp["s_m"], cp["normal_force_per_length_N_per_m"], ",", color="0.6", alpha=0.5,
+        ax.plot(cp["s_conduit_m"], cp["normal_force_per_length_N_per_m"], ",", color="0.6", alpha=0.5,
                 label="check points (force / element share)")
-    ax.plot(pp["s_m"], pp["windowed_pressure_N_per_m"], lw=1.8,
+    ax.plot(pp["s_conduit_m"], pp["windowed_pressure_N_per_m"], lw=1.8,
             label=f"exucable, windowed over {s.get('pressure_window_m', float('nan')):.3g} m")
-    ax.plot(pp["s_m"], pp["rope_windowed_pressure_N_per_m"], "k--", lw=1, label="rope (T/R and weight), windowed")
+    ax.plot(pp["s_conduit_m"], pp["rope_windowed_pressure_N_per_m"], "k--", lw=1, label="rope (T/R and weight), windowed")
     top = 1.6 * max(float(np.max(pp["windowed_pressure_N_per_m"])), float(np.max(pp["rope_windowed_pressure_N_per_m"])), 1e-9)
     for b in result.bends or []:
-        ax.axvspan(b["s_start_m"], b["s_end_m"], color="b", alpha=0.05)
+        ax.axvspan(b["s_conduit_start_m"], b["s_conduit_end_m"], color="b", alpha=0.05)
         for end in ("entry", "exit"):
             F = b[f"{end}_point_load_N"]
             if np.isfinite(F):
-                ax.annotate(f"{F:+.3g} N", (b[f"{end}_s_m"], 0.72 * top), fontsize=7, ha="center", rotation=90)
+                ax.annotate(f"{F:+.3g} N", (b[f"{end}_s_conduit_m"], 0.72 * top), fontsize=7, ha="center", rotation=90)
     ax.set_ylim(0, top)
     ax.set_xlabel("s along the conduit [m]")
     ax.set_ylabel("sidewall bearing pressure [N/m]")
