@@ -35,8 +35,9 @@ __all__ = ["AxisGauge", "cable_sample_points", "PullForceEstimate", "pull_force_
 PENETRATION_LIMIT = 0.25
 DYNAMIC_LIMIT = 0.01
 TRUSTED_STATUSES = ("ok", "steady")
-# order of severity: the run's status names the first that applies
-_SEVERITY = ("failed", "outside_conduit", "penetration", "dynamic", "not_steady")
+# order of precedence: the run's status names the first that applies. A pull fast enough for
+# inertia to matter is named before what it causes (a whipping cable pressed into or out of the wall).
+_SEVERITY = ("failed", "dynamic", "outside_conduit", "penetration", "not_steady")
 
 
 def cable_sample_points(coordinates, element_length_m) -> np.ndarray:
@@ -170,8 +171,8 @@ def assess(*, failed: bool, steady: bool, max_penetration_m: float, max_penetrat
     Returns
     -------
     status : str
-        ``base_status`` ("ok"/"steady"/"failed") when nothing is flagged, else the most severe
-        flag's name: ``"failed"``, ``"outside_conduit"``, ``"penetration"``, ``"dynamic"``,
+        ``base_status`` ("ok"/"steady"/"failed") when nothing is flagged, else the first flag
+        found of ``"failed"``, ``"dynamic"``, ``"outside_conduit"``, ``"penetration"``,
         ``"not_steady"``.
     flags : list of dict
         Each with ``flag``, ``message``, and where known ``time_s`` and ``s_conduit_m`` (along the

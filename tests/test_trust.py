@@ -62,12 +62,8 @@ def test_a_sound_run_is_trusted_and_states_its_uncertainty(tmp_path):
 def test_untrustworthy_runs_are_flagged_with_place_and_time(change, status, tmp_path):
     res = run_scenario(_tiny(**change), tmp_path, plots=False)
     s = res.summary
-    names = [f["flag"] for f in s["flags"]]
-    if status == "dynamic":
-        # at 5 m/s the whipping cable also presses 0.45 mm into the wall, more severe: named first
-        assert status in names and s["status"] not in ("ok", "steady"), s["flags"]
-    else:
-        assert s["status"] == status, s["flags"]
+    # (at 5 m/s the whipping cable also presses 0.45 mm into the wall: "dynamic", its cause, is named)
+    assert s["status"] == status, s["flags"]
     flag = next(f for f in s["flags"] if f["flag"] == status)
     assert flag["message"]
     if status in ("outside_conduit", "penetration"):
