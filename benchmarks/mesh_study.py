@@ -26,6 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from exucable.commands.converge import converge  # noqa: E402
+from exucable.io import atomic_write_text  # noqa: E402
 from exucable.scenario import load_scenario  # noqa: E402
 
 CASES = {
@@ -76,8 +77,7 @@ def main(argv=None) -> int:
             f"{rep['method'].split(':')[0]} | {' / '.join(format(r['wall_time_s'], '.0f') for r in lv)} |")
         print(lines[-1], f"({time.perf_counter() - t0:.0f} s)", flush=True)
     text = "\n".join(lines) + "\n"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "mesh_study.md").write_text(text)
+    atomic_write_text(out / "mesh_study.md", text)
     print(text)
     return 0
 

@@ -17,10 +17,10 @@ not a scalar (the conduit route) are ``kind="custom"`` and parsed by hand.
 from __future__ import annotations
 
 import re
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
 
 __all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "markdown_table", "format_default",
            "readme_with_tables"]
@@ -321,20 +321,3 @@ def readme_with_tables(text: str) -> str:
         text = text[: m.start()] + markdown_table(section) + end_newline + text[m.end():]
     return text
 
-
-def main(argv=None) -> int:
-    """Rewrite the key tables of scenarios/README.md from :data:`FIELDS` (a developer tool)."""
-    argv = sys.argv[1:] if argv is None else argv
-    path = Path(argv[0]) if argv else Path(__file__).resolve().parent.parent / "scenarios" / "README.md"
-    old = path.read_text(encoding="utf-8")
-    new = readme_with_tables(old)
-    if new != old:
-        path.write_text(new, encoding="utf-8")
-        print(f"updated the key tables of {path}")
-    else:
-        print(f"{path} is up to date")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
