@@ -12,7 +12,7 @@ from exucable.cli import main as cli_main
 from exucable.run import run_scenario
 from exucable.trust import assess, pull_force_uncertainty
 
-from conftest import make_scenario
+from conftest import ROOT, make_scenario
 
 TINY = dict(
     conduit={"inner_radius": 0.0035, "segments_per_bend": 8,
@@ -72,29 +72,10 @@ def test_untrustworthy_runs_are_flagged_with_place_and_time(change, status, tmp_
 
 
 def test_cli_exits_non_zero_and_keeps_the_results(tmp_path, capsys):
+    # the sweep tests' tiny bend with the issue's soft contact
+    base = (ROOT / "tests" / "data" / "sweep" / "tiny_bend.toml").read_text()
     toml = tmp_path / "soft.toml"
-    toml.write_text("""
-name = "soft"
-[cable]
-radius = 0.0025
-density = 1000.0
-youngs_modulus = 1.0e9
-elements = 8
-[conduit]
-inner_radius = 0.0035
-segments_per_bend = 8
-path = [ { straight = 0.5 }, { bend = 90.0, radius = 0.5, turn = "left" }, { straight = 0.5 } ]
-[contact]
-friction = 0.2
-stiffness = 5.0
-check_points_per_element = 8
-[pull]
-speed = 0.1
-back_tension = 20.0
-[solver]
-end_time = 0.1
-step = 0.01
-""")
+    toml.write_text(base.replace("friction = 0.2", "friction = 0.2\nstiffness = 5.0"))
     rc = cli_main(["run", str(toml), "--out", str(tmp_path / "out"), "--quiet", "--no-plots"])
     assert rc == 1
     err = capsys.readouterr().err
