@@ -23,6 +23,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "compare": ("exucable.commands.compare", "compare two result sets (yours and ours)"),
     "converge": ("exucable.commands.converge", "run a scenario on refined meshes and extrapolate its result"),
     "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
+    "plan": ("exucable.commands.plan", "plan a pull: both directions, section tables, limit checks, HTML report"),
 }
 
 
