@@ -21,6 +21,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "validate": ("exucable.commands.validate", "run the paper's examples against their references"),
     "sweep": ("exucable.commands.sweep", "run a parameter sweep (local pool or Dask)"),
     "compare": ("exucable.commands.compare", "compare two result sets (yours and ours)"),
+    "converge": ("exucable.commands.converge", "run a scenario on refined meshes and extrapolate its result"),
     "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
     "plan": ("exucable.commands.plan", "plan a pull: both directions, section tables, limit checks, HTML report"),
 }

@@ -7,12 +7,16 @@ data files: its presence marks complete results. The figures (optional) follow i
 Files
 -----
 ``summary.json``          scalars (forces [N], times [s]), status, scenario echoed back, versions
-``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N``
+``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N`` and, with contact,
+                          ``max_penetration_m,max_axis_offset_m,max_axis_offset_s_conduit_m``
 ``tension_profile.csv``   ``x_m,tension_N`` at the final time (x: material coordinate from the trailing end)
 ``contact_profile.csv``   ``s_conduit_m,normal_force_per_length_N_per_m,penetration_m`` (along the
                           scenario's conduit from its start)
 ``rope_profile.csv``      ``s_conduit_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
 ``snapshot_*.csv``        the state at ``[output] snapshots`` times (see :mod:`exucable.snapshots`)
+``bends.csv``             one row per bend: tensions in/out, windowed pressure mean/peak, point loads
+                          (columns ``exucable.pressure.BEND_COLUMNS``)
+``pressure_profile.csv``  ``s_conduit_m,windowed_pressure_N_per_m,rope_windowed_pressure_N_per_m``
 """
 
 from __future__ import annotations
@@ -23,12 +27,14 @@ from pathlib import Path
 
 # The writers live in io.py (one atomic writer); re-exported here, where callers have found them.
 from .io import atomic_write_bytes, atomic_write_text, read_csv, write_csv, write_json
-from .plots.results import plot_pull_force, plot_tension_profile
+from .plots.results import plot_pressure, plot_pull_force, plot_tension_profile
+from .pressure import BEND_COLUMNS, PRESSURE_COLUMNS
 
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
            "read_summary", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
-HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N")
+HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N", "max_penetration_m",
+                   "max_axis_offset_m", "max_axis_offset_s_conduit_m")
 # Arc lengths, one convention in every file: x_m = material coordinate along the cable from its
 # trailing end; s_conduit_m = along the scenario's conduit from its start (whatever the pull direction)
 PROFILE_COLUMNS = ("x_m", "tension_N")
@@ -47,6 +53,8 @@ class RunResult:
     contact_profile: dict | None = None
     rope_profile: dict | None = None
     extras: dict = field(default_factory=dict)
+    bends: list | None = None                # BEND_COLUMNS rows (exucable.pressure)
+    pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
     snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.snapshots)
 
 
@@ -56,7 +64,7 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
-    write_csv(out / "history.csv", HISTORY_COLUMNS, result.history)
+    write_csv(out / "history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
     written.append(out / "history.csv")
     if result.tension_profile is not None:
         write_csv(out / "tension_profile.csv", PROFILE_COLUMNS, result.tension_profile)
@@ -67,6 +75,12 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     if result.rope_profile is not None:
         write_csv(out / "rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
         written.append(out / "rope_profile.csv")
+    if result.bends:
+        write_csv(out / "bends.csv", BEND_COLUMNS, {c: [row[c] for row in result.bends] for c in BEND_COLUMNS})
+        written.append(out / "bends.csv")
+    if result.pressure_profile is not None:
+        write_csv(out / "pressure_profile.csv", PRESSURE_COLUMNS, result.pressure_profile)
+        written.append(out / "pressure_profile.csv")
     if result.snapshots:
         from .formats import SNAPSHOT_FILES
         for name, data in result.snapshots.items():
@@ -82,6 +96,9 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
         if result.tension_profile is not None:
             plot_tension_profile(out / "tension_profile.png", result)
             written.append(out / "tension_profile.png")
+        if result.pressure_profile is not None:
+            plot_pressure(out / "pressure.png", result)
+            written.append(out / "pressure.png")
     return written
 
 

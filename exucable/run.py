@@ -17,21 +17,20 @@ from .export import conduit_s
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
 from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity
-from .tension import detect_steady_state, tension_profile
+from .pressure import bend_table, default_window_m, pressure_profile
+from .tension import detect_steady_state, tension_at, tension_profile
+from .trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile"]
 
 
-def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
-    """Sidewall bearing pressure along the conduit at the current state.
-
-    One row per check point in order of ``s_conduit_m`` along the scenario's conduit (normal force
-    per unit length [N/m] = the point's force over its share of the element, penetration [m]);
-    beyond ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
-    penetration: max). Also returns the largest per-point pressure [N/m].
-    """
+def check_point_loads(model) -> dict | None:
+    """Every check point at the current state, ordered by its place along the scenario's conduit:
+    ``s_conduit_m`` [m], ``normal_force_N`` (weighted, what the wall pushes with) [N],
+    ``normal_force_per_length_N_per_m`` (over the point's share of its element) [N/m],
+    ``penetration_m`` [m]. None without contact."""
     if model.kernel is None:
-        return None, 0.0
+        return None
     q, v = model.coordinates()
     pts = model.kernel.points(q.reshape(-1), v.reshape(-1))
     L = model.conduit.centreline.length_m
@@ -39,9 +38,23 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
     keep = np.isfinite(s) & (s >= 0.0) & (s <= L)
     s = conduit_s(model, s)   # along the scenario's own conduit, not the pull-oriented one
     order = np.argsort(s[keep])
-    s = s[keep][order]
-    p = np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order]
-    pen = np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)
+    return {"s_conduit_m": s[keep][order],
+            "normal_force_N": np.asarray(pts.normal_force_N, dtype=float)[keep][order],
+            "normal_force_per_length_N_per_m": np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order],
+            "penetration_m": np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)}
+
+
+def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | None, float]:
+    """Sidewall bearing pressure along the conduit from :func:`check_point_loads`.
+
+    One row per check point in order of ``s_conduit_m`` along the scenario's conduit (normal force per unit
+    length [N/m] = the point's force over its share of the element, penetration [m]); beyond
+    ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
+    penetration: max). Also returns the largest per-point pressure [N/m].
+    """
+    if points is None:
+        return None, 0.0
+    s, p, pen = points["s_conduit_m"], points["normal_force_per_length_N_per_m"], points["penetration_m"]
     peak = float(p.max()) if p.size else 0.0
     if s.size > max_rows:
         groups = np.array_split(np.arange(s.size), max_rows)
@@ -51,13 +64,80 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
     return {"s_conduit_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
 
 
+def cable_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
+    """The cable's tension at its nodes [N] and their places along the scenario's conduit [m]."""
+    q, _ = model.coordinates()
+    Le = model.layout.element_length_m
+    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
+    T = tension_at(q, Le, model.axial_stiffness_N, x_nodes)
+    _, s = AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)(q[:, :3])
+    return conduit_s(model, s), T
+
+
+def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
+    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.pressure)."""
+    if points is None or rope is None:
+        return {}, [], None
+    centre = model.scenario.build_conduit().centreline
+    w = default_window_m(centre)
+    rope_p = rope.sidewall_pressure_N_per_m
+    rope_s = conduit_s(model, rope.s_conduit_m)     # the rope is solved on the pull-oriented conduit
+    prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m)
+    s_c, T_c = cable_tension_along_conduit(model)
+    lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
+    bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
+                       rope.tension_N, rope_p, w, lam, model.scenario.pull.direction)
+    i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
+    info = {"pressure_window_m": w,
+            "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
+            "max_windowed_sidewall_pressure_N_per_m": float(prof["windowed_pressure_N_per_m"][i]),
+            "max_windowed_sidewall_pressure_s_conduit_m": float(prof["s_conduit_m"][i]),
+            "rope_max_windowed_sidewall_pressure_N_per_m": float(np.max(prof["rope_windowed_pressure_N_per_m"]))}
+    return info, bends, prof
+
+
+def _assess(model, out, st, h, pull_force_N):
+    """Status and flags of a finished run (see :mod:`exucable.trust`)."""
+    sc = model.scenario
+    c = sc.cable
+    pen = np.nan_to_num(h.get("max_penetration_m", np.zeros(0)), nan=-np.inf)
+    off = np.nan_to_num(h.get("max_axis_offset_m", np.zeros(0)), nan=-np.inf)
+    t = h["time_s"]
+    ip = int(np.argmax(pen)) if pen.size else None
+    io = int(np.argmax(off)) if off.size else None
+    R_in = model.conduit.inner_radius_m
+    clearance = R_in - c.radius_m
+    # the kernel's check points give the penetration; points far outside have no candidate segment,
+    # so the cable axis's offset beyond the clearance bounds it from below
+    pen_max = max(float(pen[ip]) if ip is not None else -np.inf, float(off[io]) - clearance if io is not None else -np.inf)
+    ip_use = io if (io is not None and (ip is None or float(off[io]) - clearance >= float(pen[ip]))) else ip
+    return assess(
+        failed=out.status == "failed", steady=bool(st.steady),
+        max_penetration_m=pen_max, max_penetration_time_s=float(t[ip_use]) if ip_use is not None else float("nan"),
+        max_penetration_s_conduit_m=float(h["max_axis_offset_s_conduit_m"][ip_use]) if ip_use is not None else float("nan"),
+        max_axis_offset_m=float(off[io]) if io is not None else -np.inf,
+        max_axis_offset_time_s=float(t[io]) if io is not None else float("nan"),
+        max_axis_offset_s_conduit_m=float(h["max_axis_offset_s_conduit_m"][io]) if io is not None else float("nan"),
+        clearance_m=clearance, cable_radius_m=c.radius_m, inner_radius_m=R_in,
+        mass_per_length_kg_per_m=c.mass_per_length_kg_per_m, speed_m_per_s=sc.pull.speed_m_per_s,
+        # the quasi-static expectation (the rope's) is the scale ρA·v² is measured against; a run
+        # thrown about by inertia can report any pulling force, even a negative one
+        pull_force_N=(model.rope.pull_force_N if model.rope is not None
+                      else pull_force_N if pull_force_N is not None else float("nan")),
+        steady_window_s=sc.solver.steady_window_s, steady_tolerance=sc.solver.steady_tolerance,
+        end_time_s=out.end_time_s, base_status=out.status)
+
+
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
-                 steady_stop: bool | None = None) -> RunResult:
+                 steady_stop: bool | None = None, refine: float = 1.0,
+                 check_points_per_element: int | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
     message and the simulated time where it happened, and everything recorded until then is
     written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
+    ``refine`` divides the mesh's element length and ``check_points_per_element`` overrides the
+    scenario's (``exucable converge``).
     """
     from .model.build import build_model
 
@@ -66,7 +146,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
                                         "plan several cables per duct with `exucable plan`")
     t_start = time.perf_counter()
-    model = build_model(sc)
+    model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element)
     build_s = time.perf_counter() - t_start
     progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
     snapshot_times = sc.output.times_s(sc.solver.end_time_s)
@@ -82,10 +162,16 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                              expected_drift_N_per_s=drift)
     i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
     refs = window_references(sc, model, h["time_s"][i0:])
+    # the uncertainty is of the mean about the drift the references explain (the cable's changing
+    # extent, evaluated at the window's mean time): remove that drift first
+    pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"],
+                                st.from_s if np.isfinite(st.from_s) else 0.0) if len(h["time_s"]) else None
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
-    cprof, peak_pressure = contact_profile(model)
+    points = check_point_loads(model)
+    cprof, peak_pressure = contact_profile(points)
     rope = model.rope
+    pressure_info, bends, pressure_prof = _pressure(model, points, rope)
     summary = {
         "name": sc.name,
         "status": out.status,
@@ -95,6 +181,14 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
         if len(h["time_s"]) else None,
         "reference_drift_N_per_s": drift,
+        "pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
+        "pull_force_drift_N_per_s": pf.drift_N_per_s + drift if pf else None,
+        "pull_force_unexplained_drift_N_per_s": pf.drift_N_per_s if pf else None,
+        "pull_force_uncertainty": ({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
+                                    "periods": pf.periods, "period_s": pf.period_s,
+                                    "window_s": list(pf.window_s),
+                                    "method": pf.method + (f"; after removing the references' expected drift "
+                                                           f"{drift:.4g} N/s" if drift else "")} if pf else None),
         "steady_quantity": steady_quantity(model),
         "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
@@ -116,11 +210,21 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
         "rope_clearance_pull_force_N": refs.get("rope_clearance_pull_force_N"),
         "reference_pulled_out_m": refs.get("pulled_out_m"),
+        **pressure_info,
+        "bends": bends,
+        "mesh": model.mesh.to_dict() if model.mesh is not None else None,
+        "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
         "scenario": sc.to_dict(),
         "versions": versions(),
     }
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
+    summary["status"], summary["flags"] = _assess(model, out, st, h, summary["pull_force_N"])
+    summary["trust_limits"] = {"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
+                               "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
+                               "outside": "cable axis farther from the conduit axis than its inner radius"}
+    if summary["flags"] and not summary["message"]:
+        summary["message"] = "; ".join(f["message"] for f in summary["flags"])
     if recorder is not None:
         summary["snapshots_s"] = recorder.recorded_s
         summary["snapshots_not_reached_s"] = list(recorder.pending)
@@ -136,7 +240,8 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         extras["x_m"] = rope.s_cable_m[order]
     result = RunResult(summary=summary, history=h, tension_profile={"x_m": x, "tension_N": N},
                        contact_profile=cprof, rope_profile=rope_profile, extras=extras,
-                       snapshots=recorder.tables() if recorder is not None else None)
+                       snapshots=recorder.tables() if recorder is not None else None,
+                       bends=bends, pressure_profile=pressure_prof)
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result

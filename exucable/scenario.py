@@ -20,6 +20,7 @@ says what is allowed and what was given.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import math
@@ -51,11 +52,6 @@ __all__ = [
 ]
 
 _DEFAULT_MIN_STEP_S = 1.0e-8
-#: Default mesh rule: each element turns at most this angle [rad] on the tightest bend
-#: (half the 0.5 rad that exucable.model.build.check_resolution allows) ...
-_DEFAULT_ELEMENT_TURN_RAD = 0.25
-#: ... and a cable has at least this many elements.
-_DEFAULT_MIN_ELEMENTS = 10
 
 _FIELD_BY_KEY: dict[str, Field] = {f.key: f for f in FIELDS}
 
@@ -207,8 +203,10 @@ class CableSpec(_Spec):
     youngs_modulus_Pa : float
         Young's modulus E [Pa].
     elements : int or None
-        Number of cable finite elements; None until a :class:`Scenario` applies the default
-        rule (:func:`default_elements`).
+        Number of cable finite elements; None until a :class:`Scenario` applies the mesh rule
+        (:func:`default_elements`, :mod:`exucable.mesh`) or ``element_length_m``.
+    element_length_m : float or None
+        Element length [m] asked for instead of the mesh rule; not with ``elements``.
     length_m : float or None
         Cable length [m]; None means the conduit's centreline length.
     damping_time_s : float
@@ -231,6 +229,7 @@ class CableSpec(_Spec):
     density_kg_per_m3: float | None = _default("cable.density")
     youngs_modulus_Pa: float = _default("cable.youngs_modulus")
     elements: int | None = _default("cable.elements")
+    element_length_m: float | None = _default("cable.element_length")
     length_m: float | None = _default("cable.length")
     damping_time_s: float = _default("cable.damping_time")
     integration: str = _default("cable.integration")
@@ -239,6 +238,9 @@ class CableSpec(_Spec):
     arrangement: str = _default("cable.arrangement")
 
     def _check(self) -> None:
+        if self.elements is not None and self.element_length_m is not None:
+            raise ScenarioError("cable.element_length", "give either elements or element_length, not both "
+                                "(or neither: the mesh rule then chooses, see scenarios/README.md)")
         if self.arrangement != "auto":
             _eng.check_arrangement(self.count, self.arrangement)
         if self.density_kg_per_m3 is None and self.mass_per_length_kg_per_m is None:
@@ -252,8 +254,11 @@ class CableSpec(_Spec):
 
     @property
     def _NOT_ECHOED(self) -> frozenset[str]:  # type: ignore[override]
-        # mass_per_length follows from density when that was given
-        return frozenset({"mass_per_length_kg_per_m"}) if self.density_kg_per_m3 is not None else frozenset()
+        # mass_per_length follows from density when that was given, elements from element_length
+        out = {"mass_per_length_kg_per_m"} if self.density_kg_per_m3 is not None else set()
+        if self.element_length_m is not None:
+            out.add("elements")
+        return frozenset(out)
 
     @property
     def area_m2(self) -> float:
@@ -394,8 +399,8 @@ class ContactSpec(_Spec):
         Decay velocity of the static-to-kinetic transition [m/s].
     friction_regularisation_velocity_m_per_s : float
         Sliding speed below which friction is regularised (linear in velocity) [m/s].
-    check_points_per_element : int
-        Contact check points per cable element.
+    check_points_per_element : int or None
+        Contact check points per cable element; None: the mesh rule's (:mod:`exucable.mesh`).
     check_point_rule : str
         ``"gauss"`` or ``"uniform"`` placement of check points along an element.
     reference_spacing_m : float
@@ -419,7 +424,7 @@ class ContactSpec(_Spec):
     static_friction: float | None = _default("contact.static_friction")
     stribeck_velocity_m_per_s: float = _default("contact.stribeck_velocity")
     friction_regularisation_velocity_m_per_s: float = _default("contact.friction_regularisation_velocity")
-    check_points_per_element: int = _default("contact.check_points_per_element")
+    check_points_per_element: int | None = _default("contact.check_points_per_element")
     check_point_rule: str = _default("contact.check_point_rule")
     reference_spacing_m: float = _default("contact.reference_spacing")
     broad_phase: str = _default("contact.broad_phase")
@@ -652,20 +657,26 @@ class DisplaySpec(_Spec):
     units: str = _default("display.units")
 
 
-def default_elements(cable_length_m: float, max_curvature_1_per_m: float) -> int:
-    """The default number of cable elements: max(10, ⌈L·κ_max / 0.25⌉).
-
-    Each element then turns at most 0.25 rad on the tightest bend, half of what
-    :func:`exucable.model.build.check_resolution` allows (the paper's Examples 2–4 use 0.07–0.25 rad).
+def default_elements(centreline, clearance_m: float, cable_length_m: float,
+                     element_length_m: float | None = None) -> int:
+    """The default number of cable elements: the mesh rule's (:func:`exucable.mesh.rule_element_length_m`:
+    chord sagitta ≤ 2 clearances and ≤ 0.2 rad per element on the tightest bend, at least 10), or
+    ⌈L / element_length⌉ when an element length is asked for.
 
     Parameters
     ----------
+    centreline : exucable.geometry.Centreline
+        The route's centreline.
+    clearance_m : float
+        Conduit inner radius − cable radius [m].
     cable_length_m : float
         Cable length L [m].
-    max_curvature_1_per_m : float
-        Largest curvature κ_max of the route's centreline [1/m] (0 for a straight route).
+    element_length_m : float, optional
+        ``cable.element_length`` [m].
     """
-    return max(_DEFAULT_MIN_ELEMENTS, math.ceil(cable_length_m * max_curvature_1_per_m / _DEFAULT_ELEMENT_TURN_RAD))
+    from .mesh import rule_element_length_m
+    h = element_length_m if element_length_m is not None else rule_element_length_m(centreline, clearance_m, cable_length_m)
+    return max(1, math.ceil(cable_length_m / h - 1e-9))
 
 
 @dataclass(frozen=True)
@@ -685,7 +696,7 @@ class Scenario:
     description : str
         Free text.
     cable, conduit, contact, pull : CableSpec, ConduitSpec, ContactSpec, PullSpec
-        ``cable.elements`` is filled in from :func:`default_elements` when not given.
+        ``cable.elements`` is filled in from :func:`default_elements` (the mesh rule) when not given.
     gravity : GravitySpec or None
         None: no gravity.
     solver : SolverSpec
@@ -768,9 +779,12 @@ class Scenario:
                 f"must be <= the conduit centreline length {conduit_length_m:.6g} m, got {self.cable.length_m!r}",
             )
         if self.cable.elements is None:
-            kappa = 1.0 / conduit.centreline.min_bend_radius_m
-            n = default_elements(self.cable_length_m, kappa)
-            cable = dataclasses.replace(self.cable, elements=n)
+            n = default_elements(conduit.centreline, self.conduit.inner_radius_m - self.cable.radius_m,
+                                 self.cable_length_m, self.cable.element_length_m)
+            # a copy, not dataclasses.replace: that would re-check, and elements next to a given
+            # element_length reads as both given
+            cable = copy.copy(self.cable)
+            object.__setattr__(cable, "elements", n)
             object.__setattr__(cable, "_derived", frozenset({"elements"}))
             object.__setattr__(self, "cable", cable)
 

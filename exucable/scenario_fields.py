@@ -150,9 +150,12 @@ FIELDS: tuple[Field, ...] = (
       ours=True, default_doc="E π r⁴/4",
       rule="> 0: EJ of a stranded or layered cable, apart from `youngs_modulus` (which still gives EA)"),
     F("cable.elements", "elements", "int", "", None, ge=1, derived=True,
-      default_doc="max(10, ⌈L·κ_max / 0.25⌉)",
-      rule="integer ≥ 1; default: each element turns at most 0.25 rad on the tightest bend "
-           "(L cable length, κ_max the route's largest curvature), at least 10"),
+      default_doc="the mesh rule",
+      rule="integer ≥ 1, an override of the mesh rule (below: chord sagitta ≤ 2 clearances and ≤ 0.2 rad "
+           "per element on the tightest bend, at least 10); not with `element_length`; refused when the "
+           "sagitta exceeds 16 clearances or an element turns more than 0.5 rad"),
+    F("cable.element_length", "element_length_m", "float", "m", None, gt=0.0, ours=True, default_doc="—",
+      rule="> 0: elements of about this length instead of the mesh rule's; not with `elements`"),
     F("cable.length", "length_m", "float", "m", None, gt=0.0, default_doc="conduit centreline length",
       rule="> 0 and ≤ the conduit centreline length"),
     F("cable.damping_time", "damping_time_s", "float", "s", _DAMPING_TIME_S, ge=0.0, ours=True,
@@ -198,8 +201,10 @@ FIELDS: tuple[Field, ...] = (
       rule="> 0"),
     F("contact.friction_regularisation_velocity", "friction_regularisation_velocity_m_per_s", "float", "m/s",
       1.0e-3, gt=0.0, ours=True, rule="> 0"),
-    F("contact.check_points_per_element", "check_points_per_element", "int", "", 20, ge=1,
-      rule="integer ≥ 1"),
+    F("contact.check_points_per_element", "check_points_per_element", "int", "", None, ge=1,
+      default_doc="the mesh rule",
+      rule="integer ≥ 1; default: spaced at most λ/4, λ = √(EJ/T_max) the bending length over which bend-end "
+           "loads concentrate, 8–200 per element (8 on routes without bends)"),
     F("contact.check_point_rule", "check_point_rule", "choice", "", "gauss", choices=("gauss", "uniform"),
       ours=True, rule="`\"gauss\"` or `\"uniform\"`"),
     F("contact.reference_spacing", "reference_spacing_m", "float", "m", 1.0e-3, gt=0.0, ours=True,

@@ -17,6 +17,7 @@ import numpy as np
 import exudyn as exu
 
 from .tension import detect_steady_state, tension_at, tension_profile
+from .trust import AxisGauge, cable_sample_points
 
 __all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "expected_drift_N_per_s",
            "Progress"]
@@ -30,6 +31,9 @@ class History:
     pull_force_N: list = field(default_factory=list)
     trailing_tension_N: list = field(default_factory=list)
     max_tension_N: list = field(default_factory=list)
+    max_penetration_m: list = field(default_factory=list)
+    max_axis_offset_m: list = field(default_factory=list)
+    max_axis_offset_s_conduit_m: list = field(default_factory=list)
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {k: np.asarray(v, dtype=float) for k, v in self.__dict__.items()}
@@ -116,8 +120,11 @@ def steady_quantity(model) -> str:
     return "trailing_tension_N" if model.applied_pull_force_N is not None else "pull_force_N"
 
 
-def record_state(model, t: float, history: History) -> None:
-    """Append the current pulling force, trailing tension and maximum tension to ``history``."""
+def record_state(model, t: float, history: History, gauge=None) -> None:
+    """Append the current pulling force, trailing tension and maximum tension to ``history``, and
+    (with a contact kernel) the largest penetration [m] and the cable axis's largest distance from
+    the conduit's axis [m] with its place s [m] along the scenario's conduit (``gauge``:
+    :class:`exucable.trust.AxisGauge` of the pull-oriented conduit)."""
     q, _ = model.coordinates()
     EA = model.axial_stiffness_N
     _, N = tension_profile(q, model.layout.element_length_m, EA, points_per_element=2)
@@ -128,6 +135,20 @@ def record_state(model, t: float, history: History) -> None:
     history.pull_force_N.append(model.pull_force_N(t))
     history.trailing_tension_N.append(float(trail))
     history.max_tension_N.append(float(np.max(N)))
+    pen = offset = s_off = float("nan")
+    if model.kernel is not None:
+        _, v = model.coordinates()
+        pen = float(model.kernel.evaluate(q.reshape(-1), v.reshape(-1)).max_penetration_m)
+        if gauge is not None:
+            d, s = gauge(cable_sample_points(q, model.layout.element_length_m))
+            # beyond the conduit's ends the cable is free (feed, pulling line): not the wall's business
+            d = np.where((s >= 0.0) & (s <= gauge.length_m), d, -np.inf)
+            i = int(np.argmax(d))
+            offset = float(d[i]) if np.isfinite(d[i]) else float("nan")
+            s_off = float(s[i]) if model.scenario.pull.direction != "reverse" else float(gauge.length_m - s[i])
+    history.max_penetration_m.append(pen)
+    history.max_axis_offset_m.append(offset)
+    history.max_axis_offset_s_conduit_m.append(s_off)
 
 
 def expected_drift_N_per_s(model) -> float:
@@ -151,6 +172,7 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     sp = model.scenario.solver
     steady_stop = sp.steady_stop if steady_stop is None else steady_stop
     history = History()
+    gauge = AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m) if model.kernel is not None else None
     out_dt = sp.output_interval_s
     next_out = [0.0]
     stopped_steady = [False]
@@ -162,7 +184,7 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
         if snapshots is not None:
             snapshots.step(t, model.pull_force_N(t))
         if t >= next_out[0] - 1e-12 * max(1.0, t):
-            record_state(model, t, history)
+            record_state(model, t, history, gauge)
             next_out[0] = (np.floor(t / out_dt + 1e-9) + 1.0) * out_dt
             if progress is not None:
                 progress.update(t, f"F = {history.pull_force_N[-1]:.4g} N")
@@ -191,7 +213,7 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     if stopped_steady[0] and status == "ok":
         status = "steady"
     if status != "failed" and (not history.time_s or history.time_s[-1] < t_end - 1e-12):
-        record_state(model, t_end, history)
+        record_state(model, t_end, history, gauge)
     if progress is not None:
         progress.update(t_end)
         progress.close()

@@ -27,7 +27,8 @@ def test_run_writes_the_documented_results(tmp_path):
     assert s["versions"]["exudyn"].startswith("1.13")
     assert s["scenario"]["contact"]["friction"] == 0.3          # echoed with defaults filled in
     assert list(read_csv(tmp_path / "history.csv")) == ["time_s", "pull_force_N", "trailing_tension_N",
-                                                         "max_tension_N"]
+                                                         "max_tension_N", "max_penetration_m", "max_axis_offset_m",
+                                                         "max_axis_offset_s_conduit_m"]
     assert list(read_csv(tmp_path / "tension_profile.csv")) == ["x_m", "tension_N"]
     contact = read_csv(tmp_path / "contact_profile.csv")
     assert list(contact) == ["s_conduit_m", "normal_force_per_length_N_per_m", "penetration_m"]

@@ -72,6 +72,9 @@ BAD = [
     # missing required keys and tables
     ("no-cable", with_(base(), ("cable",), _DELETE), "cable", "required"),
     ("no-radius", with_(base(), ("cable", "radius"), _DELETE), "cable.radius", "required"),
+    ("elements-and-length", with_(base(), ("cable", "element_length"), 0.1), "cable.element_length", "not both"),
+    ("element-length-zero", with_(with_(base(), ("cable", "elements"), _DELETE), ("cable", "element_length"), 0.0),
+     "cable.element_length", "> 0"),
     ("elements-float-zero", with_(base(), ("cable", "elements"), 0.0), "cable.elements", "integer"),
     ("no-speed", with_(base(), ("pull", "speed"), _DELETE), "pull.speed", "required"),
     ("no-end-time", with_(base(), ("solver", "end_time"), _DELETE), "solver.end_time", "required"),
@@ -256,7 +259,7 @@ def test_defaults_filled():
     assert c.static_friction is None
     assert c.stribeck_velocity_m_per_s == 0.01
     assert c.friction_regularisation_velocity_m_per_s == 1.0e-3
-    assert c.check_points_per_element == 20 and c.check_point_rule == "gauss"
+    assert c.check_points_per_element is None and c.check_point_rule == "gauss"   # None: the mesh rule
     assert c.reference_spacing_m == 1.0e-3 and c.broad_phase == "aabb"
     p = s.pull
     assert (p.direction, p.back_tension_N, p.force_N, p.ramp_time_s) == ("forward", 0.0, None, 0.0)
@@ -268,7 +271,7 @@ def test_defaults_filled():
     assert v.pretension is True
     # the echo carries every default under its TOML name
     d = s.to_dict()
-    assert d["contact"]["check_points_per_element"] == 20
+    assert "check_points_per_element" not in d["contact"]      # the mesh rule chooses (exucable.mesh)
     assert d["solver"]["output_interval"] == 1.0e-2
     assert d["conduit"]["max_segment_angle"] == 1.0
     assert d["cable"]["damping_time"] == 1.0e-3

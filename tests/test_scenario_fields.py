@@ -190,10 +190,16 @@ def test_default_elements_rule():
     del data["cable"]["elements"]
     sc = parse_scenario(data, Path("."))
     L = sc.cable_length_m
-    # tightest bend R = 0.5 m: 0.25 rad per element -> ceil(L * 2 / 0.25)
-    assert sc.cable.elements == default_elements(L, 2.0) == -(-int(L * 2 / 0.25 * 1e9) // int(1e9))
+    centre = sc.build_conduit().centreline
+    c = sc.conduit.inner_radius_m - sc.cable.radius_m
+    # the mesh rule (exucable.mesh): chord sagitta ≤ 2 clearances, ≤ 0.2 rad per element
+    R = centre.min_bend_radius_m
+    h = min((16 * R * c) ** 0.5, 0.2 * R, L / 10)
+    assert sc.cable.elements == default_elements(centre, c, L) == -(-int(L / h * 1e9) // int(1e9))
     assert "elements" in sc.cable.derived_keys
-    assert default_elements(50.0, 0.0) == 10
+    assert default_elements(centre, c, L, element_length_m=L / 7) == 7
+    with_length = dict(data, cable=dict(data["cable"], element_length=L / 12))
+    assert parse_scenario(with_length, Path(".")).cable.elements == 12
     # a longer cable gets more elements when replaced
     data["conduit"]["path"][0]["straight"] = 3.0
     assert sc.replace(**{"conduit.path[0].straight": 3.0}).cable.elements > sc.cable.elements

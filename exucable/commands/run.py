@@ -9,6 +9,7 @@ import numpy as np
 
 from ..run import run_scenario
 from ..scenario import load_scenario
+from ..trust import TRUSTED_STATUSES
 
 __all__ = ["add_arguments", "main"]
 
@@ -35,7 +36,8 @@ def main(args) -> int:
     s = res.summary
     rope = s.get("rope_pull_force_N")
     print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
-          f"(± {_f(s['pull_force_std_N'], '.2g')}), trailing tension {_f(s['trailing_tension_N'])} N, "
+          f"(± {_f(s['pull_force_uncertainty_N'], '.2g')} N, sd {_f(s['pull_force_std_N'], '.2g')} N, "
+          f"drift {_f(s['pull_force_drift_N_per_s'], '.2g')} N/s), trailing tension {_f(s['trailing_tension_N'])} N, "
           f"max tension {_f(s['max_tension_N'])} N")
     if s["steady_quantity"] == "trailing_tension_N":     # force-controlled: T2 is the result
         ref, got, what = s.get("rope_trailing_tension_N"), s["trailing_tension_N"], "trailing tension"
@@ -49,8 +51,19 @@ def main(args) -> int:
     print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
           f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
+    m = s.get("mesh") or {}
+    if m:
+        print(f"  mesh: {m['elements']} elements of {m['element_length_m']:.4g} m ({m['source']}; rule "
+              f"{m['rule_element_length_m']:.4g} m), {m['check_points_per_element']} check points per element")
+    for w in s.get("warnings", []):
+        print(f"  warning: {w}", file=sys.stderr)
     if s["status"] == "failed":
         print(f"  FAILED: {s['message']} (at t = {_f(s.get('failed_at_s'))} s); "
               f"the results recorded until then are in {out_dir}/", file=sys.stderr)
+        return 1
+    if s["status"] not in TRUSTED_STATUSES:
+        for f in s["flags"]:
+            print(f"  NOT TRUSTED ({f['flag']}): {f['message']}", file=sys.stderr)
+        print(f"  status {s['status']}: do not use this result; what was computed is in {out_dir}/", file=sys.stderr)
         return 1
     return 0

@@ -13,6 +13,7 @@ import numpy as np
 import exudyn as exu
 
 from ..errors import ModelError
+from ..mesh import MeshPlan, plan_mesh
 from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
 from ..references import reference_drift_N_per_s
 from ..rope_clearance import solve_rope_with_clearance
@@ -26,7 +27,7 @@ if TYPE_CHECKING:  # for the annotations only
     from ..scenario import Scenario
     from .coupling import ContactCoupling
 
-__all__ = ["Model", "build_model", "pull_oriented_conduit"]
+__all__ = ["Model", "build_model", "pull_oriented_conduit", "plan_cable_mesh"]
 
 
 @dataclass(eq=False)
@@ -45,6 +46,7 @@ class Model:
     applied_pull_force_N: float | None   # force-controlled pull
     back_tension_N: float
     rope: RopeSolution | None
+    mesh: MeshPlan | None = None
     coupling: ContactCoupling | None = None
     kernel: ContactKernel | None = None
     ode2_index: np.ndarray = field(default=None)
@@ -106,28 +108,29 @@ def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: f
         return None
 
 
-def check_resolution(scenario, conduit) -> None:
-    """Refuse meshes too coarse for the conduit: along the tightest bend (curvature κ) each
-    element may turn at most 0.5 rad. A cubic element spanning an arc of angle φ departs from it
-    by about Rφ⁴/100 (0.3 mm at R = 0.5 m, φ = 0.5 rad: a third of the paper's 1 mm clearance), and
-    the coarse Example 3 (0.31 rad per element) is already 0.3-0.6 % off its capstan value."""
-    kappa = 1.0 / conduit.centreline.min_bend_radius_m
-    L_e = scenario.cable_length_m / scenario.cable.elements
-    if kappa > 0 and L_e * kappa > 0.5:
-        n_needed = int(np.ceil(scenario.cable_length_m * kappa / 0.5))
-        raise ModelError(
-            "cable.elements",
-            f"elements of {L_e:.4g} m cannot follow the tightest bend (radius {1/kappa:.4g} m): "
-            f"each element would turn {np.degrees(L_e * kappa):.1f} deg (at most 28.6 deg = 0.5 rad allowed); "
-            f"use at least {n_needed} elements")
+def plan_cable_mesh(scenario, conduit, rope: RopeSolution, refine: float = 1.0,
+                    check_points_per_element: int | None = None) -> MeshPlan:
+    """The scenario's cable mesh by the rule of :mod:`exucable.mesh` (or its override, checked).
+
+    ``refine`` divides the element length (``exucable converge``); ``check_points_per_element``
+    overrides the scenario's ``contact.check_points_per_element``."""
+    c = scenario.cable
+    k = check_points_per_element if check_points_per_element is not None else scenario.contact.check_points_per_element
+    return plan_mesh(conduit.centreline, conduit.inner_radius_m - c.radius_m, scenario.cable_length_m,
+                     c.bending_stiffness_N_m2, float(np.max(rope.tension_N)) if rope is not None else 0.0,
+                     elements=None if "elements" in c.derived_keys else c.elements,
+                     element_length_m=c.element_length_m,
+                     check_points_per_element=k, refine=refine)
 
 
-def build_model(scenario, with_contact: bool = True) -> Model:
+def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
+                check_points_per_element: int | None = None) -> Model:
     """Build the Exudyn system of ``scenario`` (a :class:`exucable.scenario.Scenario`).
 
     The start follows :mod:`exucable.model.layout`: pre-stretched to the rope tension, on its
     bearing wall, moving at the pull speed (unless ``solver.pretension`` is false: then on the
-    centreline, unloaded, at rest, with loads and speed ramped over ``pull.ramp_time``).
+    centreline, unloaded, at rest, with loads and speed ramped over ``pull.ramp_time``). The mesh
+    is :func:`plan_cable_mesh`'s, refined by ``refine``.
     """
     sc = scenario
     conduit = pull_oriented_conduit(sc)
@@ -136,10 +139,12 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     if L_cable > centre.length_m * (1 + 1e-12):
         raise ModelError("cable.length", f"cable of {L_cable:.6g} m is longer than the conduit "
                          f"({centre.length_m:.6g} m); shorten it or extend the route")
-    check_resolution(sc, conduit)
     c = sc.cable
     g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
     w = c.mass_per_length_kg_per_m * g
+    rope = _rope_start(sc, centre, w)
+    mesh = plan_cable_mesh(sc, conduit, rope, refine, check_points_per_element)
+    n_el = mesh.elements
     props = CableProperties(
         mass_per_length_kg_per_m=c.mass_per_length_kg_per_m,
         axial_stiffness_N=c.axial_stiffness_N,
@@ -150,11 +155,10 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     )
     clearance = conduit.inner_radius_m - c.radius_m
     speed = sc.pull.speed_m_per_s
-    rope = _rope_start(sc, centre, w)
     if sc.solver.pretension:
-        s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * sc.cable.elements + 1))
+        s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * n_el + 1))
         T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
-        L_e = L_cable / c.elements
+        L_e = L_cable / n_el
         # blend over the length on which a tensioned beam leaves the wall, √(EJ/T), but at least
         # half an element so the nodes can follow it
         T_ref = max(float(np.max(rope.tension_N)), 1e-6)
@@ -179,10 +183,10 @@ def build_model(scenario, with_contact: bool = True) -> Model:
         def offset_fn(s):
             return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
 
-        layout = lay_cable(centre, L_cable, c.elements, c.axial_stiffness_N, speed, tension_fn, offset_fn,
+        layout = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, speed, tension_fn, offset_fn,
                            clearance_m=clearance if with_contact else None)
     else:
-        layout = lay_cable(centre, L_cable, c.elements, c.axial_stiffness_N, 0.0)
+        layout = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, 0.0)
 
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
@@ -212,6 +216,7 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     model = Model(scenario=sc, system_container=SC, mbs=mbs, conduit=conduit, cable=cable, layout=layout,
                   properties=props, lead_drive=lead_drive, trail_drive=trail_drive,
                   applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope,
+                  mesh=mesh,
                   reference_drift_N_per_s=reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s))
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
@@ -222,7 +227,7 @@ def build_model(scenario, with_contact: bool = True) -> Model:
                          regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s,
                          damping_onset_m=ct.damping_onset_m)
         kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
-                               ct.check_points_per_element, rule=ct.check_point_rule,
+                               mesh.check_points_per_element, rule=ct.check_point_rule,
                                reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
                                surface=ct.surface, centreline=centre)
         model.kernel = kernel
@@ -236,7 +241,7 @@ def build_model(scenario, with_contact: bool = True) -> Model:
         if applied is not None:
             # the sheave of a force-controlled pull: lateral stiffness of the contact law's order at
             # its working point (1e6 N/m), damped near-critically for the end node's mass
-            guide = Guide(len(cable.nodes) - 1, t_exit, 1.0e6, 2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / c.elements))
+            guide = Guide(len(cable.nodes) - 1, t_exit, 1.0e6, 2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / n_el))
         model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel, damper, guide)
     mbs.Assemble()
     model.ode2_index = np.concatenate([

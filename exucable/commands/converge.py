@@ -1,0 +1,128 @@
+"""``exucable converge SCENARIO [--levels N] [--ratio R] [--out DIR]``: the scenario's result on
+N ≥ 3 meshes, each refined by R in element length (and in check-point spacing: the check points
+per element stay those of the first level), with the observed order and an extrapolated value
+with its error estimate (:mod:`exucable.convergence`).
+
+Writes ``DIR/level_K/`` (each a complete result directory), then ``DIR/converge.csv`` (one row
+per level) and ``DIR/converge.json`` (the table, the extrapolation and how it was made), each
+atomically. Exits 1 when a level's result is not trusted (its status names why) or failed.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..convergence import extrapolate
+from ..io import write_csv, write_json
+from ..run import run_scenario
+from ..scenario import load_scenario
+from ..trust import TRUSTED_STATUSES
+
+__all__ = ["add_arguments", "main", "converge", "CONVERGE_COLUMNS"]
+
+CONVERGE_COLUMNS = ("level", "refine", "elements", "element_length_m", "check_points_per_element", "value_N",
+                    "uncertainty_N", "drift_N_per_s", "wall_time_s")
+
+
+def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool = True, progress=None) -> dict:
+    """Run ``scenario`` on ``levels`` meshes refined by ``ratio``; returns the report (also written).
+
+    The quantity is the run's steady quantity: the pulling force, or for a force-controlled pull
+    the trailing tension [N]. ``progress(level, summary)`` is called after each level.
+    """
+    if levels < 3:
+        raise ValueError("converge: at least 3 levels are needed for an observed order")
+    sc = scenario if not isinstance(scenario, (str, Path)) else load_scenario(scenario)
+    out = Path(out_dir)
+    rows, statuses = [], []
+    k0 = None
+    for level in range(levels):
+        refine = ratio**level
+        res = run_scenario(sc, out / f"level_{level}", quiet=quiet, plots=False, refine=refine,
+                           check_points_per_element=k0)
+        s = res.summary
+        mesh = s["mesh"]
+        k0 = mesh["check_points_per_element"] if k0 is None else k0
+        q = s["steady_quantity"]
+        rows.append({"level": level, "refine": refine, "elements": mesh["elements"],
+                     "element_length_m": mesh["element_length_m"],
+                     "check_points_per_element": mesh["check_points_per_element"],
+                     "value_N": s[q] if s[q] is not None else float("nan"),
+                     "uncertainty_N": s["pull_force_uncertainty_N"] if q == "pull_force_N" else s.get("pull_force_std_N"),
+                     "drift_N_per_s": s["pull_force_drift_N_per_s"], "wall_time_s": s["wall_time_s"],
+                     "status": s["status"],
+                     "bends": [{k: b[k] for k in ("bend", "mean_pressure_vs_rope", "entry_point_load_N",
+                                                  "exit_point_load_N")} for b in s.get("bends", [])]})
+        statuses.append(s["status"])
+        if progress is not None:
+            progress(level, s)
+    report = {"name": sc.name, "quantity": q, "ratio": ratio, "levels": rows,
+              "trusted": all(st in TRUSTED_STATUSES for st in statuses)}
+    values = [r["value_N"] for r in rows]
+    try:
+        ex = extrapolate(values, ratio, [r["uncertainty_N"] for r in rows])
+        report.update(extrapolated_N=ex.value, error_N=ex.error, observed_order=ex.order, method=ex.method,
+                      finest_vs_extrapolated=(values[-1] / ex.value - 1.0) if ex.value else None,
+                      default_vs_extrapolated=(values[0] / ex.value - 1.0) if ex.value else None)
+    except ValueError as exc:
+        report.update(extrapolated_N=None, error_N=None, observed_order=None, method=str(exc))
+    write_csv(out / "converge.csv", CONVERGE_COLUMNS, {c: [r[c] if r[c] is not None else np.nan for r in rows]
+                                                       for c in CONVERGE_COLUMNS})
+    write_json(out / "converge.json", report)
+    return report
+
+
+def add_arguments(p) -> None:
+    p.add_argument("scenario", help="scenario file (TOML)")
+    p.add_argument("--levels", type=int, default=3, help="number of meshes, at least 3 (default 3)")
+    p.add_argument("--ratio", type=float, default=2.0, help="refinement ratio of the element length (default 2)")
+    p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>-converge)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bars")
+
+
+def _f(v, fmt=".6g"):
+    return "n/a" if v is None or not np.isfinite(v) else format(v, fmt)
+
+
+def main(args) -> int:
+    sc = load_scenario(args.scenario)
+    if args.levels < 3:
+        print("exucable converge: error: --levels: at least 3 (an observed order needs three meshes)", file=sys.stderr)
+        return 2
+    if not args.ratio > 1.0:
+        print(f"exucable converge: error: --ratio: must be > 1, got {args.ratio}", file=sys.stderr)
+        return 2
+    out = Path(args.out) if args.out else Path("out") / f"{sc.name}-converge"
+
+    def progress(level, s):
+        m = s["mesh"]
+        print(f"  level {level}: {m['elements']} elements × {m['check_points_per_element']} check points: "
+              f"{s['steady_quantity']} {_f(s[s['steady_quantity']])} N, status {s['status']}, "
+              f"wall {s['wall_time_s']:.1f} s", flush=True)
+
+    print(f"{sc.name}: {args.levels} levels, element length refined by {args.ratio:g} per level", flush=True)
+    rep = converge(sc, out, args.levels, args.ratio, quiet=args.quiet, progress=progress)
+    print(f"\n{'level':>5} {'elements':>8} {'h [m]':>9} {'points/el':>9} {rep['quantity']:>22} {'± [N]':>9} {'status':>10}")
+    for r in rep["levels"]:
+        print(f"{r['level']:>5} {r['elements']:>8} {r['element_length_m']:>9.4g} {r['check_points_per_element']:>9} "
+              f"{_f(r['value_N'], '.8g'):>22} {_f(r['uncertainty_N'], '.2g'):>9} {r['status']:>10}")
+    for i, b in enumerate(rep["levels"][0]["bends"]):
+        cells = [(r["bends"][i]["mean_pressure_vs_rope"], r["bends"][i]["entry_point_load_N"],
+                  r["bends"][i]["exit_point_load_N"]) for r in rep["levels"]]
+        print(f"bend {b['bend']}: windowed pressure in the body vs the rope's T/R "
+              + " / ".join(f"{100 * c[0]:+.2f} %" for c in cells) + "; point loads entry "
+              + " / ".join(f"{c[1]:.3g}" for c in cells) + " N, exit " + " / ".join(f"{c[2]:.3g}" for c in cells)
+              + " N (levels 0 …)")
+    print(f"extrapolated: {_f(rep['extrapolated_N'], '.8g')} ± {_f(rep['error_N'], '.2g')} N "
+          f"(observed order {_f(rep['observed_order'], '.3g')}; {rep['method']})")
+    if rep.get("default_vs_extrapolated") is not None:
+        print(f"level 0 (the default mesh) differs from it by {100 * rep['default_vs_extrapolated']:+.3f} %")
+    print(f"results in {out}/ (converge.csv, converge.json, level_K/)")
+    if not rep["trusted"]:
+        print("exucable converge: a level's result is not trusted (see its status above and its summary.json)",
+              file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,153 @@
+"""Sidewall bearing pressure an engineer can use: windowed along the route, point loads at bend
+ends, and a per-bend table beside the rope's (issue #10 item 5).
+
+The contact check points carry forces [N] at their places s along the conduit. Their force per
+element share (``contact_profile.csv``) is a row of spikes when elements touch a bend near their
+nodes, and its maximum grows under refinement where bending stiffness concentrates the load at a
+bend's ends. Engineering quantities that converge are
+
+* the **windowed pressure** p̄(s) = (sum of the normal forces of the check points within
+  s ± w/2) / w [N/m], with a window w stated in the summary (``pressure_window_m``), by default
+  half the tightest bend radius (at least a few elements of the mesh rule, so the spikes average
+  out, and short enough to follow T/R along a bend); the rope's pressure (T/R and the weight)
+  is windowed the same way for comparison;
+* the **point load** at each bend end: the contact force within ±w/2 of the end beyond the rope's
+  over the same stretch [N] — the concentrated load of a stiff cable turning into a bend
+  (Iordanescu & Tamowski's PULLFLEX adds it to the rope), reported with its place.
+
+The *body* of a bend is the bend less w/2 + 3 λ at each end (λ = √(EJ/T), the bending length,
+over which the end loads decay); its mean windowed pressure is the number to set against T/R.
+Pure numpy; no Exudyn.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["BEND_COLUMNS", "PRESSURE_COLUMNS", "default_window_m", "windowed_load", "bend_table",
+           "pressure_profile"]
+
+BEND_COLUMNS = ("bend", "s_conduit_start_m", "s_conduit_end_m", "radius_m", "angle_deg", "tension_in_N", "tension_out_N",
+                "rope_tension_in_N", "rope_tension_out_N", "mean_pressure_N_per_m", "peak_pressure_N_per_m",
+                "rope_mean_pressure_N_per_m", "rope_peak_pressure_N_per_m", "mean_pressure_vs_rope",
+                "entry_point_load_N", "entry_s_conduit_m", "exit_point_load_N", "exit_s_conduit_m")
+PRESSURE_COLUMNS = ("s_conduit_m", "windowed_pressure_N_per_m", "rope_windowed_pressure_N_per_m")
+
+
+def default_window_m(centreline) -> float:
+    """w = half the tightest bend radius [m]; on a route without bends, a twentieth of its length."""
+    radii = [p.radius_of_curvature_m for p in centreline.pieces if p.is_curved]
+    return 0.5 * min(radii) if radii else centreline.length_m / 20.0
+
+
+def _cumulative_points(s_m, force_N):
+    order = np.argsort(s_m)
+    s = np.asarray(s_m, dtype=float)[order]
+    c = np.concatenate([[0.0], np.cumsum(np.asarray(force_N, dtype=float)[order])])
+    return s, c
+
+
+def _load_between(s_sorted, cum, a, b):
+    """Sum of the point forces with a < s ≤ b [N] (arrays a, b)."""
+    return cum[np.searchsorted(s_sorted, b, side="right")] - cum[np.searchsorted(s_sorted, a, side="right")]
+
+
+def _rope_cumulative(rope_s_m, rope_pressure_N_per_m):
+    order = np.argsort(rope_s_m)
+    s = np.asarray(rope_s_m, dtype=float)[order]
+    p = np.asarray(rope_pressure_N_per_m, dtype=float)[order]
+    c = np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(s))])
+    return s, c
+
+
+def _rope_between(s, c, a, b):
+    return np.interp(b, s, c) - np.interp(a, s, c)
+
+
+def windowed_load(s_m, force_N, window_m: float, at_m) -> np.ndarray:
+    """p̄(s) = (sum of point forces within s ± w/2) / w [N/m] at ``at_m``."""
+    s, c = _cumulative_points(s_m, force_N)
+    at = np.asarray(at_m, dtype=float)
+    return _load_between(s, c, at - window_m / 2, at + window_m / 2) / window_m
+
+
+def pressure_profile(s_m, force_N, rope_s_m, rope_pressure_N_per_m, window_m: float, length_m: float) -> dict:
+    """Windowed pressure of the cable and of the rope on a grid of w/10 along [0, L] [N/m]."""
+    grid = np.linspace(0.0, length_m, max(21, int(np.ceil(10 * length_m / window_m)) + 1))
+    rs, rc = _rope_cumulative(rope_s_m, rope_pressure_N_per_m)
+    lo, hi = np.clip(grid - window_m / 2, 0.0, length_m), np.clip(grid + window_m / 2, 0.0, length_m)
+    return {"s_conduit_m": grid, "windowed_pressure_N_per_m": windowed_load(s_m, force_N, window_m, grid),
+            "rope_windowed_pressure_N_per_m": _rope_between(rs, rc, lo, hi) / window_m}
+
+
+@dataclass(frozen=True)
+class _Piece:
+    s0: float
+    s1: float
+    radius: float
+    angle_deg: float
+
+
+def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_tension_N,
+               rope_pressure_N_per_m, window_m: float, bending_length_m: float,
+               direction: str = "forward") -> list[dict]:
+    """One row per bend/helix of the route (columns :data:`BEND_COLUMNS`).
+
+    Parameters
+    ----------
+    pieces : sequence
+        The scenario's centreline pieces (``is_curved``, ``s_start_m``, ``s_end_m``,
+        ``radius_of_curvature_m``, ``turning_angle_rad``).
+    s_m, force_N : array_like
+        Check points' places along the scenario's conduit [m] and normal forces [N].
+    cable_s_m, cable_tension_N : array_like
+        The cable's tension [N] at places along the conduit [m].
+    rope_s_m, rope_tension_N, rope_pressure_N_per_m : array_like
+        The rope reference along the conduit.
+    window_m : float
+        w [m].
+    bending_length_m : float
+        λ = √(EJ/T) [m].
+    direction : str
+        ``"forward"``: the cable enters a bend at its start; ``"reverse"``: at its end.
+    """
+    s_pts, cum = _cumulative_points(s_m, force_N)
+    rs, rc = _rope_cumulative(rope_s_m, rope_pressure_N_per_m)
+    ro = np.argsort(rope_s_m)
+    rope_T = (np.asarray(rope_s_m, dtype=float)[ro], np.asarray(rope_tension_N, dtype=float)[ro])
+    co = np.argsort(cable_s_m)
+    cab_T = (np.asarray(cable_s_m, dtype=float)[co], np.asarray(cable_tension_N, dtype=float)[co])
+    a = window_m / 2
+    rows = []
+    bends = [_Piece(p.s_start_m, p.s_end_m, p.radius_of_curvature_m, float(np.degrees(p.turning_angle_rad)))
+             for p in pieces if p.is_curved]
+    for k, b in enumerate(bends, start=1):
+        grid = np.linspace(b.s0 - a, b.s1 + a, 201)
+        p_w = windowed_load(s_m, force_N, window_m, grid)
+        r_w = _rope_between(rs, rc, grid - a, grid + a) / window_m
+        margin = a + 3.0 * bending_length_m
+        body = (grid >= b.s0 + margin) & (grid <= b.s1 - margin)
+        mean = float(np.mean(p_w[body])) if body.any() else float("nan")
+        rope_mean = float(np.mean(r_w[body])) if body.any() else float("nan")
+        ends = {}
+        for name, s_end in (("start", b.s0), ("end", b.s1)):
+            F = float(_load_between(s_pts, cum, np.array([s_end - a]), np.array([s_end + a]))[0])
+            R = float(_rope_between(rs, rc, s_end - a, s_end + a))
+            ends[name] = (F - R, s_end)
+        t_start = (float(np.interp(b.s0, *cab_T)), float(np.interp(b.s1, *cab_T)))
+        r_start = (float(np.interp(b.s0, *rope_T)), float(np.interp(b.s1, *rope_T)))
+        entry, exit_ = ("start", "end") if direction == "forward" else ("end", "start")
+        flip = (lambda x: x) if direction == "forward" else (lambda x: x[::-1])
+        rows.append({
+            "bend": k, "s_conduit_start_m": b.s0, "s_conduit_end_m": b.s1, "radius_m": b.radius, "angle_deg": b.angle_deg,
+            "tension_in_N": flip(t_start)[0], "tension_out_N": flip(t_start)[1],
+            "rope_tension_in_N": flip(r_start)[0], "rope_tension_out_N": flip(r_start)[1],
+            "mean_pressure_N_per_m": mean, "peak_pressure_N_per_m": float(np.max(p_w)),
+            "rope_mean_pressure_N_per_m": rope_mean, "rope_peak_pressure_N_per_m": float(np.max(r_w)),
+            "mean_pressure_vs_rope": mean / rope_mean - 1.0 if rope_mean > 0 else float("nan"),
+            "entry_point_load_N": ends[entry][0], "entry_s_conduit_m": ends[entry][1],
+            "exit_point_load_N": ends[exit_][0], "exit_s_conduit_m": ends[exit_][1],
+        })
+    return rows
