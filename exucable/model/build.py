@@ -15,12 +15,12 @@ from ..errors import ModelError
 from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, contact_offsets, lay_cable
-from .rig import Drive, Guide, add_drive, add_end_force, add_tangential_drive, smooth_ramp
+from .rig import Drive, add_drive, add_guide, add_end_force, add_tangential_drive, smooth_ramp
 
 __all__ = ["Model", "build_model", "pull_oriented_conduit"]
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, repr=False)
 class Model:
     """An assembled Exudyn system of one scenario and the handles post-processing needs."""
 
@@ -39,6 +39,10 @@ class Model:
     coupling: object | None = None
     kernel: object | None = None
     ode2_index: np.ndarray = field(default=None)
+
+    def __repr__(self) -> str:
+        return (f"Model({self.scenario.name!r}: {len(self.cable.elements)} cable elements, "
+                f"{'with' if self.coupling is not None else 'without'} contact)")
 
     @property
     def axial_stiffness_N(self) -> float:
@@ -181,7 +185,8 @@ def build_model(scenario, with_contact: bool = True) -> Model:
                   applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope)
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
-        from .coupling import ContactCoupling, StartupDamper
+        from .coupling import ContactCoupling
+        from .startup import StartupDamper, add_startup_damper
         ct = sc.contact
         law = ContactLaw(stiffness=ct.stiffness, damping=ct.damping, exponent=ct.exponent, friction=ct.friction,
                          static_friction=ct.static_friction, stribeck_velocity_m_per_s=ct.stribeck_velocity_m_per_s,
@@ -192,18 +197,18 @@ def build_model(scenario, with_contact: bool = True) -> Model:
                                reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
                                surface=ct.surface, centreline=centre)
         model.kernel = kernel
-        damper = None
+        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel)
         sp = sc.solver
         if sp.pretension and sp.startup_time_s > 0.0:
             Le = layout.element_length_m
             lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
-            damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
-        guide = None
+            add_startup_damper(mbs, cable.nodes, StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s,
+                                                               sp.startup_time_s))
         if applied is not None:
             # the sheave of a force-controlled pull: lateral stiffness of the contact law's order at
             # its working point (1e6 N/m), damped near-critically for the end node's mass
-            guide = Guide(len(cable.nodes) - 1, t_exit, 1.0e6, 2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / c.elements))
-        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel, damper, guide)
+            add_guide(mbs, cable.nodes[-1], t_exit, 1.0e6,
+                      2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / c.elements))
     mbs.Assemble()
     model.ode2_index = np.concatenate([
         np.arange(mbs.GetNodeODE2Index(n), mbs.GetNodeODE2Index(n) + 6) for n in cable.nodes])

@@ -15,10 +15,10 @@ from typing import Callable
 import numpy as np
 import exudyn as exu
 from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, MarkerNodeCoordinate,
-                                  MarkerNodeCoordinates, MarkerNodePosition, NodePointGround,
+                                  MarkerNodeCoordinates, MarkerNodePosition, NodePointGround, ObjectGenericODE2,
                                   ObjectConnectorCoordinateVector)
 
-__all__ = ["Drive", "Guide", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
+__all__ = ["Drive", "add_guide", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
            "smooth_ramp", "ramped_displacement"]
 
 
@@ -90,28 +90,30 @@ def add_end_force(mbs, node: int, force_vector_N, factor: Callable[[float], floa
 
 
 
-class Guide:
-    """A sheave on the exit tangent for a force-controlled pull: node ``node`` is held near the
-    line through its start position along unit ``direction`` by a stiff lateral spring-damper
+def add_guide(mbs, node: int, direction, stiffness_N_per_m: float, damping_N_s_per_m: float) -> int:
+    """A sheave on the exit tangent for a force-controlled pull: ``node`` is held near the line
+    through its start position along unit ``direction`` d by a stiff lateral spring-damper
     (force −k·P·u − c·P·v with P = I − d dᵀ, u its displacement), free to move along it.
 
-    Applied through the contact coupling's user function (Exudyn 1.13's
-    ObjectConnectorCoordinateVector enforced only the first of two such rows in our tests)."""
-
-    def __init__(self, node_index: int, direction, stiffness_N_per_m: float, damping_N_s_per_m: float):
-        d = np.asarray(direction, dtype=float)
-        d = d / np.linalg.norm(d)
-        self.node_index = int(node_index)      # index of the node within the cable (0 = trailing)
-        self.P = np.eye(3) - np.outer(d, d)
-        self.k = float(stiffness_N_per_m)
-        self.c = float(damping_N_s_per_m)
-
-    def force(self, q_disp, v) -> np.ndarray:
-        """Generalized force on the cable coordinates (displacements ``q_disp`` from the start)."""
-        Q = np.zeros_like(v)
-        i = 6 * self.node_index
-        Q[i:i + 3] = -self.P @ (self.k * q_disp[i:i + 3] + self.c * v[i:i + 3])
-        return Q
+    A mass-free ``ObjectGenericODE2`` on the node with constant stiffness k·P and damping c·P
+    (Exudyn 1.13's ObjectConnectorCoordinateVector enforced only the first of two such rows in
+    our tests). Returns its object index.
+    """
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    P = np.eye(3) - np.outer(d, d)
+    K = np.zeros((6, 6))
+    D = np.zeros((6, 6))
+    K[:3, :3] = float(stiffness_N_per_m) * P
+    D[:3, :3] = float(damping_N_s_per_m) * P
+    M, Kc, Dc = (exu.MatrixContainer() for _ in range(3))
+    M.Initialize(6, 6, False)
+    Kc.SetWithDenseMatrix(K, False)
+    Dc.SetWithDenseMatrix(D, False)
+    return mbs.AddObject(ObjectGenericODE2(
+        nodeNumbers=[node], massMatrix=M, stiffnessMatrix=Kc, dampingMatrix=Dc,
+        visualization={"show": False, "color": [-1.0, -1.0, -1.0, -1.0], "triangleMesh": [],
+                       "showNodes": False, "graphicsDataUserFunction": 0}))
 
 
 @dataclass(frozen=True)
