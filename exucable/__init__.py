@@ -2,6 +2,28 @@
 
 After Yang, Hong, Ren & Zhao, "Cable installation simulation by using a multibody
 dynamic model", Multibody Syst Dyn 30 (2013) 433-447. SI units throughout.
+
+The Python API (see ``examples/``)::
+
+    import exucable as xc
+    route = xc.Route(inner_radius=3.5e-3).straight(1.0).bend(90, radius=0.5, turn="left").straight(1.0)
+    sc = xc.Scenario(route=route, cable=xc.Cable(radius=2.5e-3, density=1000.0, youngs_modulus=1e9),
+                     contact=xc.Contact(friction=0.2), pull=xc.Pull(speed=0.1, back_tension=150.0),
+                     solver=xc.Solver(end_time=0.5))
+    res = xc.run(sc)
+
+Importing exucable imports neither Exudyn nor matplotlib and changes no global state.
 """
 
 __version__ = "0.1.0"
+
+from .api import Cable, Contact, Gravity, History, Pull, Result, Route, Solver, TensionProfile, run, sweep
+from .errors import ExucableError, GeometryError, ModelError, ScenarioError, SolverError
+from .scenario import Scenario, load_scenario
+
+__all__ = [
+    "__version__",
+    "Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Scenario", "load_scenario",
+    "run", "sweep", "Result", "History", "TensionProfile",
+    "ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError",
+]

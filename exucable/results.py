@@ -107,6 +107,7 @@ class RunResult:
     contact_profile: dict | None = None
     rope_profile: dict | None = None
     extras: dict = field(default_factory=dict)
+    model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
 
 
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:

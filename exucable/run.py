@@ -111,7 +111,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                         "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m}
         extras["s_cable_m"] = rope.s_cable_m
     result = RunResult(summary=summary, history=h, tension_profile={"s_m": x, "tension_N": N},
-                       contact_profile=cprof, rope_profile=rope_profile, extras=extras)
+                       contact_profile=cprof, rope_profile=rope_profile, extras=extras, model=model)
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result
