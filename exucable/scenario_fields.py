@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "markdown_table", "format_default",
+__all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "default_of", "markdown_table", "format_default",
            "readme_with_tables"]
 
 
@@ -244,6 +244,17 @@ FIELDS: tuple[Field, ...] = (
       rule="start from the rope solution's tension profile near contact equilibrium"),
 )
 del F
+
+
+def default_of(key: str):
+    """The default of ``key`` (e.g. ``"contact.damping_onset"``), so that building blocks below
+    the scenario layer default to the validated values."""
+    for f in FIELDS:
+        if f.key == key:
+            if f.default is REQUIRED:
+                raise KeyError(f"{key} has no default")
+            return f.default
+    raise KeyError(key)
 
 
 def fields_of(section: str) -> tuple[Field, ...]:
