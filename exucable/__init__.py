@@ -17,13 +17,28 @@ Importing exucable imports neither Exudyn nor matplotlib and changes no global s
 
 __version__ = "0.1.0"
 
+# The submodule exucable.run first: importing it after the function below would rebind the
+# package attribute "run" to the module (Python sets it when a submodule is first loaded).
+from . import run as _run_module  # noqa: F401
 from .api import Cable, Contact, Gravity, History, Pull, Result, Route, Solver, TensionProfile, run, sweep
 from .errors import ExucableError, GeometryError, ModelError, ScenarioError, SolverError
+from .model.layout import InitialLayout, initial_layout
 from .scenario import Scenario, load_scenario
+
+# The plugin face on Exudyn, imported on first use so that "import exucable" does not load Exudyn.
+_PLUGIN = {"add_cable_in_conduit", "CableInConduit", "JoinToMarker", "ReelOnto"}
+
+
+def __getattr__(name):
+    if name in _PLUGIN:
+        from .model import build
+        return getattr(build, name)
+    raise AttributeError(f"module 'exucable' has no attribute {name!r}")
 
 __all__ = [
     "__version__",
     "Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Scenario", "load_scenario",
     "run", "sweep", "Result", "History", "TensionProfile",
+    "add_cable_in_conduit", "CableInConduit", "JoinToMarker", "ReelOnto", "initial_layout", "InitialLayout",
     "ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError",
 ]

@@ -16,7 +16,6 @@ from .versions import versions
 from .errors import ExucableError
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
-from .solve import Progress, simulate, steady_quantity
 from .tension import detect_steady_state, tension_profile
 
 __all__ = ["run_scenario", "contact_profile", "add_arguments", "main"]
@@ -61,6 +60,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
     """
     from .model.build import build_model
+    from .solve import Progress, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     t_start = time.perf_counter()

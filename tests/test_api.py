@@ -115,3 +115,9 @@ def test_import_changes_no_matplotlib_backend():
     code = ("import matplotlib; b = matplotlib.get_backend(); import exucable; "
             "assert matplotlib.get_backend() == b; import sys; assert 'exudyn' not in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_run_stays_the_function_after_the_submodule_is_imported():
+    import exucable.run  # noqa: F401  (the module of the same name as the function)
+    from exucable.api import run
+    assert xc.run is run

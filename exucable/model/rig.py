@@ -18,7 +18,7 @@ from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, MarkerN
                                   MarkerNodeCoordinates, MarkerNodePosition, NodePointGround, ObjectGenericODE2,
                                   ObjectConnectorCoordinateVector)
 
-__all__ = ["Drive", "add_guide", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
+__all__ = ["Drive", "add_guide", "add_reel", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
            "smooth_ramp", "ramped_displacement"]
 
 
@@ -49,12 +49,14 @@ class Drive:
 
     constraints: tuple[int, int, int]
     direction: np.ndarray
+    # Exudyn's multiplier is the force on the node with the opposite sign when the node's
+    # coordinate is the constraint's second marker (checked: a cable held back by 100 N gives
+    # -100 on the drive along +x); +1 when it is the first marker (a reel, add_reel).
+    sign: float = -1.0
 
     def force_N(self, mbs) -> float:
         lam = np.array([mbs.GetObjectOutput(c, exu.OutputVariableType.Force) for c in self.constraints])
-        # Exudyn's multiplier is the force on the node with the opposite sign (checked: a cable
-        # held back by 100 N gives -100 on the drive along +x).
-        return float(-lam @ self.direction)
+        return float(self.sign * (lam @ self.direction))
 
 
 def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: float = 0.0) -> Drive:
@@ -75,6 +77,22 @@ def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: floa
             visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]},
         )))
     return Drive(constraints=tuple(cons), direction=d)
+
+
+def add_reel(mbs, node: int, direction, coordinate_marker: int, radius_m: float) -> Drive:
+    """Reel ``node`` in along unit ``direction`` d by ``radius_m`` × a user's coordinate (a drum's
+    rotation angle [rad]): u_k = d_k·R·φ for each position coordinate k (three
+    ``CoordinateConstraint``, the node's coordinate first, ``factorValue1 = d_k R``), so the drum
+    feels the cable's pull as the torque R·F. Returns the :class:`Drive` (``force_N`` = F)."""
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    cons = []
+    for k in range(3):
+        m = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=k))
+        cons.append(mbs.AddObject(CoordinateConstraint(
+            markerNumbers=[m, coordinate_marker], factorValue1=float(d[k] * radius_m),
+            visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]})))
+    return Drive(constraints=tuple(cons), direction=d, sign=1.0)
 
 
 def add_end_force(mbs, node: int, force_vector_N, factor: Callable[[float], float] | None = None) -> int:
