@@ -82,7 +82,7 @@ def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: floa
 def add_reel(mbs, node: int, direction, coordinate_marker: int, radius_m: float) -> Drive:
     """Reel ``node`` in along unit ``direction`` d by ``radius_m`` × a user's coordinate (a drum's
     rotation angle [rad]): u_k = d_k·R·φ for each position coordinate k (three
-    ``CoordinateConstraint``, the node's coordinate first, ``factorValue1 = d_k R``), so the drum
+    ``CoordinateConstraint``, the node's coordinate first, ``factor1 = d_k R``), so the drum
     feels the cable's pull as the torque R·F. Returns the :class:`Drive` (``force_N`` = F)."""
     d = np.asarray(direction, dtype=float)
     d = d / np.linalg.norm(d)
@@ -90,7 +90,7 @@ def add_reel(mbs, node: int, direction, coordinate_marker: int, radius_m: float)
     for k in range(3):
         m = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=k))
         cons.append(mbs.AddObject(CoordinateConstraint(
-            markerNumbers=[m, coordinate_marker], factorValue1=float(d[k] * radius_m),
+            markerNumbers=[m, coordinate_marker], factor1=float(d[k] * radius_m),
             visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]})))
     return Drive(constraints=tuple(cons), direction=d, sign=1.0)
 
