@@ -11,25 +11,22 @@ both, the maximum and RMS differences are reported, absolute [N] and relative to
 exit status is 1 if any relative maximum difference exceeds ``--rtol`` (default 1e-2), else 0. Input errors
 raise :class:`~exucable.errors.ExucableError` (the CLI prints the message without a traceback).
 
-Hook into the CLI with :func:`add_arguments` and :func:`main`; use :func:`compare_results` from Python.
+Use :func:`compare_results` from Python; :mod:`exucable.commands.compare` is the command-line face.
 """
 
 from __future__ import annotations
 
-import argparse
 import csv
 import math
-import os
-import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from exucable.errors import ExucableError
+from .errors import ExucableError
+from .io import new_figure, save_figure
 
-__all__ = ["compare_results", "write_overlay_plot", "format_report", "add_arguments", "main", "DEFAULT_RTOL"]
+__all__ = ["compare_results", "write_overlay_plot", "format_report", "DEFAULT_RTOL"]
 
 #: Default threshold on the relative maximum difference [-] (1 %: the paper's own agreement with its closed forms
 #: is 0.39 %, and other multibody codes differ from exucable by their discretisation).
@@ -194,13 +191,9 @@ def format_report(result: dict) -> str:
 
 def write_overlay_plot(result: dict, out) -> Path:
     """Overlay A and B (and B − A below) for every compared column; PNG written atomically to ``out``."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
     tables_a, tables_b = _load(result["a"]), _load(result["b"])
     comps = result["comparisons"]
-    fig = Figure(figsize=(7.0, 3.6 * len(comps)), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(7.0, 3.6 * len(comps)), layout="constrained")
     axes = fig.subplots(2 * len(comps), 1, squeeze=False, height_ratios=[3, 1] * len(comps))[:, 0]
     for i, c in enumerate(comps):
         ta, tb = tables_a[c["kind"]], tables_b[c["kind"]]
@@ -217,46 +210,6 @@ def write_overlay_plot(result: dict, out) -> Path:
         bottom.axhline(0.0, color="0.5", lw=0.6)
         bottom.set_ylabel("B − A [N]")
         bottom.set_xlabel("s [m]" if c["abscissa"] == "s_m" else "t [s]")
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     # Atomic: a reader never sees a half-written figure, and a failed save leaves the old one in place.
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fig.savefig(fh, format=out.suffix.lstrip(".") or "png", dpi=120)
-        os.replace(tmp, out)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return out
+    return save_figure(fig, out, dpi=120)
 
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add the ``compare`` subcommand's arguments to ``parser``."""
-    parser.add_argument("a", help="reference results: a result directory or a tension_profile/history CSV")
-    parser.add_argument("b", help="results to check, same kinds as A (interpolated onto A's abscissa)")
-    parser.add_argument("--rtol", type=float, default=DEFAULT_RTOL,
-                        help=f"largest allowed relative max difference, relative to max |A| (default {DEFAULT_RTOL:g})")
-    parser.add_argument("--out", default=None, help="write an overlay plot (PNG) to this path")
-
-
-def main(args: argparse.Namespace) -> int:
-    """Run ``exucable compare``; print the table, write the plot if asked; 1 if A and B differ beyond rtol."""
-    if not (args.rtol >= 0.0 and math.isfinite(args.rtol)):
-        raise ExucableError(f"--rtol must be a finite number >= 0, got {args.rtol!r}")
-    result = compare_results(args.a, args.b, rtol=args.rtol)
-    print(format_report(result))
-    if args.out:
-        print(f"overlay plot: {write_overlay_plot(result, args.out)}")
-    return 0 if result["passed"] else 1
-
-
-if __name__ == "__main__":  # python -m exucable.compare A B, until the lead's CLI table lists it
-    _parser = argparse.ArgumentParser(prog="exucable compare", description=__doc__.splitlines()[0])
-    add_arguments(_parser)
-    try:
-        sys.exit(main(_parser.parse_args()))
-    except ExucableError as _exc:
-        print(f"error: {_exc}", file=sys.stderr)
-        sys.exit(2)

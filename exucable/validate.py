@@ -13,28 +13,22 @@ from __future__ import annotations
 import csv
 import io
 import math
-import sys
 import time
-import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .results import atomic_write_text, read_csv
+from .data import data_path
+from .io import atomic_write_text
+from .plots.validation import plot_validation_figures
+from .reference import load_reference
 
-__all__ = ["Check", "load_reference", "validate", "add_arguments", "main", "ROOT"]
+__all__ = ["Check", "ValidationRun", "validate", "format_table", "write_report", "TOLERANCES", "CASES"]
 
-ROOT = Path(__file__).resolve().parents[1]
-REFERENCE_FILE = ROOT / "reference" / "paper_values.toml"
-
-
-def load_reference(path=REFERENCE_FILE) -> dict:
-    """The reference values as a nested dict ``{section: {key: value}}``."""
-    with open(path, "rb") as f:
-        data = tomllib.load(f)
-    return {sec: {k: v["value"] for k, v in tab.items() if isinstance(v, dict) and "value" in v}
-            for sec, tab in data.items() if isinstance(tab, dict)}
+#: The validation cases, in the order they run.
+CASES = ("ex1", "ex2", "ex3", "fig12", "ex4")
 
 
 @dataclass(frozen=True)
@@ -84,15 +78,18 @@ class ValidationRun:
     failures: list = field(default_factory=list)   # (case, message)
 
 
-def _scenario(name: str, fast: bool) -> Path:
-    return ROOT / "scenarios" / ("fast" if fast else "") / f"{name}.toml"
+def _shipped(*parts: str, fast: bool) -> tuple[Path, str]:
+    """A shipped scenario file (its coarse variant in ``fast/`` beside it) and its name for messages."""
+    *dirs, name = parts
+    parts = (*dirs, "fast", name) if fast else parts
+    return data_path("scenarios", *parts), "/".join(("scenarios",) + parts)
 
 
-def _run(case, name, fast, out_dir, quiet, vr: ValidationRun):
+def _run(case, name, fast, out_dir, quiet, vr: ValidationRun, progress):
     from .run import run_scenario
-    path = _scenario(name, fast)
-    if not quiet:
-        print(f"validate: running {case} ({path.relative_to(ROOT)})", flush=True)
+    path, shown = _shipped(f"{name}.toml", fast=fast)
+    if progress is not None:
+        progress(f"validate: running {case} ({shown})")
     res = run_scenario(path, Path(out_dir) / name, quiet=quiet, plots=True)
     vr.runs[case] = res
     if res.summary["status"] == "failed":
@@ -104,16 +101,32 @@ def _tol(key, fast):
     return TOLERANCES[key][1 if fast else 0]
 
 
-def validate(fast: bool = False, out_dir="validation", quiet: bool = True, cases=None) -> ValidationRun:
-    """Run the validation set; returns the checks (see :class:`Check`)."""
+def validate(fast: bool = False, out_dir="validation", quiet: bool = True, cases=None,
+             progress: Callable[[str], None] | None = None) -> ValidationRun:
+    """Run the validation set, write its table and figures into ``out_dir``; returns the checks
+    (see :class:`Check`).
+
+    Parameters
+    ----------
+    fast : bool
+        The coarse variants (``scenarios/fast``) with their looser tolerances.
+    out_dir : str or os.PathLike
+        Where ``validation.csv``, ``validation.md``, the figures and each run's results go.
+    quiet : bool
+        No progress bar in the runs.
+    cases : iterable of str, optional
+        A subset of :data:`CASES` (default: all).
+    progress : callable, optional
+        Called with one line of text as each case starts.
+    """
     ref = load_reference()
     vr = ValidationRun()
     t0 = time.perf_counter()
-    wanted = set(cases or ("ex1", "ex2", "ex3", "fig12", "ex4"))
+    wanted = set(cases or CASES)
     out = Path(out_dir)
 
     if "ex1" in wanted:
-        r = _run("Ex. 1", "paper_ex1_incline", fast, out, quiet, vr)
+        r = _run("Ex. 1", "paper_ex1_incline", fast, out, quiet, vr, progress)
         T50 = ref["example1"]["pull_force_N"]
         slope = ref["example1"]["tension_slope_N_per_m"]
         vr.checks.append(Check("Ex. 1", "pulling force at the top end [N]", r.summary["pull_force_N"], T50,
@@ -124,21 +137,21 @@ def validate(fast: bool = False, out_dir="validation", quiet: bool = True, cases
         vr.checks.append(Check("Ex. 1", "max |T(x) - Eq. 25| along the cable / T(50 m)", T50 + worst, T50,
                                _tol("ex1_profile", fast), scale=T50, note="Fig. 7"))
     if "ex2" in wanted:
-        r = _run("Ex. 2", "paper_ex2_bend90", fast, out, quiet, vr)
+        r = _run("Ex. 2", "paper_ex2_bend90", fast, out, quiet, vr, progress)
         T1 = ref["example2"]["pull_force_N"]
         paper = abs(ref["example2"].get("pull_force_reported_N", float("nan")) / T1 - 1)
         vr.checks.append(Check("Ex. 2", "pulling force T1 [N]", r.summary["pull_force_N"], T1,
                                _tol("ex2", fast), paper_error=paper, note="Eq. 26, capstan"))
     if "ex3" in wanted:
-        r = _run("Ex. 3", "paper_ex3_helix", fast, out, quiet, vr)
+        r = _run("Ex. 3", "paper_ex3_helix", fast, out, quiet, vr, progress)
         T2 = ref["example3"]["back_tension_N"]
         vr.checks.append(Check("Ex. 3", "trailing tension T2 [N]", r.summary["trailing_tension_N"], T2,
                                _tol("ex3", fast), paper_error=ref["example3"].get("relative_error_reported"),
                                note="Eq. 26 with the exact helix angle"))
     if "fig12" in wanted:
-        _fig12(ref, fast, out, quiet, vr)
+        _fig12(ref, fast, out, quiet, vr, progress)
     if "ex4" in wanted:
-        r = _run("Ex. 4", "paper_ex4_spatial", fast, out, quiet, vr)
+        r = _run("Ex. 4", "paper_ex4_spatial", fast, out, quiet, vr, progress)
         vr.checks.append(Check("Ex. 4", "pulling force vs rope solver [N]", r.summary["pull_force_N"],
                                r.summary["rope_pull_force_N"], _tol("ex4", fast),
                                note="independent rope solution (paper: RecurDyn)"))
@@ -147,11 +160,11 @@ def validate(fast: bool = False, out_dir="validation", quiet: bool = True, cases
     return vr
 
 
-def _fig12(ref, fast, out, quiet, vr):
+def _fig12(ref, fast, out, quiet, vr, progress):
     from .sweep import load_sweep, run_sweep
-    path = ROOT / "scenarios" / "sweeps" / ("fast" if fast else "") / "paper_fig12_coils.toml"
-    if not quiet:
-        print(f"validate: running Fig. 12 ({path.relative_to(ROOT)})", flush=True)
+    path, shown = _shipped("sweeps", "paper_fig12_coils.toml", fast=fast)
+    if progress is not None:
+        progress(f"validate: running Fig. 12 ({shown})")
     sweep = load_sweep(path)
     rows = run_sweep(sweep, out / "fig12", quiet=quiet)
     vr.sweep_rows = rows
@@ -209,24 +222,5 @@ def write_report(vr: ValidationRun, out: Path, fast: bool) -> None:
     for case, msg in vr.failures:
         md.append(f"- {case}: run failed: {msg}")
     atomic_write_text(out / "validation.md", "\n".join(md) + "\n")
-    from .plots.validation import plot_validation_figures
-    plot_validation_figures(vr, out)
+    plot_validation_figures(vr, out, load_reference())
 
-
-def add_arguments(p) -> None:
-    p.add_argument("--fast", action="store_true", help="coarse variants (scenarios/fast), looser tolerances")
-    p.add_argument("--out", "-o", default="validation", help="output directory (default: validation/)")
-    p.add_argument("--quiet", "-q", action="store_true", help="no progress output")
-    p.add_argument("--case", action="append", choices=["ex1", "ex2", "ex3", "fig12", "ex4"],
-                   help="run only these cases (repeatable)")
-
-
-def main(args) -> int:
-    vr = validate(fast=args.fast, out_dir=args.out, quiet=args.quiet, cases=args.case)
-    print(format_table(vr))
-    for case, msg in vr.failures:
-        print(f"{case}: run failed: {msg}", file=sys.stderr)
-    n_fail = sum(not c.passed for c in vr.checks)
-    print(f"\n{len(vr.checks) - n_fail}/{len(vr.checks)} checks passed in {vr.wall_time_s:.1f} s; "
-          f"table and figures in {args.out}/")
-    return 1 if n_fail or vr.failures else 0

@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from exucable.compare import add_arguments, compare_results, main
+from exucable.commands.compare import add_arguments, main
+from exucable.compare import compare_results
 from exucable.errors import ExucableError
 
 # Differences of exactly representable synthetic data are computed to rounding: 1e-12 relative/absolute.
@@ -157,7 +158,7 @@ def test_missing_inputs_and_mismatches_raise_clear_errors(tmp_path, s):
 
 
 def test_module_entry_point_reports_errors_without_traceback(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "exucable.compare", str(tmp_path / "nope.csv"),
+    proc = subprocess.run([sys.executable, "-m", "exucable", "compare", str(tmp_path / "nope.csv"),
                            str(tmp_path / "nope.csv")], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2
     assert "no such file" in proc.stderr and "Traceback" not in proc.stderr
