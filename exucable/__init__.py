@@ -15,24 +15,29 @@ The Python API (see ``examples/``)::
 Importing exucable imports neither Exudyn nor matplotlib and changes no global state.
 """
 
-__version__ = "0.1.0"
+from .version import __version__
 
-# The submodule exucable.run first: importing it after the function below would rebind the
-# package attribute "run" to the module (Python sets it when a submodule is first loaded).
+# The submodules exucable.run and exucable.sweep first: importing one after the function of the
+# same name below would rebind the package attribute to the module (Python sets it when a
+# submodule is first loaded). Both are light (no Exudyn, matplotlib or dask at import).
 from . import run as _run_module  # noqa: F401
+from . import sweep as _sweep_package  # noqa: F401
 from .api import Cable, Contact, Gravity, History, Pull, Result, Route, Solver, TensionProfile, run, sweep
 from .errors import ExucableError, GeometryError, ModelError, ScenarioError, SolverError
-from .model.layout import InitialLayout, initial_layout
 from .scenario import Scenario, load_scenario
 
 # The plugin face on Exudyn, imported on first use so that "import exucable" does not load Exudyn.
 _PLUGIN = {"add_cable_in_conduit", "CableInConduit", "JoinToMarker", "ReelOnto"}
+_LAYOUT = {"initial_layout", "InitialLayout"}  # Exudyn-free, but in the model package
 
 
 def __getattr__(name):
     if name in _PLUGIN:
         from .model import build
         return getattr(build, name)
+    if name in _LAYOUT:
+        from .model import layout
+        return getattr(layout, name)
     raise AttributeError(f"module 'exucable' has no attribute {name!r}")
 
 __all__ = [

@@ -23,13 +23,16 @@ import itertools
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
 from .scenario import (CableSpec, ConduitSpec, ContactSpec, GravitySpec, PullSpec, Scenario, SolverSpec,
-                       _parse_conduit)
+                       _build_conduit, _conduit_length_m, _parse_conduit)
 from .scenario_fields import REQUIRED, fields_of
+
+if TYPE_CHECKING:  # for the annotation only: Exudyn is imported when a run is asked for
+    from .model.build import Model
 
 __all__ = ["Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "run", "sweep", "Result", "History",
            "TensionProfile"]
@@ -174,8 +177,7 @@ class Route:
     @property
     def length_m(self) -> float:
         """Centreline length [m]."""
-        from . import scenario as _sc
-        return _sc._conduit_length_m(_sc._build_conduit(self.to_spec()))
+        return _conduit_length_m(_build_conduit(self.to_spec()))
 
     def __repr__(self) -> str:
         what = f"{len(self._pieces)} pieces" if self._survey is None else "survey"
@@ -237,7 +239,7 @@ class Result:
     history: History
     tension_profile: TensionProfile
     summary: dict
-    model: Any
+    model: Model
     scenario: Scenario
     out_dir: Path | None
 

@@ -29,7 +29,7 @@ from dataclasses import InitVar, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
-from exucable import geometry as _geo
+import exucable.geometry as _geo
 from exucable.errors import GeometryError, ScenarioError
 from exucable.scenario_fields import FIELDS, REQUIRED, Field, fields_of
 

@@ -102,11 +102,13 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
                         progress=progress.update if progress is not None else None)
     history = recorder.history
     mbs = model.mbs
-    users = mbs.GetPostStepUserFunction()
+    # Exudyn 1.13 returns {"function": f, "type": "Python"} for a set function, 0 for none
+    previous = mbs.GetPostStepUserFunction()
+    users = previous.get("function") if isinstance(previous, dict) else (previous or None)
 
     def post_step(mbs, t):
         go_on = recorder(mbs, t)
-        if users:
+        if users is not None:
             go_on = (users(mbs, t) is not False) and go_on
         return go_on
 
@@ -122,7 +124,7 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
         status, message = "failed", f"{type(exc).__name__}: {exc}".strip()
     finally:
-        mbs.SetPostStepUserFunction(users if users else 0)
+        mbs.SetPostStepUserFunction(users if users is not None else 0)
     wall = time.perf_counter() - t0
     t_end = float(solver.it.currentTime)
     if recorder.stopped_steady and status == "ok":

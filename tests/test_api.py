@@ -117,7 +117,8 @@ def test_import_changes_no_matplotlib_backend():
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
-def test_run_stays_the_function_after_the_submodule_is_imported():
-    import exucable.run  # noqa: F401  (the module of the same name as the function)
-    from exucable.api import run
-    assert xc.run is run
+def test_run_and_sweep_stay_functions_after_the_submodules_are_imported():
+    import exucable.run  # noqa: F401  (modules of the same names as the functions)
+    import exucable.sweep  # noqa: F401
+    from exucable.api import run, sweep
+    assert xc.run is run and xc.sweep is sweep

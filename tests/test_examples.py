@@ -43,6 +43,11 @@ def test_winch_drum_torque_over_radius_is_the_pulling_force():
 
 
 def test_results_into_numpy(tmp_path):
+    import matplotlib
+    backend = matplotlib.get_backend()
     res, mean_from_csv, summary = load("results_numpy").main(out_dir=tmp_path, end_time=0.3)
+    # a run that writes its figures leaves the user's matplotlib backend alone
+    assert matplotlib.get_backend() == backend
+    assert (tmp_path / "pull_force.png").stat().st_size > 0
     assert mean_from_csv == pytest.approx(summary["pull_force_N"], rel=1e-9)
     assert res.pull_force_N == pytest.approx(summary["pull_force_N"], rel=1e-12)

@@ -10,6 +10,7 @@ SystemContainer for ``exucable run``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import exudyn as exu
@@ -21,6 +22,15 @@ from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, InitialLayout, initial_layout
 from .recorder import Recorder
 from .rig import Drive, add_drive, add_end_force, add_guide, add_reel, add_tangential_drive, smooth_ramp
+
+if TYPE_CHECKING:  # names for the annotations only
+    from ..contact import ContactKernel
+    from ..geometry import Conduit
+    from ..rope import RopeSolution
+    from ..scenario import Scenario
+    from .coupling import ContactCoupling
+    from .rig import TangentialDrive
+    from .startup import StartupDamper
 
 __all__ = ["CableInConduit", "Model", "JoinToMarker", "ReelOnto", "add_cable_in_conduit", "build_model",
            "pull_oriented_conduit", "check_resolution"]
@@ -85,9 +95,9 @@ class CableInConduit:
         pulling force, trailing and maximum tension at ``solver.output_interval``.
     """
 
-    scenario: object
-    mbs: object
-    conduit: object
+    scenario: Scenario
+    mbs: exu.MainSystem
+    conduit: Conduit
     cable: CableHandles
     layout: CableLayout
     start: InitialLayout
@@ -95,13 +105,13 @@ class CableInConduit:
     leading_marker: int
     trailing_marker: int
     lead_drive: Drive | None = None
-    trail_drive: object | None = None
+    trail_drive: Drive | TangentialDrive | None = None
     applied_pull_force_N: float | None = None
     back_tension_N: float = 0.0
-    rope: object | None = None
-    coupling: object | None = None
-    kernel: object | None = None
-    startup_damper: object | None = None
+    rope: RopeSolution | None = None
+    coupling: ContactCoupling | None = None
+    kernel: ContactKernel | None = None
+    startup_damper: StartupDamper | None = None
     guide: int | None = None
     recorder: Recorder | None = None
     _ode2_index: np.ndarray | None = field(default=None)
@@ -171,7 +181,7 @@ class CableInConduit:
 class Model(CableInConduit):
     """A cable in a conduit in its own assembled SystemContainer (:func:`build_model`)."""
 
-    system_container: object = None
+    system_container: exu.SystemContainer | None = None
 
 
 def pull_oriented_conduit(scenario):
@@ -301,7 +311,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         add_end_force(mbs, lead_node, sc.pull.force_N * t_exit, factor)
     elif isinstance(leading, JoinToMarker):
         mbs.AddObject(ObjectJointSpherical(markerNumbers=[leading.marker, h.leading_marker],
-                                           visualization={"show": False}))
+                                           visualization={"show": False, "jointRadius": 0.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
     elif isinstance(leading, ReelOnto):
         h.lead_drive = add_reel(mbs, lead_node, t_exit, leading.coordinate_marker, leading.radius_m)
 
@@ -315,7 +325,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
             h.trail_drive = add_tangential_drive(mbs, trail_node, t_entry, speed)
     elif isinstance(trailing, JoinToMarker):
         mbs.AddObject(ObjectJointSpherical(markerNumbers=[trailing.marker, h.trailing_marker],
-                                           visualization={"show": False}))
+                                           visualization={"show": False, "jointRadius": 0.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
 
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
