@@ -97,3 +97,24 @@ def test_simulate_keeps_and_calls_the_users_post_step_function():
     out = simulate(model)
     assert out.status == "ok" and calls and calls[-1] == pytest.approx(0.03)
     assert model.mbs.GetPostStepUserFunction()["function"] is mine
+
+
+def test_initial_layout_runs_with_exudyn_blocked():
+    import subprocess
+    import sys
+    import textwrap
+    code = textwrap.dedent("""
+        import sys
+        class Block:
+            def find_spec(self, name, path=None, target=None):
+                if name == "exudyn" or name.startswith("exudyn."):
+                    raise ImportError("exudyn is blocked in this test")
+        sys.meta_path.insert(0, Block())
+        import exucable as xc
+        route = xc.Route(inner_radius=3.5e-3).straight(1.0).bend(90, radius=0.5, turn="left").straight(1.0)
+        sc = xc.Scenario(route=route, cable=xc.Cable(radius=2.5e-3, density=1000.0, youngs_modulus=1e9),
+                         pull=xc.Pull(speed=0.1, back_tension=150.0), solver=xc.Solver(end_time=0.1))
+        start = xc.initial_layout(sc)
+        assert start.cable.n_elements == sc.cable.elements and "exudyn" not in sys.modules
+    """)
+    subprocess.run([sys.executable, "-c", code], check=True)
