@@ -20,9 +20,9 @@ def main(out_dir="out/results_numpy", end_time=0.5):
 
     # in memory: numpy arrays
     t, F = res.history.time_s, res.history.pull_force_N
-    s, N = res.tension_profile.s_m, res.tension_profile.tension_N
-    print(f"{len(t)} records; pulling force at the end {F[-1]:.3f} N; tension from {N[0]:.1f} N at s = 0 "
-          f"to {N[-1]:.1f} N at s = {s[-1]:.3f} m")
+    x, N = res.tension_profile.x_m, res.tension_profile.tension_N
+    print(f"{len(t)} records; pulling force at the end {F[-1]:.3f} N; tension from {N[0]:.1f} N at x = 0 "
+          f"to {N[-1]:.1f} N at x = {x[-1]:.3f} m (along the cable from its trailing end)")
 
     # on disk: the same numbers, column names from the header
     history = np.genfromtxt(Path(out_dir) / "history.csv", delimiter=",", names=True, comments="#")
@@ -31,8 +31,8 @@ def main(out_dir="out/results_numpy", end_time=0.5):
     steady = history["time_s"] >= summary["steady_from_s"]
     mean_from_csv = float(np.mean(history["pull_force_N"][steady]))
     print(f"steady mean from history.csv {mean_from_csv:.4f} N = summary.json {summary['pull_force_N']:.4f} N")
-    print(f"largest tension {profile['tension_N'].max():.2f} N at s = "
-          f"{profile['s_m'][np.argmax(profile['tension_N'])]:.3f} m")
+    print(f"largest tension {profile['tension_N'].max():.2f} N at x = "
+          f"{profile['x_m'][np.argmax(profile['tension_N'])]:.3f} m")
     return res, mean_from_csv, summary
 
 

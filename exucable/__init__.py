@@ -22,7 +22,8 @@ from .version import __version__
 # submodule is first loaded). Both are light (no Exudyn, matplotlib or dask at import).
 from . import run as _run_module  # noqa: F401
 from . import sweep as _sweep_package  # noqa: F401
-from .api import Cable, Contact, Gravity, History, Pull, Result, Route, Solver, TensionProfile, run, sweep
+from .api import (Cable, Contact, Gravity, History, Output, Pull, Result, Route, Solver, TensionProfile, run,
+                  sweep)
 from .errors import ExucableError, GeometryError, ModelError, ScenarioError, SolverError
 from .scenario import Scenario, load_scenario
 
@@ -42,7 +43,7 @@ def __getattr__(name):
 
 __all__ = [
     "__version__",
-    "Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Scenario", "load_scenario",
+    "Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Output", "Scenario", "load_scenario",
     "run", "sweep", "Result", "History", "TensionProfile",
     "add_cable_in_conduit", "CableInConduit", "JoinToMarker", "ReelOnto", "initial_layout", "InitialLayout",
     "ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError",

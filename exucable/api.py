@@ -27,14 +27,14 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
-from .scenario import (CableSpec, ConduitSpec, ContactSpec, GravitySpec, PullSpec, Scenario, SolverSpec,
-                       _build_conduit, _conduit_length_m, _parse_conduit)
+from .scenario import (CableSpec, ConduitSpec, ContactSpec, GravitySpec, OutputSpec, PullSpec, Scenario,
+                       SolverSpec, _build_conduit, _conduit_length_m, _parse_conduit)
 from .scenario_fields import REQUIRED, fields_of
 
 if TYPE_CHECKING:  # for the annotation only: Exudyn is imported when a run is asked for
     from .model.build import Model
 
-__all__ = ["Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "run", "sweep", "Result", "History",
+__all__ = ["Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Output", "run", "sweep", "Result", "History",
            "TensionProfile"]
 
 
@@ -75,6 +75,7 @@ Contact = _part("contact", ContactSpec, "The cable–conduit contact law (paper 
 Pull = _part("pull", PullSpec, "The pulling rig (paper Sect. 2.1, Eq. 1) and the trailing-end load.")
 Gravity = _part("gravity", GravitySpec, "Gravity along −z.")
 Solver = _part("solver", SolverSpec, "Time integration settings.")
+Output = _part("output", OutputSpec, "What is written besides the standard results (snapshots).")
 
 
 class Route:
@@ -199,10 +200,24 @@ class History:
 
 @dataclass(frozen=True)
 class TensionProfile:
-    """Axial force N = EA·ε along the cable at the final time (paper Eq. 24)."""
+    """Axial force N = EA·ε along the cable at the final time (paper Eq. 24), as
+    ``tension_profile.csv``.
 
-    s_m: np.ndarray          # arc length from the trailing end [m]
+    Attributes
+    ----------
+    x_m : ndarray
+        Material coordinate along the cable from the trailing end [m].
+    tension_N : ndarray
+        N at each x [N].
+    """
+
+    x_m: np.ndarray
     tension_N: np.ndarray
+
+    @property
+    def s_m(self) -> np.ndarray:
+        """Arc length along the cable from the trailing end [m] (= :attr:`x_m`)."""
+        return self.x_m
 
 
 @dataclass(frozen=True)
@@ -296,7 +311,7 @@ def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False) -
         message=s.get("message", ""),
         history=History(**{k: np.asarray(h[k], dtype=float) for k in
                            ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N")}),
-        tension_profile=TensionProfile(s_m=np.asarray(raw.tension_profile["s_m"], dtype=float),
+        tension_profile=TensionProfile(x_m=np.asarray(raw.tension_profile["x_m"], dtype=float),
                                        tension_N=np.asarray(raw.tension_profile["tension_N"], dtype=float)),
         summary=s,
         model=raw.model,

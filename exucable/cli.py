@@ -21,6 +21,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "validate": ("exucable.commands.validate", "run the paper's examples against their references"),
     "sweep": ("exucable.commands.sweep", "run a parameter sweep (local pool or Dask)"),
     "compare": ("exucable.commands.compare", "compare two result sets (yours and ours)"),
+    "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
 }
 
 

@@ -56,14 +56,19 @@ def atomic_write_text(path, text: str) -> Path:
 def write_csv(path, columns, data: dict) -> Path:
     """Write equal-length columns ``data[c]`` for ``c in columns`` as CSV with a header, atomically.
 
-    Floats are written with ``repr`` (shortest round-trip form), so reading them back is exact.
+    Floats are written with ``repr`` (shortest round-trip form), so reading them back is exact;
+    integer arrays (indices) as integers.
     """
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(columns)
-    arrays = [np.asarray(data[c], dtype=float) for c in columns]
+    # integer columns (node and element indices) stay integers
+    arrays = [np.asarray(data[c]) for c in columns]
+    arrays = [a if np.issubdtype(a.dtype, np.integer) else a.astype(float) for a in arrays]
+    fmt = [(lambda v: str(int(v))) if np.issubdtype(a.dtype, np.integer) else (lambda v: repr(float(v)))
+           for a in arrays]
     for row in zip(*arrays):
-        w.writerow([repr(float(v)) for v in row])
+        w.writerow([f(v) for f, v in zip(fmt, row)])
     return atomic_write_text(path, buf.getvalue())
 
 

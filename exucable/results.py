@@ -8,9 +8,11 @@ Files
 -----
 ``summary.json``          scalars (forces [N], times [s]), status, scenario echoed back, versions
 ``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N``
-``tension_profile.csv``   ``s_m,tension_N`` at the final time (s from the trailing end)
-``contact_profile.csv``   ``s_m,normal_force_per_length_N_per_m,penetration_m`` (s along the conduit)
-``rope_profile.csv``      ``s_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+``tension_profile.csv``   ``x_m,tension_N`` at the final time (x: material coordinate from the trailing end)
+``contact_profile.csv``   ``s_conduit_m,normal_force_per_length_N_per_m,penetration_m`` (along the
+                          scenario's conduit from its start)
+``rope_profile.csv``      ``s_conduit_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+``snapshot_*.csv``        the state at ``[output] snapshots`` times (see :mod:`exucable.snapshots`)
 """
 
 from __future__ import annotations
@@ -27,9 +29,12 @@ __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", 
            "read_summary", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
 HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N")
-PROFILE_COLUMNS = ("s_m", "tension_N")
-CONTACT_COLUMNS = ("s_m", "normal_force_per_length_N_per_m", "penetration_m")
-ROPE_COLUMNS = ("s_m", "tension_N", "sidewall_pressure_N_per_m")
+# Arc lengths, one convention in every file: x_m = material coordinate along the cable from its
+# trailing end; s_conduit_m = along the scenario's conduit from its start (whatever the pull direction)
+PROFILE_COLUMNS = ("x_m", "tension_N")
+CONTACT_COLUMNS = ("s_conduit_m", "normal_force_per_length_N_per_m", "penetration_m")
+ROPE_COLUMNS = ("s_conduit_m", "tension_N", "sidewall_pressure_N_per_m")
+# (the old name s_m is still read by ``compare`` for one release: exucable.compare.FAMILIES)
 
 
 @dataclass
@@ -42,6 +47,7 @@ class RunResult:
     contact_profile: dict | None = None
     rope_profile: dict | None = None
     extras: dict = field(default_factory=dict)
+    snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.snapshots)
     model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
 
 
@@ -61,6 +67,11 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     if result.rope_profile is not None:
         write_csv(out / "rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
         written.append(out / "rope_profile.csv")
+    if result.snapshots:
+        from .formats import SNAPSHOT_FILES
+        for name, data in result.snapshots.items():
+            write_csv(out / name, SNAPSHOT_FILES[name], data)
+            written.append(out / name)
     if plots:
         plot_pull_force(out / "pull_force.png", result)
         written.append(out / "pull_force.png")

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .versions import versions
+from .export import conduit_s
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
 from .tension import detect_steady_state, tension_profile
@@ -22,7 +23,7 @@ __all__ = ["run_scenario", "contact_profile"]
 def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
     """Sidewall bearing pressure along the conduit at the current state.
 
-    One row per check point in contact order of ``s`` along the scenario's conduit (normal force
+    One row per check point in order of ``s_conduit_m`` along the scenario's conduit (normal force
     per unit length [N/m] = the point's force over its share of the element, penetration [m]);
     beyond ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
     penetration: max). Also returns the largest per-point pressure [N/m].
@@ -34,8 +35,7 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
     L = model.conduit.centreline.length_m
     s = np.asarray(pts.s_conduit_m, dtype=float)
     keep = np.isfinite(s) & (s >= 0.0) & (s <= L)
-    if model.scenario.pull.direction == "reverse":
-        s = L - s   # report along the scenario's own conduit
+    s = conduit_s(model, s)   # along the scenario's own conduit, not the pull-oriented one
     order = np.argsort(s[keep])
     s = s[keep][order]
     p = np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order]
@@ -46,7 +46,7 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
         s = np.array([s[g].mean() for g in groups])
         p = np.array([p[g].mean() for g in groups])
         pen = np.array([pen[g].max() for g in groups])
-    return {"s_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
+    return {"s_conduit_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
 
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
@@ -65,7 +65,12 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     model = build_model(sc)
     build_s = time.perf_counter() - t_start
     progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
-    out = simulate(model, progress=progress, steady_stop=steady_stop)
+    snapshot_times = sc.output.times_s(sc.solver.end_time_s)
+    recorder = None
+    if snapshot_times:
+        from .snapshots import SnapshotRecorder
+        recorder = SnapshotRecorder(model, snapshot_times)
+    out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
     h = out.history.arrays()
     sp = sc.solver
     st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
@@ -102,14 +107,22 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     }
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
+    if recorder is not None:
+        summary["snapshots_s"] = recorder.recorded_s
+        summary["snapshots_not_reached_s"] = list(recorder.pending)
     rope_profile = None
     extras = {}
     if rope is not None:
-        rope_profile = {"s_m": rope.s_conduit_m, "tension_N": rope.tension_N,
-                        "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m}
-        extras["s_cable_m"] = rope.s_cable_m
-    result = RunResult(summary=summary, history=h, tension_profile={"s_m": x, "tension_N": N},
-                       contact_profile=cprof, rope_profile=rope_profile, extras=extras, model=model)
+        # the rope is solved on the pull-oriented conduit, trailing end first; written along the
+        # scenario's conduit in increasing s_conduit_m, as the contact profile
+        order = slice(None, None, -1) if sc.pull.direction == "reverse" else slice(None)
+        rope_profile = {"s_conduit_m": conduit_s(model, rope.s_conduit_m)[order],
+                        "tension_N": rope.tension_N[order],
+                        "sidewall_pressure_N_per_m": rope.sidewall_pressure_N_per_m[order]}
+        extras["x_m"] = rope.s_cable_m[order]
+    result = RunResult(summary=summary, history=h, tension_profile={"x_m": x, "tension_N": N},
+                       contact_profile=cprof, rope_profile=rope_profile, extras=extras,
+                       snapshots=recorder.tables() if recorder is not None else None, model=model)
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result

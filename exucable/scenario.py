@@ -39,6 +39,7 @@ __all__ = [
     "ContactSpec",
     "PullSpec",
     "GravitySpec",
+    "OutputSpec",
     "SolverSpec",
     "Scenario",
     "load_scenario",
@@ -468,6 +469,45 @@ class GravitySpec(_Spec):
 
 
 @dataclass(frozen=True)
+class OutputSpec(_Spec):
+    """What is written besides the histories and final profiles.
+
+    Attributes
+    ----------
+    snapshots_s : tuple of float
+        Times at which the whole state is written (snapshot files) [s], sorted, each >= 0 (and
+        <= ``solver.end_time``, checked by the scenario).
+    snapshot_interval_s : float or None
+        Also a snapshot every this many seconds, at k·interval, k = 1, 2, … [s].
+    """
+
+    _SECTION: ClassVar[str] = "output"
+
+    snapshots_s: tuple = ()
+    snapshot_interval_s: float | None = None
+
+    def _check(self) -> None:
+        raw = self.snapshots_s
+        if not isinstance(raw, (list, tuple)):
+            raise ScenarioError("output.snapshots", f"must be an array of times [s], got {_describe(raw)}")
+        times = []
+        for i, value in enumerate(raw):
+            key = f"output.snapshots[{i}]"
+            v = _as_float(key, value, "s")
+            _check_range(key, v, "s", ge=0.0)
+            times.append(v)
+        object.__setattr__(self, "snapshots_s", tuple(sorted(set(times))))
+
+    def times_s(self, end_time_s: float) -> tuple:
+        """All snapshot times up to ``end_time_s`` [s], sorted, duplicates merged."""
+        times = set(self.snapshots_s)
+        if self.snapshot_interval_s is not None:
+            n = int(math.floor(end_time_s / self.snapshot_interval_s * (1 + 1e-12)))
+            times.update(k * self.snapshot_interval_s for k in range(1, n + 1))
+        return tuple(sorted(t for t in times if t <= end_time_s))
+
+
+@dataclass(frozen=True)
 class SolverSpec(_Spec):
     """Time integration settings.
 
@@ -563,6 +603,8 @@ class Scenario:
     gravity : GravitySpec or None
         None: no gravity.
     solver : SolverSpec
+    output : OutputSpec
+        Snapshot times (default: none).
     source_path : Path or None
         File the scenario was read from (provenance only; not compared).
     route : exucable.Route, optional
@@ -577,6 +619,7 @@ class Scenario:
     pull: PullSpec | None = None
     gravity: GravitySpec | None = None
     solver: SolverSpec | None = None
+    output: OutputSpec = field(default_factory=OutputSpec)
     source_path: Path | None = field(default=None, compare=False)
     route: InitVar[Any] = None
 
@@ -603,6 +646,13 @@ class Scenario:
                 raise ScenarioError(part, f"required: give the [{part}] table, or {part}={how} in Python")
             if not isinstance(value, cls):
                 raise ScenarioError(part, f"must be a {cls.__name__} ({how}), got {_describe(value)}")
+        if not isinstance(self.output, OutputSpec):
+            raise ScenarioError("output", f"must be an OutputSpec, got {_describe(self.output)}")
+        late = [t for t in self.output.snapshots_s if t > self.solver.end_time_s]
+        if late:
+            i = self.output.snapshots_s.index(late[0])
+            raise ScenarioError(f"output.snapshots[{i}]", f"must be <= solver.end_time = "
+                                f"{self.solver.end_time_s!r} s, got {late[0]!r}")
         if self.gravity is not None and not isinstance(self.gravity, GravitySpec):
             raise ScenarioError("gravity", f"must be a GravitySpec (exucable.Gravity(...)) or None, got "
                                            f"{_describe(self.gravity)}")
@@ -670,6 +720,7 @@ class Scenario:
         if self.gravity is not None:
             d["gravity"] = self.gravity.to_dict()
         d["solver"] = self.solver.to_dict()
+        d["output"] = self.output.to_dict()
         return d
 
     def replace(self, **changes) -> "Scenario":
@@ -781,7 +832,8 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     ScenarioError
         The first problem found, naming its full dotted key.
     """
-    top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver"})
+    top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver",
+                            "output"})
     name = top.string("name", default=default_name)
     if not name.strip():
         raise ScenarioError("name", "must be a non-empty string")
@@ -794,6 +846,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     gravity_data = top.table("gravity", default=None)
     gravity = None if gravity_data is None else _parse_gravity(gravity_data)
     solver = _parse_solver(top.table("solver"))
+    output = _parse_output(top.table("output", default={}))
     # Cross-section rules (inner radius > cable radius, cable length <= conduit length),
     # the route build and the default mesh are the Scenario's own checks.
     return Scenario(
@@ -805,6 +858,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
         pull=pull,
         gravity=gravity,
         solver=solver,
+        output=output,
     )
 
 
@@ -1005,6 +1059,10 @@ def _parse_solver(data) -> SolverSpec:
     return _parse_table("solver", data, SolverSpec)
 
 
+def _parse_output(data) -> OutputSpec:
+    return _parse_table("output", data, OutputSpec)
+
+
 _PATH_KINDS: dict[str, set[str]] = {
     "straight": {"straight"},
     "bend": {"bend", "radius", "turn", "axis"},
@@ -1085,6 +1143,7 @@ _PARSERS = {
     "pull": _parse_pull,
     "gravity": _parse_gravity,
     "solver": _parse_solver,
+    "output": _parse_output,
 }
 
 

@@ -36,7 +36,7 @@ class _Required:
 REQUIRED: Any = _Required()
 
 #: Sections in file order; "" is the top level.
-SECTIONS = ("", "cable", "conduit", "contact", "pull", "gravity", "solver")
+SECTIONS = ("", "cable", "conduit", "contact", "pull", "gravity", "solver", "output")
 
 #: Heading of each section's key table in scenarios/README.md.
 SECTION_HEADINGS = {
@@ -47,6 +47,7 @@ SECTION_HEADINGS = {
     "pull": "## `[pull]` (paper Sect. 2.1, Eq. 1)",
     "gravity": "## `[gravity]` (optional; absent = no gravity)",
     "solver": "## `[solver]`",
+    "output": "## `[output]` (optional; snapshots, see docs/results-format.md)",
 }
 
 
@@ -242,6 +243,12 @@ FIELDS: tuple[Field, ...] = (
       rule="> 0, relative drift/scatter bound"),
     F("solver.pretension", "pretension", "bool", "", True, ours=True,
       rule="start from the rope solution's tension profile near contact equilibrium"),
+    # ---- output
+    F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
+      rule="array of times in [0, `solver.end_time`]: the whole state is written at each "
+           "(interpolated between solver steps)"),
+    F("output.snapshot_interval", "snapshot_interval_s", "float", "s", None, gt=0.0, ours=True,
+      default_doc="none", rule="> 0: also a snapshot at every multiple of it up to `solver.end_time`"),
 )
 del F
 

@@ -88,11 +88,15 @@ def solver_settings(solver_spec) -> exu.SimulationSettings:
     return s
 
 
-def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None) -> SolveOutcome:
+def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None,
+             snapshots=None) -> SolveOutcome:
     """Integrate ``model`` to the scenario's end time (or to a steady pulling force).
 
     Records with the model's :class:`~exucable.model.recorder.Recorder`; a post-step function
     already set on ``model.mbs`` is called after it each step and set back afterwards.
+    ``snapshots`` (an :class:`exucable.snapshots.SnapshotRecorder`, optional) is fed the state at
+    the end of every step.
+
     Never raises for a diverging run: the outcome has ``status == "failed"``, the simulated time
     where it happened, and the history recorded until then.
     """
@@ -107,6 +111,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     users = previous.get("function") if isinstance(previous, dict) else (previous or None)
 
     def post_step(mbs, t):
+        if snapshots is not None:
+            snapshots.step(t, model.pull_force_N(t))
         go_on = recorder(mbs, t)
         if users is not None:
             go_on = (users(mbs, t) is not False) and go_on

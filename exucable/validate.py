@@ -131,7 +131,7 @@ def validate(fast: bool = False, out_dir="validation", quiet: bool = True, cases
         slope = ref["example1"]["tension_slope_N_per_m"]
         vr.checks.append(Check("Ex. 1", "pulling force at the top end [N]", r.summary["pull_force_N"], T50,
                                _tol("ex1_top", fast), note="Eq. 25"))
-        x = np.asarray(r.tension_profile["s_m"])
+        x = np.asarray(r.tension_profile["x_m"])
         N = np.asarray(r.tension_profile["tension_N"])
         worst = float(np.max(np.abs(N - slope * x)))
         vr.checks.append(Check("Ex. 1", "max |T(x) - Eq. 25| along the cable / T(50 m)", T50 + worst, T50,

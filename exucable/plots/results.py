@@ -38,11 +38,11 @@ def plot_tension_profile(path, result) -> None:
     p = result.tension_profile
     fig = new_figure(figsize=(7, 4))
     ax = fig.subplots()
-    ax.plot(p["s_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
+    ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
     rp = result.rope_profile
-    if rp is not None and "s_cable_m" in result.extras:
-        ax.plot(result.extras["s_cable_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
-    ax.set_xlabel("arc length from the trailing end [m]")
+    if rp is not None and "x_m" in result.extras:
+        ax.plot(result.extras["x_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
+    ax.set_xlabel("x: material coordinate from the trailing end [m]")
     ax.set_ylabel("tension [N]")
     ax.set_title(f"{result.summary.get('name', '')}: tension along the cable")
     ax.grid(alpha=0.3)

@@ -38,7 +38,7 @@ def plot_validation_figures(vr, out, ref: dict | None = None) -> list:
     if r is not None:
         fig = new_figure(figsize=(7, 4))
         ax = fig.subplots()
-        x = np.asarray(r.tension_profile["s_m"])
+        x = np.asarray(r.tension_profile["x_m"])
         ax.plot(x, r.tension_profile["tension_N"], ".", ms=3, label="exucable")
         xs = np.linspace(0, x.max(), 50)
         ax.plot(xs, ref["example1"]["tension_slope_N_per_m"] * xs, "k-", lw=1, label="Eq. 25")
