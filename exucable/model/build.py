@@ -21,7 +21,7 @@ from ..tension import tension_at
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, InitialLayout, initial_layout
 from .recorder import Recorder
-from .rig import Drive, add_drive, add_end_force, add_guide, add_reel, add_tangential_drive, smooth_ramp
+from .rig import Drive, Guide, add_drive, add_end_force, add_guide, add_reel, add_tangential_drive, smooth_ramp
 
 if TYPE_CHECKING:  # names for the annotations only
     from ..contact import ContactKernel
@@ -88,8 +88,8 @@ class CableInConduit:
     coupling, kernel
         The contact coupling (an ObjectGenericODE2 over the cable nodes) and its kernel.
     startup_damper : StartupDamper or None
-    guide : int or None
-        Object index of the force-controlled pull's sheave.
+    guide : Guide or None
+        The force-controlled pull's sheave.
     recorder : Recorder
         Call ``recorder(mbs, t)`` from your post-step function; ``recorder.history`` holds the
         pulling force, trailing and maximum tension at ``solver.output_interval``.
@@ -112,7 +112,7 @@ class CableInConduit:
     coupling: ContactCoupling | None = None
     kernel: ContactKernel | None = None
     startup_damper: StartupDamper | None = None
-    guide: int | None = None
+    guide: Guide | None = None
     recorder: Recorder | None = None
     _ode2_index: np.ndarray | None = field(default=None)
 
@@ -351,7 +351,8 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
             # the sheave of a force-controlled pull: lateral stiffness of the contact law's order at
             # its working point (1e6 N/m), damped near-critically for the end node's mass
             h.guide = add_guide(mbs, lead_node, t_exit, 1.0e6,
-                                2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / c.elements))
+                                2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / c.elements),
+                                node_index=len(cable.nodes) - 1)
     sp = sc.solver
     h.recorder = Recorder(h, sp.output_interval_s, sp.steady_stop, sp.steady_window_s, sp.steady_tolerance)
     return h

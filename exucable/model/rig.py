@@ -18,7 +18,7 @@ from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, MarkerN
                                   MarkerNodeCoordinates, MarkerNodePosition, NodePointGround, ObjectGenericODE2,
                                   ObjectConnectorCoordinateVector)
 
-__all__ = ["Drive", "add_guide", "add_reel", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
+__all__ = ["Drive", "Guide", "add_guide", "add_reel", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
            "smooth_ramp", "ramped_displacement"]
 
 
@@ -108,14 +108,37 @@ def add_end_force(mbs, node: int, force_vector_N, factor: Callable[[float], floa
 
 
 
-def add_guide(mbs, node: int, direction, stiffness_N_per_m: float, damping_N_s_per_m: float) -> int:
+@dataclass(frozen=True)
+class Guide:
+    """The sheave of a force-controlled pull (see :func:`add_guide`).
+
+    Attributes
+    ----------
+    object : int
+        Exudyn object index.
+    node_index : int
+        Index of the guided node within the cable (0 = trailing end).
+    k : float
+        Lateral stiffness [N/m].
+    c : float
+        Lateral damping [N s/m].
+    """
+
+    object: int
+    node_index: int
+    k: float
+    c: float
+
+
+def add_guide(mbs, node: int, direction, stiffness_N_per_m: float, damping_N_s_per_m: float,
+              node_index: int = -1) -> Guide:
     """A sheave on the exit tangent for a force-controlled pull: ``node`` is held near the line
     through its start position along unit ``direction`` d by a stiff lateral spring-damper
     (force −k·P·u − c·P·v with P = I − d dᵀ, u its displacement), free to move along it.
 
     A mass-free ``ObjectGenericODE2`` on the node with constant stiffness k·P and damping c·P
     (Exudyn 1.13's ObjectConnectorCoordinateVector enforced only the first of two such rows in
-    our tests). Returns its object index.
+    our tests). ``node_index`` is the node's index within the cable (for the record).
     """
     d = np.asarray(direction, dtype=float)
     d = d / np.linalg.norm(d)
@@ -128,10 +151,11 @@ def add_guide(mbs, node: int, direction, stiffness_N_per_m: float, damping_N_s_p
     M.Initialize(6, 6, False)
     Kc.SetWithDenseMatrix(K, False)
     Dc.SetWithDenseMatrix(D, False)
-    return mbs.AddObject(ObjectGenericODE2(
+    obj = mbs.AddObject(ObjectGenericODE2(
         nodeNumbers=[node], massMatrix=M, stiffnessMatrix=Kc, dampingMatrix=Dc,
         visualization={"show": False, "color": [-1.0, -1.0, -1.0, -1.0], "triangleMesh": [],
                        "showNodes": False, "graphicsDataUserFunction": 0}))
+    return Guide(object=obj, node_index=int(node_index), k=float(stiffness_N_per_m), c=float(damping_N_s_per_m))
 
 
 @dataclass(frozen=True)
