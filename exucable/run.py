@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import ModelError
 from .versions import versions
 from .export import conduit_s
 from .results import RunResult, write_results
@@ -58,9 +59,12 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
     """
     from .model.build import build_model
-    from .solve import Progress, simulate, steady_quantity  # Exudyn: only when a run is asked for
+    from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if sc.cable.count != 1:
+        raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
+                                        "plan several cables per duct with `exucable plan`")
     t_start = time.perf_counter()
     model = build_model(sc)
     build_s = time.perf_counter() - t_start
@@ -73,8 +77,11 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
     h = out.history.arrays()
     sp = sc.solver
-    st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
+    drift = expected_drift_N_per_s(model)
+    st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
+                             expected_drift_N_per_s=drift)
     i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
+    refs = window_references(sc, model, h["time_s"][i0:])
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
     cprof, peak_pressure = contact_profile(model)
@@ -84,7 +91,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "status": out.status,
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
-        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+        # scatter about the drift the cable's changing extent explains (none without gravity)
+        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
+        if len(h["time_s"]) else None,
+        "reference_drift_N_per_s": drift,
         "steady_quantity": steady_quantity(model),
         "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
@@ -99,9 +109,11 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "build_time_s": build_s,
         "kernel_time_s": model.coupling.kernel_time_s if model.coupling is not None else 0.0,
         "max_sidewall_pressure_N_per_m": peak_pressure,
-        "rope_pull_force_N": rope.pull_force_N if rope is not None else None,
+        "rope_pull_force_N": refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        "rope_clearance_pull_force_N": refs.get("rope_clearance_pull_force_N"),
+        "reference_pulled_out_m": refs.get("pulled_out_m"),
         "scenario": sc.to_dict(),
         "versions": versions(),
     }
@@ -127,3 +139,17 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         write_results(out_dir, result, plots=plots)
     return result
 
+
+def window_references(scenario, model, window_time_s) -> dict:
+    """Both flexible references (:mod:`exucable.references`) for the cable's extent at the mean
+    time of the averaging window ``window_time_s`` [s] of a velocity-controlled pull; ``{}`` for a
+    force-controlled one (its references are the model's centreline rope)."""
+    from .model.rig import ramped_displacement
+    from .references import pull_force_references_N
+
+    sc = scenario
+    if sc.pull.force_N is not None or len(window_time_s) == 0:
+        return {}
+    t_mean = float(np.mean(window_time_s))
+    out = ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s)
+    return pull_force_references_N(sc, model.conduit, out)

@@ -11,13 +11,15 @@ from __future__ import annotations
 import sys
 import time
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 import exudyn as exu
 
-from .model.recorder import History, Recorder, record_state, steady_quantity
+from .model.recorder import History, Recorder, expected_drift_N_per_s, record_state, steady_quantity
 
-__all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "Progress"]
+__all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "expected_drift_N_per_s",
+           "Progress"]
 
 
 @dataclass
@@ -25,7 +27,7 @@ class SolveOutcome:
     """What the integration did."""
 
     history: History
-    status: str                  # "ok" | "steady" (stopped early) | "failed"
+    status: Literal["ok", "steady", "failed"]  # "steady": stopped early, once steady
     message: str
     end_time_s: float            # simulated time reached [s]
     steps: int

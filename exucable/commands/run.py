@@ -43,6 +43,9 @@ def main(args) -> int:
         ref, got, what = rope, s["pull_force_N"], "pulling force"
     if ref is not None and got is not None and np.isfinite(got):
         print(f"  rope reference: {what} {ref:.6g} N ({100 * (got / ref - 1):+.3f} %)")
+    ref_c = s.get("rope_clearance_pull_force_N")
+    if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
+        print(f"  rope with clearance: pulling force {ref_c:.6g} N ({100 * (got / ref_c - 1):+.3f} %)")
     print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
           f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")

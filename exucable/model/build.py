@@ -17,6 +17,7 @@ import exudyn as exu
 from exudyn.itemInterface import MarkerNodePosition, ObjectJointSpherical
 
 from ..errors import ModelError, ScenarioError
+from ..references import reference_drift_N_per_s
 from ..tension import tension_at
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, InitialLayout, initial_layout
@@ -114,6 +115,8 @@ class CableInConduit:
     startup_damper: StartupDamper | None = None
     guide: Guide | None = None
     recorder: Recorder | None = None
+    # how fast the flexible reference's pulling force moves as the cable leaves its conduit [N/s]
+    reference_drift_N_per_s: float = 0.0
     _ode2_index: np.ndarray | None = field(default=None)
 
     def __repr__(self) -> str:
@@ -353,6 +356,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
             h.guide = add_guide(mbs, lead_node, t_exit, 1.0e6,
                                 2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / c.elements),
                                 node_index=len(cable.nodes) - 1)
+    h.reference_drift_N_per_s = reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s)
     sp = sc.solver
     h.recorder = Recorder(h, sp.output_interval_s, sp.steady_stop, sp.steady_window_s, sp.steady_tolerance)
     return h

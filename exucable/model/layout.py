@@ -98,6 +98,8 @@ def contact_offsets(
     line_stiffness_N_per_m_e_per_m: float,
     exponent: float,
     blend_length_m: float,
+    path_offset_m: np.ndarray | None = None,
+    path_pressure_N_per_m: np.ndarray | None = None,
 ) -> np.ndarray:
     """Offset of the cable axis from the conduit axis at rest on its bearing wall.
 
@@ -123,6 +125,10 @@ def contact_offsets(
         Hertz exponent e [-].
     blend_length_m : float
         Smoothing length [m].
+    path_offset_m, path_pressure_N_per_m : ndarray (m, 3) and (m,), optional
+        The path and wall pressure of the rope with clearance on the grid
+        (:mod:`exucable.rope_clearance`); when given, the cable starts on that path (free spans
+        included) instead of on the wall the centreline rope's load points to.
 
     Returns
     -------
@@ -136,12 +142,17 @@ def contact_offsets(
     w_perp = weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
     load = np.asarray(tension_N, dtype=float)[:, None] * kn - w_perp
     p = np.linalg.norm(load, axis=1)
+    off = np.zeros_like(load)
+    if path_offset_m is not None:
+        p = np.asarray(path_pressure_N_per_m, dtype=float)
+        load = np.asarray(path_offset_m, dtype=float)   # only its direction is used where loaded
+        off = load.copy()
     scale = max(p.max(), 1e-300)
     loaded = p > 1e-9 * scale
-    off = np.zeros_like(load)
     if loaded.any():
         delta = (p[loaded] / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent)
-        off[loaded] = load[loaded] / p[loaded, None] * (clearance_m + delta)[:, None]
+        size = np.maximum(np.linalg.norm(load[loaded], axis=1), 1e-300)
+        off[loaded] = load[loaded] / size[:, None] * (clearance_m + delta)[:, None]
     ds = s[1] - s[0] if len(s) > 1 else 1.0
     sigma = blend_length_m / ds
     if sigma > 0.5 and loaded.any():
@@ -338,6 +349,21 @@ class InitialLayout:
         return self.cable.position_m[0].copy()
 
 
+def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: float):
+    """The rope with clearance for the start of a velocity-controlled pull, or None (force-controlled,
+    no clearance, or a cable that runs slack somewhere)."""
+    from ..errors import ModelError
+    from ..rope_clearance import solve_rope_with_clearance
+
+    if scenario.pull.force_N is not None or clearance_m <= 0.0:
+        return None
+    try:
+        return solve_rope_with_clearance(centreline, clearance_m, scenario.contact.friction, w_N_per_m,
+                                         scenario.pull.back_tension_N, cable_length_m=scenario.cable_length_m)
+    except ModelError:
+        return None
+
+
 def initial_layout(scenario, with_contact: bool = True) -> InitialLayout:
     """The start state of ``scenario``'s cable, without Exudyn.
 
@@ -380,12 +406,22 @@ def initial_layout(scenario, with_contact: bool = True) -> InitialLayout:
         # half an element so the nodes can follow it
         T_ref = max(float(np.max(rope.tension_N)), 1e-6)
         blend = max(0.5 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
+        free = _clearance_rope_start(sc, centre, w, clearance) if with_contact else None
+        path = {}
+        if free is not None:
+            # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
+            # free spans across the clearance, and a start pressed onto the wall the centreline rope's
+            # load points to rang for a second as those spans formed (issue 10, item 3).
+            T_grid = np.interp(s_grid, free.s_conduit_m, free.tension_N)
+            path = {"path_offset_m": np.stack([np.interp(s_grid, free.s_conduit_m, free.offset_m[:, j])
+                                               for j in range(3)], axis=1),
+                    "path_pressure_N_per_m": np.interp(s_grid, free.s_conduit_m, free.sidewall_pressure_N_per_m)}
         off = contact_offsets(centre, s_grid, T_grid, w, clearance,
                               sc.contact.stiffness / sc.contact.reference_spacing_m,
-                              sc.contact.exponent, blend) if with_contact else np.zeros((len(s_grid), 3))
+                              sc.contact.exponent, blend, **path) if with_contact else np.zeros((len(s_grid), 3))
 
         def tension_fn(s):
-            return np.interp(s, rope.s_conduit_m, rope.tension_N, left=rope.tension_N[0], right=rope.tension_N[-1])
+            return np.interp(s, s_grid, T_grid)
 
         def offset_fn(s):
             return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..tension import detect_steady_state, tension_at, tension_profile
 
-__all__ = ["History", "Recorder", "record_state", "steady_quantity"]
+__all__ = ["History", "Recorder", "expected_drift_N_per_s", "record_state", "steady_quantity"]
 
 
 @dataclass
@@ -32,6 +32,14 @@ def steady_quantity(cable) -> str:
     """The history column whose steadiness ends a run: the pulling force, or for a
     force-controlled pull (whose pulling force is given) the trailing tension."""
     return "trailing_tension_N" if cable.applied_pull_force_N is not None else "pull_force_N"
+
+
+def expected_drift_N_per_s(cable) -> float:
+    """The drift the steady detector takes off the steady quantity [N/s]: the flexible reference's,
+    as the cable leaves its conduit (pulling force of a velocity-controlled pull), else 0."""
+    if steady_quantity(cable) != "pull_force_N":
+        return 0.0
+    return float(getattr(cable, "reference_drift_N_per_s", 0.0))
 
 
 def record_state(cable, t: float, history: History) -> None:
@@ -97,7 +105,8 @@ class Recorder:
             self.progress(t, f"F = {self.history.pull_force_N[-1]:.4g} N")
         if self.steady_stop and t >= self.steady_window_s:
             st = detect_steady_state(self.history.time_s, getattr(self.history, steady_quantity(self.cable)),
-                                     self.steady_window_s, self.steady_tolerance)
+                                     self.steady_window_s, self.steady_tolerance,
+                                     expected_drift_N_per_s=expected_drift_N_per_s(self.cable))
             if st.steady:
                 self.stopped_steady = True
                 return False
