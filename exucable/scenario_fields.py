@@ -6,10 +6,10 @@ Every key of a scenario is one :class:`Field` row in :data:`FIELDS`. The row dri
   default, the dotted key and unit in every error message;
 - ``to_dict`` of each spec dataclass (the TOML name of each attribute);
 - the key tables of ``scenarios/README.md``: :func:`markdown_table` renders them and a test
-  checks the README against it (``python -m exucable.scenario_fields`` rewrites them).
+  checks the README against it (``python -m exucable.commands.key_tables`` rewrites them).
 
 To add a key: add a row here, the attribute to the section's dataclass, and rerun
-``python -m exucable.scenario_fields`` to update the README. Cross-field rules (e.g.
+``python -m exucable.commands.key_tables`` to update the README. Cross-field rules (e.g.
 ``static_friction >= friction``) live in the dataclass's ``_check`` method; keys whose value is
 not a scalar (the conduit route) are ``kind="custom"`` and parsed by hand.
 """
