@@ -1,6 +1,6 @@
 """A friction sweep in Python: one Scenario, friction varied, pulling force against the capstan law.
 
-``xc.sweep`` runs the cases one after another and returns (parameters, Result) pairs; for many
+``xc.vary`` runs the cases one after another and returns (parameters, Result) pairs; for many
 cases in parallel with results on disk, use ``exucable sweep`` with a sweep file.
 The figure is drawn on a matplotlib ``Figure`` of its own (no pyplot, the backend is untouched).
 """
@@ -18,7 +18,7 @@ def main(frictions=(0.0, 0.1, 0.2, 0.3, 0.4), end_time=0.5, out="friction_sweep.
     route = xc.Route(inner_radius=3.5e-3).straight(1.0).bend(90, radius=0.5, turn="left").straight(1.0)
     base = xc.Scenario(route=route, cable=xc.Cable(radius=2.5e-3, density=1000.0, youngs_modulus=1e9),
                        pull=xc.Pull(speed=0.1, back_tension=150.0), solver=xc.Solver(end_time=end_time))
-    runs = xc.sweep(base, {"contact.friction": list(frictions)})
+    runs = xc.vary(base, {"contact.friction": list(frictions)})
     mu = np.array([p["contact.friction"] for p, _ in runs])
     force = np.array([r.pull_force_N for _, r in runs])
     error = np.array([r.pull_force_uncertainty_N for _, r in runs])

@@ -17,13 +17,11 @@ Importing exucable imports neither Exudyn nor matplotlib and changes no global s
 
 from .version import __version__
 
-# The submodules exucable.run and exucable.sweep first: importing one after the function of the
-# same name below would rebind the package attribute to the module (Python sets it when a
-# submodule is first loaded). Both are light (no Exudyn, matplotlib or dask at import).
+# The submodule exucable.run first: importing it after the function of the same name below would
+# rebind the package attribute to the module (Python sets it when a submodule is first loaded).
+# It is light (no Exudyn, matplotlib or dask at import).
 from . import run as _run_module  # noqa: F401
-from . import sweep as _sweep_package  # noqa: F401
-from .api import (Cable, Contact, Gravity, History, Output, Pull, Result, Route, Solver, TensionProfile, run,
-                  sweep)
+from .api import (Cable, Contact, Gravity, History, Output, Pull, Result, Route, Solver, TensionProfile, run, vary)
 from .errors import ExucableError, GeometryError, ModelError, ScenarioError, SolverError
 from .scenario import Scenario, load_scenario
 
@@ -44,7 +42,7 @@ def __getattr__(name):
 __all__ = [
     "__version__",
     "Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Output", "Scenario", "load_scenario",
-    "run", "sweep", "Result", "History", "TensionProfile",
+    "run", "vary", "Result", "History", "TensionProfile",
     "add_cable_in_conduit", "CableInConduit", "JoinToMarker", "ReelOnto", "initial_layout", "InitialLayout",
     "ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError",
 ]

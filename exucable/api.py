@@ -34,7 +34,7 @@ from .scenario_fields import REQUIRED, fields_of
 if TYPE_CHECKING:  # for the annotation only: Exudyn is imported when a run is asked for
     from .model.build import Model
 
-__all__ = ["Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Output", "run", "sweep", "Result", "History",
+__all__ = ["Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Output", "run", "vary", "Result", "History",
            "TensionProfile"]
 
 
@@ -320,13 +320,15 @@ def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False) -
     )
 
 
-def sweep(scenario: Scenario, vary: dict[str, Sequence], progress: bool = False) -> list[tuple[dict, Result]]:
-    """Run ``scenario`` for every combination of the values in ``vary``, one after another.
+def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False) -> list[tuple[dict, Result]]:
+    """Run ``scenario`` for every combination of ``values``, one after another (a Python sweep).
+
+    Named ``vary`` because ``exucable.sweep`` is the package of sweep files (``exucable sweep``).
 
     Parameters
     ----------
     scenario : Scenario
-    vary : dict
+    values : dict
         Dotted key → values, e.g. ``{"contact.friction": [0.1, 0.2, 0.3]}``; the first key varies slowest.
     progress : bool
         Progress bar of each run.
@@ -338,7 +340,7 @@ def sweep(scenario: Scenario, vary: dict[str, Sequence], progress: bool = False)
         (``Scenario.replace``) before the first one runs. For many cases in parallel, with
         results on disk and restarts, use ``exucable sweep``.
     """
-    keys = list(vary)
-    params = [dict(zip(keys, values)) for values in itertools.product(*(vary[k] for k in keys))]
+    keys = list(values)
+    params = [dict(zip(keys, combo)) for combo in itertools.product(*(values[k] for k in keys))]
     cases = [scenario.replace(**p) for p in params]
     return [(p, run(c, progress=progress)) for p, c in zip(params, cases)]

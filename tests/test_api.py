@@ -14,7 +14,7 @@ from exucable.closed_forms import capstan_out_N
 
 def test_exports():
     for name in ("Route", "Cable", "Contact", "Pull", "Gravity", "Solver", "Scenario", "run", "load_scenario",
-                 "sweep", "Result", "ScenarioError"):
+                 "vary", "Result", "ScenarioError"):
         assert name in xc.__all__ and hasattr(xc, name)
 
 
@@ -120,5 +120,5 @@ def test_import_changes_no_matplotlib_backend():
 def test_run_and_sweep_stay_functions_after_the_submodules_are_imported():
     import exucable.run  # noqa: F401  (modules of the same names as the functions)
     import exucable.sweep  # noqa: F401
-    from exucable.api import run, sweep
-    assert xc.run is run and xc.sweep is sweep
+    from exucable.api import run, vary
+    assert xc.run is run and xc.vary is vary
