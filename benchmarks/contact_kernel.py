@@ -123,7 +123,7 @@ def main():
     segments = Segments(verts, s_verts, R_CONDUIT)
     rng = np.random.default_rng(4)
     q, q_t, length = cable_state(at, total, rng)
-    law = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.3)
+    law = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.3, damping_onset_m=0.0)  # Eq. 18
     n_points = N_ELEMENTS * CHECK_POINTS
     print(f"Example-4-size case: {N_ELEMENTS} elements x {CHECK_POINTS} check points = {n_points} "
           f"points, {segments.count} segments, route {total:.2f} m")

@@ -59,7 +59,7 @@ import exudyn as exu
 import exucable.contact as contact
 from exucable.scenario import parse_scenario
 from exucable.model.build import build_model
-from exucable.solve import History, record_state
+from exucable.model.recorder import History, record_state
 
 # the numpy reference kernel (force and exact sparse Jacobian), not the compiled one
 contact.ContactKernel = functools.partial(contact.ContactKernel, backend="numpy")

@@ -81,8 +81,8 @@ def problem_description(model) -> dict:
                              "or the last one's end: no contact; surface 'smooth': refined onto that "
                              "segment's piece, continued along the piece's end tangent beyond its ends",
         }
-    damper = model.coupling.damper if model.coupling is not None else None
-    guide = model.coupling.guide if model.coupling is not None else None
+    damper = model.startup_damper
+    guide = model.guide
     rig = {
         "controlled": "speed" if model.lead_drive is not None else "force",
         "leading_node": model.layout.n_elements,

@@ -56,6 +56,7 @@ class RunResult:
     bends: list | None = None                # BEND_COLUMNS rows (exucable.pressure)
     pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
     snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.snapshots)
+    model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
 
 
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:

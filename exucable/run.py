@@ -16,7 +16,6 @@ from .versions import versions
 from .export import conduit_s
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
-from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity
 from .pressure import bend_table, default_window_m, pressure_profile
 from .tension import detect_steady_state, tension_at, tension_profile
 from .trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
@@ -140,6 +139,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     scenario's (``exucable converge``).
     """
     from .model.build import build_model
+    from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if sc.cable.count != 1:
@@ -241,7 +241,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     result = RunResult(summary=summary, history=h, tension_profile={"x_m": x, "tension_N": N},
                        contact_profile=cprof, rope_profile=rope_profile, extras=extras,
                        snapshots=recorder.tables() if recorder is not None else None,
-                       bends=bends, pressure_profile=pressure_prof)
+                       bends=bends, pressure_profile=pressure_prof, model=model)
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result

@@ -30,8 +30,8 @@ from dataclasses import InitVar, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
-from exucable import engineering as _eng
-from exucable import geometry as _geo
+import exucable.engineering as _eng
+import exucable.geometry as _geo
 from exucable.errors import GeometryError, ScenarioError
 from exucable.scenario_fields import FIELDS, REQUIRED, Field, fields_of
 

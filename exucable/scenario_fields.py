@@ -6,10 +6,10 @@ Every key of a scenario is one :class:`Field` row in :data:`FIELDS`. The row dri
   default, the dotted key and unit in every error message;
 - ``to_dict`` of each spec dataclass (the TOML name of each attribute);
 - the key tables of ``scenarios/README.md``: :func:`markdown_table` renders them and a test
-  checks the README against it (``python -m exucable.scenario_fields`` rewrites them).
+  checks the README against it (``python -m exucable.commands.key_tables`` rewrites them).
 
 To add a key: add a row here, the attribute to the section's dataclass, and rerun
-``python -m exucable.scenario_fields`` to update the README. Cross-field rules (e.g.
+``python -m exucable.commands.key_tables`` to update the README. Cross-field rules (e.g.
 ``static_friction >= friction``) live in the dataclass's ``_check`` method; keys whose value is
 not a scalar (the conduit route) are ``kind="custom"`` and parsed by hand.
 """
@@ -21,8 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-
-__all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "markdown_table", "format_default",
+__all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "default_of", "markdown_table", "format_default",
            "readme_with_tables"]
 
 
@@ -295,6 +294,17 @@ FIELDS: tuple[Field, ...] = (
       rule="unit system of bare numbers in the file and of printed tables (see above); results files stay SI"),
 )
 del F
+
+
+def default_of(key: str):
+    """The default of ``key`` (e.g. ``"contact.damping_onset"``), so that building blocks below
+    the scenario layer default to the validated values."""
+    for f in FIELDS:
+        if f.key == key:
+            if f.default is REQUIRED:
+                raise KeyError(f"{key} has no default")
+            return f.default
+    raise KeyError(key)
 
 
 def fields_of(section: str) -> tuple[Field, ...]:

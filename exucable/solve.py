@@ -10,33 +10,16 @@ from __future__ import annotations
 
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 import exudyn as exu
 
-from .tension import detect_steady_state, tension_at, tension_profile
-from .trust import AxisGauge, cable_sample_points
+from .model.recorder import History, Recorder, expected_drift_N_per_s, steady_quantity
 
 __all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "expected_drift_N_per_s",
            "Progress"]
-
-
-@dataclass
-class History:
-    """Time histories saved at the output interval."""
-
-    time_s: list = field(default_factory=list)
-    pull_force_N: list = field(default_factory=list)
-    trailing_tension_N: list = field(default_factory=list)
-    max_tension_N: list = field(default_factory=list)
-    max_penetration_m: list = field(default_factory=list)
-    max_axis_offset_m: list = field(default_factory=list)
-    max_axis_offset_s_conduit_m: list = field(default_factory=list)
-
-    def arrays(self) -> dict[str, np.ndarray]:
-        return {k: np.asarray(v, dtype=float) for k, v in self.__dict__.items()}
 
 
 @dataclass
@@ -114,55 +97,12 @@ def solver_settings(solver_spec) -> exu.SimulationSettings:
     return s
 
 
-def steady_quantity(model) -> str:
-    """The history column whose steadiness ends a run: the pulling force, or for a
-    force-controlled pull (whose pulling force is given) the trailing tension."""
-    return "trailing_tension_N" if model.applied_pull_force_N is not None else "pull_force_N"
-
-
-def record_state(model, t: float, history: History, gauge=None) -> None:
-    """Append the current pulling force, trailing tension and maximum tension to ``history``, and
-    (with a contact kernel) the largest penetration [m] and the cable axis's largest distance from
-    the conduit's axis [m] with its place s [m] along the scenario's conduit (``gauge``:
-    :class:`exucable.trust.AxisGauge` of the pull-oriented conduit)."""
-    q, _ = model.coordinates()
-    EA = model.axial_stiffness_N
-    _, N = tension_profile(q, model.layout.element_length_m, EA, points_per_element=2)
-    trail = model.trailing_reaction_N()
-    if trail is None:
-        trail = float(tension_at(q, model.layout.element_length_m, EA, [0.0])[0])
-    history.time_s.append(float(t))
-    history.pull_force_N.append(model.pull_force_N(t))
-    history.trailing_tension_N.append(float(trail))
-    history.max_tension_N.append(float(np.max(N)))
-    pen = offset = s_off = float("nan")
-    if model.kernel is not None:
-        _, v = model.coordinates()
-        pen = float(model.kernel.evaluate(q.reshape(-1), v.reshape(-1)).max_penetration_m)
-        if gauge is not None:
-            d, s = gauge(cable_sample_points(q, model.layout.element_length_m))
-            # beyond the conduit's ends the cable is free (feed, pulling line): not the wall's business
-            d = np.where((s >= 0.0) & (s <= gauge.length_m), d, -np.inf)
-            i = int(np.argmax(d))
-            offset = float(d[i]) if np.isfinite(d[i]) else float("nan")
-            s_off = float(s[i]) if model.scenario.pull.direction != "reverse" else float(gauge.length_m - s[i])
-    history.max_penetration_m.append(pen)
-    history.max_axis_offset_m.append(offset)
-    history.max_axis_offset_s_conduit_m.append(s_off)
-
-
-def expected_drift_N_per_s(model) -> float:
-    """The drift the steady detector takes off the steady quantity [N/s]: the flexible reference's,
-    as the cable leaves its conduit (pulling force of a velocity-controlled pull), else 0."""
-    if steady_quantity(model) != "pull_force_N":
-        return 0.0
-    return float(getattr(model, "reference_drift_N_per_s", 0.0))
-
-
 def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None,
              snapshots=None) -> SolveOutcome:
     """Integrate ``model`` to the scenario's end time (or to a steady pulling force).
 
+    Records with the model's :class:`~exucable.model.recorder.Recorder`; a post-step function
+    already set on ``model.mbs`` is called after it each step and set back afterwards.
     ``snapshots`` (an :class:`exucable.snapshots.SnapshotRecorder`, optional) is fed the state at
     the end of every step.
 
@@ -171,53 +111,44 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     """
     sp = model.scenario.solver
     steady_stop = sp.steady_stop if steady_stop is None else steady_stop
-    history = History()
-    gauge = AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m) if model.kernel is not None else None
-    out_dt = sp.output_interval_s
-    next_out = [0.0]
-    stopped_steady = [False]
-    # nothing is recorded at t = 0: the rig's reaction (a Lagrange multiplier) exists only
-    # once a step has been solved
-    next_out[0] = out_dt
+    recorder = Recorder(model, sp.output_interval_s, steady_stop, sp.steady_window_s, sp.steady_tolerance,
+                        progress=progress.update if progress is not None else None)
+    history = recorder.history
+    mbs = model.mbs
+    # Exudyn 1.13 returns {"function": f, "type": "Python"} for a set function, 0 for none
+    previous = mbs.GetPostStepUserFunction()
+    users = previous.get("function") if isinstance(previous, dict) else (previous or None)
 
     def post_step(mbs, t):
         if snapshots is not None:
             snapshots.step(t, model.pull_force_N(t))
-        if t >= next_out[0] - 1e-12 * max(1.0, t):
-            record_state(model, t, history, gauge)
-            next_out[0] = (np.floor(t / out_dt + 1e-9) + 1.0) * out_dt
-            if progress is not None:
-                progress.update(t, f"F = {history.pull_force_N[-1]:.4g} N")
-            if steady_stop and t >= sp.steady_window_s:
-                st = detect_steady_state(history.time_s, getattr(history, steady_quantity(model)),
-                                         sp.steady_window_s, sp.steady_tolerance,
-                                         expected_drift_N_per_s=expected_drift_N_per_s(model))
-                if st.steady:
-                    stopped_steady[0] = True
-                    return False
-        return True
+        go_on = recorder(mbs, t)
+        if users is not None:
+            go_on = (users(mbs, t) is not False) and go_on
+        return go_on
 
-    model.mbs.SetPostStepUserFunction(post_step)
+    mbs.SetPostStepUserFunction(post_step)
     solver = exu.MainSolverImplicitSecondOrder()
     settings = solver_settings(sp)
     t0 = time.perf_counter()
     status, message = "ok", ""
     try:
-        ok = solver.SolveSystem(model.mbs, settings)
-        if not ok and not stopped_steady[0]:
+        ok = solver.SolveSystem(mbs, settings)
+        if not ok and not recorder.stopped_steady:
             status, message = "failed", (solver.GetErrorString() or "the solver did not converge")
     except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
         status, message = "failed", f"{type(exc).__name__}: {exc}".strip()
+    finally:
+        mbs.SetPostStepUserFunction(users if users is not None else 0)
     wall = time.perf_counter() - t0
     t_end = float(solver.it.currentTime)
-    if stopped_steady[0] and status == "ok":
+    if recorder.stopped_steady and status == "ok":
         status = "steady"
     if status != "failed" and (not history.time_s or history.time_s[-1] < t_end - 1e-12):
-        record_state(model, t_end, history, gauge)
+        recorder.record(t_end)
     if progress is not None:
         progress.update(t_end)
         progress.close()
-    model.mbs.SetPostStepUserFunction(0)
     return SolveOutcome(history=history, status=status, message=message, end_time_s=t_end,
                         steps=int(solver.it.currentStepIndex), newton_iterations=int(solver.it.newtonStepsCount),
                         jacobian_updates=int(solver.it.newtonJacobiCount), wall_time_s=wall)

@@ -107,7 +107,7 @@ def test_exudyn_ancf_cable_mini_example_through_our_builder():
     coords[:, 0] = x
     coords[:, 3] = 1.0
     props = CableProperties(mass_per_length_kg_per_m=78.0, axial_stiffness_N=1.0e6,
-                            bending_stiffness_N_m2=833.3333333333333)
+                            bending_stiffness_N_m2=833.3333333333333, integration="full")  # as Exudyn's example
     cable = add_cable(mbs, coords, np.diff(x), props)
     add_gravity(mbs, cable, [0.0, -9.81, 0.0])
     from exudyn.itemInterface import CoordinateConstraint, MarkerNodeCoordinate, NodePointGround

@@ -35,11 +35,12 @@ GAP = R_CONDUIT - R_CABLE
 
 BACKENDS = ["numpy", "numba"]
 
-SLIDING = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.3)
-STATIC = ContactLaw(stiffness=1e6, damping=50.0, exponent=1.5, friction=0.2, static_friction=0.35,
+# damping_onset_m=0: the paper's Eq. 18 as written, which the reference loops below implement
+SLIDING = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.3, damping_onset_m=0.0)
+STATIC = ContactLaw(stiffness=1e6, damping=50.0, exponent=1.5, friction=0.2, static_friction=0.35, damping_onset_m=0.0,
                     stribeck_velocity_m_per_s=0.05, regularisation_velocity_m_per_s=1e-3)
-LINEAR = ContactLaw(stiffness=2e5, damping=0.0, exponent=1.0, friction=0.1)
-GENERIC = ContactLaw(stiffness=5e6, damping=20.0, exponent=1.3, friction=0.25)
+LINEAR = ContactLaw(stiffness=2e5, damping=0.0, exponent=1.0, friction=0.1, damping_onset_m=0.0)
+GENERIC = ContactLaw(stiffness=5e6, damping=20.0, exponent=1.3, friction=0.25, damping_onset_m=0.0)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -477,7 +478,7 @@ def test_jacobian_without_friction_normal_coupling_is_wrong():
     route, law, q, q_t, L, _, _ = fd_case("sliding")
     k = ContactKernel(route.segments, L, R_CABLE, law, 5, n_elements=3, backend="numpy")
     no_friction = ContactKernel(route.segments, L, R_CABLE,
-                                ContactLaw(law.stiffness, law.damping, law.exponent, 0.0), 5,
+                                ContactLaw(law.stiffness, law.damping, law.exponent, 0.0, damping_onset_m=0.0), 5,
                                 n_elements=3, backend="numpy")
     jq = assemble_blocks_dense(k.evaluate(q, q_t, jacobian=True).jac_q_blocks)
     jq0 = assemble_blocks_dense(no_friction.evaluate(q, q_t, jacobian=True).jac_q_blocks)
@@ -506,7 +507,7 @@ def one_point_case(delta0, vel):
 def test_single_point_hertz_force(backend, damping, vel):
     delta0 = 2e-4
     seg, L, q, q_t = one_point_case(delta0, np.array(vel))
-    law = ContactLaw(stiffness=1e6, damping=damping, exponent=1.5, friction=0.3)
+    law = ContactLaw(stiffness=1e6, damping=damping, exponent=1.5, friction=0.3, damping_onset_m=0.0)
     h_ref = 1e-3
     k = ContactKernel(seg, L, R_CABLE, law, 1, reference_spacing_m=h_ref, n_elements=1,
                       backend=backend)
@@ -611,7 +612,7 @@ def test_numba_cache_and_first_call_in_fresh_process():
         from exucable.contact import ContactKernel, ContactLaw
         from exucable.geometry.segments import Segments
         seg = Segments(np.array([[0.0, 0, 0], [1.0, 0, 0]]), np.array([0.0, 1.0]), 3.5e-3)
-        k = ContactKernel(seg, 0.5, 2.5e-3, ContactLaw(1e6, 1e3, 1.5, 0.3), 8, n_elements=1,
+        k = ContactKernel(seg, 0.5, 2.5e-3, ContactLaw(1e6, 1e3, 1.5, 0.3, damping_onset_m=0.0), 8, n_elements=1,
                           backend="numba")
         q = np.array([0.1, 1.2e-3, 0, 1, 0, 0, 0.6, 1.2e-3, 0, 1, 0, 0])
         r = k.evaluate(q, np.zeros(12), jacobian=True)

@@ -10,7 +10,7 @@ from exucable.geometry import Bend, Conduit, Helix, Straight, centreline_from_pa
 
 R_CABLE, R_CONDUIT = 0.0025, 0.0035
 GAP = R_CONDUIT - R_CABLE
-LAW = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.2)
+LAW = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.2, damping_onset_m=0.0)  # Eq. 18
 
 
 def conduit(kind, segments_per_bend=12):

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.segments import Segments
+from ..scenario_fields import default_of
 from .checkpoints import check_points, hermite_unit
 from .law import ContactLaw
 from .reference import ReferenceKernel
@@ -192,10 +193,12 @@ class ContactKernel:
     """
 
     def __init__(self, segments: Segments, element_length_m, cable_radius_m: float,
-                 law: ContactLaw, check_points_per_element: int, rule: str = "gauss",
-                 reference_spacing_m: float = 1e-3, broad_phase: str = "aabb",
+                 law: ContactLaw, check_points_per_element: int = default_of("contact.check_points_per_element"),
+                 rule: str = default_of("contact.check_point_rule"),
+                 reference_spacing_m: float = default_of("contact.reference_spacing"),
+                 broad_phase: str = default_of("contact.broad_phase"),
                  backend: str = "auto", n_elements: int | None = None, open_ends: bool = True,
-                 surface: str = "segments", centreline=None):
+                 surface: str | None = None, centreline=None):
         length = np.asarray(element_length_m, dtype=float)
         if length.ndim == 0:
             if n_elements is None:
@@ -228,6 +231,9 @@ class ContactKernel:
         self.open_ends = bool(open_ends)
         # "segments": the paper's wall of straight hollow cylinders; "smooth": the same search,
         # then the closest point refined onto the exact bend/helix (exucable.contact.smooth)
+        if surface is None:
+            # the scenario's default "smooth" needs the centreline; without one, the segments
+            surface = default_of("contact.surface") if centreline is not None else "segments"
         if surface not in ("segments", "smooth"):
             raise ValueError(f"surface must be 'segments' or 'smooth', got {surface!r}")
         if surface == "smooth" and centreline is None:

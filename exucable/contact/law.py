@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..scenario_fields import default_of
+
 import numpy as np
 
 __all__ = ["ContactLaw", "normal_force_magnitude", "friction_coefficient", "damping_ramp"]
@@ -41,18 +43,19 @@ class ContactLaw:
         instead of v_τ/|v_τ| (Eq. 20), so the force is smooth through zero sliding speed.
     damping_onset_m : float
         Penetration δ_d [m] over which the damping term grows from 0 to C_n δ̇:
-        f_n = K_n δ^e + C_n min(δ/δ_d, 1) δ̇. 0 (default) is the paper's Eq. 18, whose damping
+        f_n = K_n δ^e + C_n min(δ/δ_d, 1) δ̇ (default 1e-5 m, as the scenario's). 0 is the paper's Eq. 18, whose damping
         force jumps to C_n δ̇ at first touch.
     """
 
-    stiffness: float
-    damping: float
-    exponent: float
-    friction: float
-    static_friction: float | None = None
-    stribeck_velocity_m_per_s: float = 1e-2
-    regularisation_velocity_m_per_s: float = 1e-3
-    damping_onset_m: float = 0.0
+    # defaults: the validated scenario defaults (scenarios/README.md)
+    stiffness: float = default_of("contact.stiffness")
+    damping: float = default_of("contact.damping")
+    exponent: float = default_of("contact.exponent")
+    friction: float = default_of("contact.friction")
+    static_friction: float | None = default_of("contact.static_friction")
+    stribeck_velocity_m_per_s: float = default_of("contact.stribeck_velocity")
+    regularisation_velocity_m_per_s: float = default_of("contact.friction_regularisation_velocity")
+    damping_onset_m: float = default_of("contact.damping_onset")
 
     def __post_init__(self):
         # The kernel is below the scenario layer, which reports bad user input with its own

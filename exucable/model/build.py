@@ -1,7 +1,10 @@
-"""Assemble the Exudyn system of one scenario: cable + rig + loads + contact.
+"""A cable pulled through a conduit, added to an Exudyn system: the plugin face of exucable.
 
-Reads like the physical system: lay the cable in the conduit, hang the loads on it, hook the
-rig to its leading end, let the conduit's wall act on it.
+Reads like the physical system: lay the cable in the conduit (:func:`initial_layout`, no
+Exudyn), hang the loads on it, hook its leading end to the rig (or to the user's own drum or
+vehicle), let the conduit's wall act on it. :func:`add_cable_in_conduit` does that in the user's
+own ``mbs`` without assembling it; :func:`build_model` is the thin wrapper that makes its own
+SystemContainer for ``exucable run``.
 """
 
 from __future__ import annotations
@@ -11,51 +14,140 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import exudyn as exu
+from exudyn.itemInterface import MarkerNodePosition, ObjectJointSpherical
 
-from ..errors import ModelError
-from ..mesh import MeshPlan, plan_mesh
-from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
+from ..errors import ModelError, ScenarioError
+from ..mesh import MeshPlan
 from ..references import reference_drift_N_per_s
-from ..rope_clearance import solve_rope_with_clearance
+from ..tension import tension_at
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
-from .layout import CableLayout, contact_offsets, lay_cable
-from .rig import Drive, Guide, add_drive, add_end_force, add_tangential_drive, smooth_ramp
+from .layout import CableLayout, InitialLayout, initial_layout
+from .recorder import Recorder
+from .rig import Drive, Guide, add_drive, add_end_force, add_guide, add_reel, add_tangential_drive, smooth_ramp
 
-if TYPE_CHECKING:  # for the annotations only
+if TYPE_CHECKING:  # names for the annotations only
     from ..contact import ContactKernel
     from ..geometry import Conduit
+    from ..rope import RopeSolution
     from ..scenario import Scenario
     from .coupling import ContactCoupling
+    from .rig import TangentialDrive
+    from .startup import StartupDamper
 
-__all__ = ["Model", "build_model", "pull_oriented_conduit", "plan_cable_mesh"]
+__all__ = ["CableInConduit", "Model", "JoinToMarker", "ReelOnto", "add_cable_in_conduit", "build_model",
+           "pull_oriented_conduit"]
 
 
-@dataclass(eq=False)
-class Model:
-    """An assembled Exudyn system of one scenario and the handles post-processing needs."""
+@dataclass(frozen=True)
+class JoinToMarker:
+    """Join a cable end to a position marker of the user's own body (a vehicle, a winch carriage)
+    with a spherical joint; place the body's marker at the end's start position
+    (``InitialLayout.leading_position_m``)."""
+
+    marker: int
+
+
+@dataclass(frozen=True)
+class ReelOnto:
+    """Reel the leading end in along the exit tangent by ``radius_m`` × the user's coordinate
+    marked by ``coordinate_marker`` (a drum's rotation angle [rad]); the drum then carries the
+    cable's pull as a torque R·F."""
+
+    coordinate_marker: int
+    radius_m: float
+
+
+_LEADING = ("rig", "force", "free")
+_TRAILING = ("back_tension", "brake", "free")
+
+
+@dataclass(eq=False, repr=False)
+class CableInConduit:
+    """Handles of a cable in a conduit inside an Exudyn system (see :func:`add_cable_in_conduit`).
+
+    Attributes
+    ----------
+    scenario : exucable.scenario.Scenario
+    mbs : exudyn.MainSystem
+    conduit : exucable.geometry.Conduit
+        Pull-oriented: the leading end is at the end of its centreline.
+    cable : CableHandles
+        Node and element indices; ``cable.nodes[0]`` is the trailing end.
+    layout : CableLayout
+        The start state (reference coordinates of the nodes).
+    start : InitialLayout
+    properties : CableProperties
+    leading_marker, trailing_marker : int
+        ``MarkerNodePosition`` of the two end nodes (to join, load or sense them).
+    lead_drive, trail_drive : Drive or None
+        The rig (or reel) at the leading end and the brake of a force-controlled pull.
+    applied_pull_force_N : float or None
+        The prescribed pulling force of a force-controlled pull [N].
+    back_tension_N : float
+        Tension applied at the trailing end [N].
+    rope : exucable.rope.RopeSolution
+        The quasi-static reference the start is pre-tensioned to.
+    coupling, kernel
+        The contact coupling (an ObjectGenericODE2 over the cable nodes) and its kernel.
+    startup_damper : StartupDamper or None
+    guide : Guide or None
+        The force-controlled pull's sheave.
+    recorder : Recorder
+        Call ``recorder(mbs, t)`` from your post-step function; ``recorder.history`` holds the
+        pulling force, trailing and maximum tension at ``solver.output_interval``.
+    """
 
     scenario: Scenario
-    system_container: exu.SystemContainer
     mbs: exu.MainSystem
-    conduit: Conduit                     # pull-oriented: the leading end is at its end
+    conduit: Conduit
     cable: CableHandles
     layout: CableLayout
+    start: InitialLayout
     properties: CableProperties
-    lead_drive: Drive | None
-    trail_drive: Drive | None
-    applied_pull_force_N: float | None   # force-controlled pull
-    back_tension_N: float
-    rope: RopeSolution | None
+    leading_marker: int
+    trailing_marker: int
+    lead_drive: Drive | None = None
+    trail_drive: Drive | TangentialDrive | None = None
+    applied_pull_force_N: float | None = None
+    back_tension_N: float = 0.0
+    rope: RopeSolution | None = None
     mesh: MeshPlan | None = None
     coupling: ContactCoupling | None = None
     kernel: ContactKernel | None = None
-    ode2_index: np.ndarray = field(default=None)
+    startup_damper: StartupDamper | None = None
+    guide: Guide | None = None
+    recorder: Recorder | None = None
     # how fast the flexible reference's pulling force moves as the cable leaves its conduit [N/s]
     reference_drift_N_per_s: float = 0.0
+    _ode2_index: np.ndarray | None = field(default=None)
+
+    def __repr__(self) -> str:
+        return (f"{type(self).__name__}({self.scenario.name!r}: {len(self.cable.elements)} cable elements, "
+                f"{'with' if self.coupling is not None else 'without'} contact)")
+
+    @property
+    def nodes(self) -> tuple[int, ...]:
+        """Cable node indices, trailing end first."""
+        return self.cable.nodes
 
     @property
     def axial_stiffness_N(self) -> float:
         return self.properties.axial_stiffness_N
+
+    @property
+    def ode2_index(self) -> np.ndarray:
+        """Indices of the cable's coordinates in the system's ODE2 vector (after ``Assemble``)."""
+        if self._ode2_index is None:
+            self._ode2_index = np.concatenate([
+                np.arange(self.mbs.GetNodeODE2Index(n), self.mbs.GetNodeODE2Index(n) + 6) for n in self.cable.nodes])
+        return self._ode2_index
+
+    def recommended_settings(self) -> exu.SimulationSettings:
+        """Exudyn simulation settings from the scenario's ``[solver]`` table, to start from:
+        generalized-α with adaptive steps, full Newton on the exact contact Jacobian, the end time
+        and step of ``solver`` (see scenarios/README.md for why each)."""
+        from ..solve import solver_settings
+        return solver_settings(self.scenario.solver)
 
     def load_factor(self, t: float) -> float:
         """Ramp factor of loads and speed at time t [-]."""
@@ -68,17 +160,33 @@ class Model:
         v = np.asarray(sd.GetODE2Coordinates_t())[self.ode2_index]
         return (self.layout.coordinates + q.reshape(-1, 6), v.reshape(-1, 6))
 
+    def leading_tension_N(self) -> float:
+        """Axial force N = EA·ε at the leading end now [N] (paper Eq. 24)."""
+        q, _ = self.coordinates()
+        Le = self.layout.element_length_m
+        return float(tension_at(q, Le, self.axial_stiffness_N, [float(np.sum(Le))])[0])
+
     def pull_force_N(self, t: float) -> float:
-        """Force of the rig on the leading end along the pull [N]."""
+        """Force of the rig on the leading end along the pull [N]: the drive's (or reel's)
+        reaction, the prescribed force, or else the cable's tension at its leading end."""
         if self.lead_drive is not None:
             return self.lead_drive.force_N(self.mbs)
-        return self.applied_pull_force_N * self.load_factor(t)
+        if self.applied_pull_force_N is not None:
+            return self.applied_pull_force_N * self.load_factor(t)
+        return self.leading_tension_N()
 
     def trailing_reaction_N(self) -> float | None:
         """Brake force at the trailing end of a force-controlled pull [N] (None otherwise)."""
         if self.trail_drive is None:
             return None
         return -self.trail_drive.force_N(self.mbs)
+
+
+@dataclass(eq=False, repr=False)
+class Model(CableInConduit):
+    """A cable in a conduit in its own assembled SystemContainer (:func:`build_model`)."""
+
+    system_container: exu.SystemContainer | None = None
 
 
 def pull_oriented_conduit(scenario):
@@ -88,63 +196,77 @@ def pull_oriented_conduit(scenario):
     return conduit.reversed() if scenario.pull.direction == "reverse" else conduit
 
 
-def _rope_start(scenario, centreline, w_N_per_m: float) -> RopeSolution:
-    common = dict(friction=scenario.contact.friction, weight_per_length_N_per_m=w_N_per_m,
-                  cable_length_m=scenario.cable_length_m)
-    if scenario.pull.force_N is not None:
-        return solve_rope_for_pull_force(centreline, pull_force_N=scenario.pull.force_N, **common)
-    return solve_rope(centreline, trailing_tension_N=scenario.pull.back_tension_N, **common)
+def _scenario_from(scenario, parts: dict):
+    from ..scenario import Scenario, SolverSpec
+    if scenario is not None:
+        if parts:
+            raise TypeError(f"give a scenario or its parts, not both (got {sorted(parts)})")
+        return scenario
+    parts = dict(parts)
+    # The user's own settings decide the run; the solver spec only sets the start-up damper,
+    # the recorder's interval and recommended_settings().
+    parts.setdefault("solver", SolverSpec(end_time_s=1.0))
+    return Scenario(**parts)
 
 
-def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: float):
-    """The rope with clearance for the start of a velocity-controlled pull, or None (force-controlled,
-    no clearance, or a cable that runs slack somewhere)."""
-    if scenario.pull.force_N is not None or clearance_m <= 0.0:
-        return None
-    try:
-        return solve_rope_with_clearance(centreline, clearance_m, scenario.contact.friction, w_N_per_m,
-                                         scenario.pull.back_tension_N, cable_length_m=scenario.cable_length_m)
-    except ModelError:
-        return None
+def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | ReelOnto | None = None,
+                         trailing: str | JoinToMarker | None = None, with_contact: bool = True,
+                         start: InitialLayout | None = None, **parts) -> CableInConduit:
+    """Add a cable pulled through a conduit to the user's own Exudyn system, without assembling it.
 
+    Adds the ANCF cable (paper Sect. 2.2) pre-tensioned in the conduit (:func:`initial_layout`),
+    its weight, the end loads, the contact coupling with the conduit wall (Sects. 2.4-2.5) and the
+    start-up damper. Nothing of the user's is changed: no post-step function is set (call the
+    returned ``recorder`` from yours) and ``mbs.Assemble()`` is left to the caller.
 
-def plan_cable_mesh(scenario, conduit, rope: RopeSolution, refine: float = 1.0,
-                    check_points_per_element: int | None = None) -> MeshPlan:
-    """The scenario's cable mesh by the rule of :mod:`exucable.mesh` (or its override, checked).
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    scenario : exucable.scenario.Scenario, optional
+        Or its parts as keywords: ``route=``, ``cable=``, ``contact=``, ``pull=``, ``gravity=``,
+        ``solver=`` (as for :class:`exucable.Scenario`; ``solver`` defaults to ``Solver(end_time=1)``).
+    leading : {"rig", "force", "free"}, JoinToMarker or ReelOnto, optional
+        The leading end: the built-in velocity rig at ``pull.speed`` (default), the prescribed
+        ``pull.force`` with its sheave (default when ``pull.force`` is given), free, joined to a
+        user's marker, or reeled onto a user's drum coordinate.
+    trailing : {"back_tension", "brake", "free"} or JoinToMarker, optional
+        The trailing end: ``pull.back_tension`` along the entry tangent (default), the pay-out
+        brake at ``pull.speed`` (default for a force-controlled pull), free, or joined to a marker.
+    with_contact : bool
+        False: no conduit wall (a free cable, for tests).
+    start : InitialLayout, optional
+        A start state computed before (default: ``initial_layout(scenario, with_contact)``).
 
-    ``refine`` divides the element length (``exucable converge``); ``check_points_per_element``
-    overrides the scenario's ``contact.check_points_per_element``."""
-    c = scenario.cable
-    k = check_points_per_element if check_points_per_element is not None else scenario.contact.check_points_per_element
-    return plan_mesh(conduit.centreline, conduit.inner_radius_m - c.radius_m, scenario.cable_length_m,
-                     c.bending_stiffness_N_m2, float(np.max(rope.tension_N)) if rope is not None else 0.0,
-                     elements=None if "elements" in c.derived_keys else c.elements,
-                     element_length_m=c.element_length_m,
-                     check_points_per_element=k, refine=refine)
+    Returns
+    -------
+    CableInConduit
+        Handles: nodes, end markers, drives, coupling and kernel, recorder, recommended_settings().
 
-
-def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
-                check_points_per_element: int | None = None) -> Model:
-    """Build the Exudyn system of ``scenario`` (a :class:`exucable.scenario.Scenario`).
-
-    The start follows :mod:`exucable.model.layout`: pre-stretched to the rope tension, on its
-    bearing wall, moving at the pull speed (unless ``solver.pretension`` is false: then on the
-    centreline, unloaded, at rest, with loads and speed ramped over ``pull.ramp_time``). The mesh
-    is :func:`plan_cable_mesh`'s, refined by ``refine``.
+    Raises
+    ------
+    ModelError
+        Mesh too coarse for the tightest bend, or a cable longer than its conduit.
     """
-    sc = scenario
-    conduit = pull_oriented_conduit(sc)
+    sc = _scenario_from(scenario, parts)
+    force_pull = sc.pull.force_N is not None
+    leading = ("force" if force_pull else "rig") if leading is None else leading
+    trailing = ("brake" if force_pull else "back_tension") if trailing is None else trailing
+    if isinstance(leading, str) and leading not in _LEADING:
+        raise ValueError(f"leading must be one of {_LEADING}, JoinToMarker(...) or ReelOnto(...), got {leading!r}")
+    if isinstance(trailing, str) and trailing not in _TRAILING:
+        raise ValueError(f"trailing must be one of {_TRAILING} or JoinToMarker(...), got {trailing!r}")
+    if leading == "force" and not force_pull:
+        raise ScenarioError("pull.force", 'required with leading="force": the pulling force to apply (N)')
+
+    start = initial_layout(sc, with_contact) if start is None else start
+    conduit = start.conduit
     centre = conduit.centreline
     L_cable = sc.cable_length_m
     if L_cable > centre.length_m * (1 + 1e-12):
         raise ModelError("cable.length", f"cable of {L_cable:.6g} m is longer than the conduit "
                          f"({centre.length_m:.6g} m); shorten it or extend the route")
     c = sc.cable
-    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
-    w = c.mass_per_length_kg_per_m * g
-    rope = _rope_start(sc, centre, w)
-    mesh = plan_cable_mesh(sc, conduit, rope, refine, check_points_per_element)
-    n_el = mesh.elements
+    layout = start.cable
     props = CableProperties(
         mass_per_length_kg_per_m=c.mass_per_length_kg_per_m,
         axial_stiffness_N=c.axial_stiffness_N,
@@ -153,97 +275,92 @@ def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
         bending_damping_N_m2_s=c.bending_damping_N_m2_s,
         integration=c.integration,
     )
-    clearance = conduit.inner_radius_m - c.radius_m
-    speed = sc.pull.speed_m_per_s
-    if sc.solver.pretension:
-        s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * n_el + 1))
-        T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
-        L_e = L_cable / n_el
-        # blend over the length on which a tensioned beam leaves the wall, √(EJ/T), but at least
-        # half an element so the nodes can follow it
-        T_ref = max(float(np.max(rope.tension_N)), 1e-6)
-        blend = max(0.5 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
-        free = _clearance_rope_start(sc, centre, w, clearance) if with_contact else None
-        path = {}
-        if free is not None:
-            # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
-            # free spans across the clearance, and a start pressed onto the wall the centreline rope's
-            # load points to rang for a second as those spans formed (issue 10, item 3).
-            T_grid = np.interp(s_grid, free.s_conduit_m, free.tension_N)
-            path = {"path_offset_m": np.stack([np.interp(s_grid, free.s_conduit_m, free.offset_m[:, j])
-                                               for j in range(3)], axis=1),
-                    "path_pressure_N_per_m": np.interp(s_grid, free.s_conduit_m, free.sidewall_pressure_N_per_m)}
-        off = contact_offsets(centre, s_grid, T_grid, w, clearance,
-                              sc.contact.stiffness / sc.contact.reference_spacing_m,
-                              sc.contact.exponent, blend, **path) if with_contact else np.zeros((len(s_grid), 3))
-
-        def tension_fn(s):
-            return np.interp(s, s_grid, T_grid)
-
-        def offset_fn(s):
-            return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
-
-        layout = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, speed, tension_fn, offset_fn,
-                           clearance_m=clearance if with_contact else None)
-    else:
-        layout = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, 0.0)
-
-    SC = exu.SystemContainer()
-    mbs = SC.AddSystem()
     cable = add_cable(mbs, layout.coordinates, layout.element_length_m, props, layout.velocities,
                       draw_radius_m=c.radius_m)
+    lead_node, trail_node = cable.nodes[-1], cable.nodes[0]
+    h = CableInConduit(
+        scenario=sc, mbs=mbs, conduit=conduit, cable=cable, layout=layout, start=start, properties=props,
+        leading_marker=mbs.AddMarker(MarkerNodePosition(nodeNumber=lead_node)),
+        trailing_marker=mbs.AddMarker(MarkerNodePosition(nodeNumber=trail_node)),
+        back_tension_N=sc.pull.back_tension_N, rope=start.rope, mesh=start.mesh)
+
     ramp_time = sc.pull.ramp_time_s
     factor = None if ramp_time <= 0 else (lambda t: smooth_ramp(t, ramp_time))
+    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
     if g > 0:
         add_gravity(mbs, cable, [0.0, 0.0, -g], factor)
-    t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
-    s_trail = centre.length_m - L_cable
-    t_entry = np.asarray(centre.tangent(s_trail), dtype=float)
-    lead_drive = trail_drive = None
-    applied = None
-    if sc.pull.force_N is None:
-        lead_drive = add_drive(mbs, cable.nodes[-1], t_exit, speed, ramp_time)
-        if sc.pull.back_tension_N > 0:
-            add_end_force(mbs, cable.nodes[0], -sc.pull.back_tension_N * t_entry, factor)
-    else:
-        applied = sc.pull.force_N
-        add_end_force(mbs, cable.nodes[-1], applied * t_exit, factor)
-        if ramp_time > 0.0:
-            trail_drive = add_drive(mbs, cable.nodes[0], t_entry, speed, ramp_time)
-        else:
-            trail_drive = add_tangential_drive(mbs, cable.nodes[0], t_entry, speed)
+    speed = sc.pull.speed_m_per_s
+    t_exit, t_entry = start.exit_tangent, start.entry_tangent
 
-    model = Model(scenario=sc, system_container=SC, mbs=mbs, conduit=conduit, cable=cable, layout=layout,
-                  properties=props, lead_drive=lead_drive, trail_drive=trail_drive,
-                  applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope,
-                  mesh=mesh,
-                  reference_drift_N_per_s=reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s))
+    if leading == "rig":
+        h.lead_drive = add_drive(mbs, lead_node, t_exit, speed, ramp_time)
+    elif leading == "force":
+        h.applied_pull_force_N = sc.pull.force_N
+        add_end_force(mbs, lead_node, sc.pull.force_N * t_exit, factor)
+    elif isinstance(leading, JoinToMarker):
+        mbs.AddObject(ObjectJointSpherical(markerNumbers=[leading.marker, h.leading_marker],
+                                           visualization={"show": False, "jointRadius": 0.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
+    elif isinstance(leading, ReelOnto):
+        h.lead_drive = add_reel(mbs, lead_node, t_exit, leading.coordinate_marker, leading.radius_m)
+
+    if trailing == "back_tension":
+        if sc.pull.back_tension_N > 0:
+            add_end_force(mbs, trail_node, -sc.pull.back_tension_N * t_entry, factor)
+    elif trailing == "brake":
+        if ramp_time > 0.0:
+            h.trail_drive = add_drive(mbs, trail_node, t_entry, speed, ramp_time)
+        else:
+            h.trail_drive = add_tangential_drive(mbs, trail_node, t_entry, speed)
+    elif isinstance(trailing, JoinToMarker):
+        mbs.AddObject(ObjectJointSpherical(markerNumbers=[trailing.marker, h.trailing_marker],
+                                           visualization={"show": False, "jointRadius": 0.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
+
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
-        from .coupling import ContactCoupling, StartupDamper
+        from .coupling import ContactCoupling
+        from .startup import StartupDamper, add_startup_damper
         ct = sc.contact
         law = ContactLaw(stiffness=ct.stiffness, damping=ct.damping, exponent=ct.exponent, friction=ct.friction,
                          static_friction=ct.static_friction, stribeck_velocity_m_per_s=ct.stribeck_velocity_m_per_s,
                          regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s,
                          damping_onset_m=ct.damping_onset_m)
-        kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
-                               mesh.check_points_per_element, rule=ct.check_point_rule,
-                               reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
-                               surface=ct.surface, centreline=centre)
-        model.kernel = kernel
-        damper = None
+        h.kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
+                                 start.mesh.check_points_per_element, rule=ct.check_point_rule,
+                                 reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
+                                 surface=ct.surface, centreline=centre)
+        h.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, h.kernel)
         sp = sc.solver
         if sp.pretension and sp.startup_time_s > 0.0:
             Le = layout.element_length_m
             lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
-            damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
-        guide = None
-        if applied is not None:
+            h.startup_damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
+            add_startup_damper(mbs, cable.nodes, h.startup_damper)
+        if leading == "force":
             # the sheave of a force-controlled pull: lateral stiffness of the contact law's order at
             # its working point (1e6 N/m), damped near-critically for the end node's mass
-            guide = Guide(len(cable.nodes) - 1, t_exit, 1.0e6, 2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / n_el))
-        model.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, kernel, damper, guide)
+            h.guide = add_guide(mbs, lead_node, t_exit, 1.0e6,
+                                2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / layout.n_elements),
+                                node_index=len(cable.nodes) - 1)
+    h.reference_drift_N_per_s = reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s)
+    sp = sc.solver
+    h.recorder = Recorder(h, sp.output_interval_s, sp.steady_stop, sp.steady_window_s, sp.steady_tolerance)
+    return h
+
+
+def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
+                check_points_per_element: int | None = None) -> Model:
+    """Build and assemble the Exudyn system of ``scenario`` in a SystemContainer of its own.
+
+    A thin wrapper of :func:`add_cable_in_conduit` with the scenario's rig and loads. The mesh is
+    :func:`exucable.model.layout.plan_cable_mesh`'s: the rule of :mod:`exucable.mesh` or the
+    scenario's override, with the element length divided by ``refine`` and the check points per
+    element overridden by ``check_points_per_element`` (``exucable converge``).
+    """
+    start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)
+    SC = exu.SystemContainer()
+    mbs = SC.AddSystem()
+    h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start)
+    model = Model(**{f: getattr(h, f) for f in h.__dataclass_fields__}, system_container=SC)
+    model.recorder.cable = model
     mbs.Assemble()
-    model.ode2_index = np.concatenate([
-        np.arange(mbs.GetNodeODE2Index(n), mbs.GetNodeODE2Index(n) + 6) for n in cable.nodes])
     return model

@@ -14,6 +14,8 @@ import numpy as np
 import exudyn as exu
 from exudyn.itemInterface import MarkerBodyMass, NodePointSlope1, ObjectANCFCable, LoadMassProportional
 
+from ..scenario_fields import default_of
+
 __all__ = ["CableProperties", "CableHandles", "add_cable", "add_gravity", "INTEGRATION"]
 
 # Exudyn's useReducedOrderIntegration. Full Gauss quadrature lets coarse elements on curves carry
@@ -47,7 +49,7 @@ class CableProperties:
     bending_stiffness_N_m2: float
     axial_damping_N_s: float = 0.0
     bending_damping_N_m2_s: float = 0.0
-    integration: str = "full"
+    integration: str = default_of("cable.integration")
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""Thin glue between the contact kernel and Exudyn.
+"""Thin glue between the contact kernel and Exudyn: the conduit wall's forces, nothing else.
 
 One ``ObjectGenericODE2`` spans all cable nodes and carries no mass, stiffness or damping of its
 own; its ``forceUserFunction`` returns the kernel's generalized contact force Q (paper Eqs. 21-23
@@ -8,6 +8,8 @@ friction-normal-force coupling, is what lets Newton converge in a few iterations
 (``../shared/notes/exudyn-findings.md``).
 
 Exudyn passes coordinates *without* their reference values: absolute = reference + q.
+The start-up damper (:mod:`exucable.model.startup`) and the force-controlled pull's guide
+(:func:`exucable.model.rig.add_guide`) are objects of their own.
 """
 
 from __future__ import annotations
@@ -16,50 +18,10 @@ import time
 
 import numpy as np
 import exudyn as exu
-from exudyn.itemInterface import ObjectGenericODE2
 
-__all__ = ["ContactCoupling", "StartupDamper"]
+from .generic import add_user_force_object
 
-
-class StartupDamper:
-    """A viscous damper that settles the start and then fades away.
-
-    The pre-tensioned start is close to, not at, equilibrium: where an element spans the end of
-    a bend it cannot follow the jump of curvature, and the misfit sets the cable's free spans
-    ringing as taut strings (ω ≈ (π/ℓ)√(T/ρA), tens of rad/s, all but undamped by the cable's
-    material damping). Each slap on the wall then clips the contact damping (f_n ≥ 0) and Newton
-    needs tiny steps: Example 4 took 1300 steps per 0.03 s. This damper pulls the nodes' velocities
-    toward the start's sliding field with force -c(t)·m_k·(v_k - v_k,ref) (m_k the node's lumped
-    mass) and fades out smoothly, c(t) = c0·(1 - smoothstep(t/T)). Along the cable v ≈ v_ref, so
-    the pulling force is not biased; after T it is gone. Results are read after it
-    (``solver.startup_time``).
-    """
-
-    def __init__(self, lumped_mass_kg, reference_velocity, rate_1_per_s, duration_s):
-        n_nodes = len(lumped_mass_kg)
-        self.mass = np.zeros((n_nodes, 6))
-        self.mass[:, :3] = np.asarray(lumped_mass_kg, dtype=float)[:, None]
-        self.mass = self.mass.reshape(-1)
-        self.v_ref = np.asarray(reference_velocity, dtype=float).reshape(-1)
-        self.rate = float(rate_1_per_s)
-        self.duration = float(duration_s)
-
-    def coefficient(self, t: float) -> float:
-        """c(t) [1/s]."""
-        if self.duration <= 0.0 or t >= self.duration:
-            return 0.0
-        tau = max(t, 0.0) / self.duration
-        return self.rate * (1.0 - tau * tau * (3.0 - 2.0 * tau))
-
-    def force(self, t, v):
-        c = self.coefficient(t)
-        if c == 0.0:
-            return 0.0
-        return -c * self.mass * (v - self.v_ref)
-
-    def rate_jacobian_diagonal(self, t):
-        """Diagonal of ∂Q/∂q̇ [kg/s]."""
-        return -self.coefficient(t) * self.mass
+__all__ = ["ContactCoupling"]
 
 
 class ContactCoupling:
@@ -80,7 +42,7 @@ class ContactCoupling:
         two kernel passes per Newton iteration, for the benchmarks' comparison).
     """
 
-    def __init__(self, mbs, nodes, reference_coordinates, kernel, startup_damper=None, guide=None):
+    def __init__(self, mbs, nodes, reference_coordinates, kernel):
         from ..contact import block_sparsity
 
         self.kernel = kernel
@@ -94,23 +56,6 @@ class ContactCoupling:
         self._rows = (unique // self.n).astype(float)
         self._cols = (unique % self.n).astype(float)
         self._n_unique = unique.size
-        self.damper = startup_damper
-        if startup_damper is not None:
-            # its Jacobian is diagonal: make sure the diagonal is in the sparsity pattern
-            diag = np.arange(self.n, dtype=np.int64)
-            lin_all = np.concatenate([lin, diag * self.n + diag])
-            unique, inv = np.unique(lin_all, return_inverse=True)
-            self._inverse = inv[:lin.size]
-            self._diag_index = inv[lin.size:]
-            self._rows = (unique // self.n).astype(float)
-            self._cols = (unique % self.n).astype(float)
-            self._n_unique = unique.size
-        self.guide = guide
-        if guide is not None:
-            i0 = 6 * guide.node_index
-            ii, jj = np.meshgrid(np.arange(i0, i0 + 3), np.arange(i0, i0 + 3), indexing="ij")
-            pos = {int(v): k for k, v in enumerate((self._rows * self.n + self._cols).astype(np.int64))}
-            self._guide_index = np.array([pos[int(a * self.n + b)] for a, b in zip(ii.ravel(), jj.ravel())])
         self.kernel_time_s = 0.0
         self.user_time_s = 0.0
         self.force_calls = 0
@@ -119,16 +64,7 @@ class ContactCoupling:
         self.reused_evaluations = 0
         self.jacobian_with_force = True
         self._last = None
-        empty = [exu.MatrixContainer() for _ in range(3)]
-        for m in empty:
-            m.Initialize(self.n, self.n, False)
-        self.object = mbs.AddObject(ObjectGenericODE2(
-            nodeNumbers=list(nodes),
-            massMatrix=empty[0], stiffnessMatrix=empty[1], dampingMatrix=empty[2],
-            forceUserFunction=self._force, jacobianUserFunction=self._jacobian,
-            visualization={"show": False, "color": [-1.0, -1.0, -1.0, -1.0], "triangleMesh": [],
-                           "showNodes": False, "graphicsDataUserFunction": 0},
-        ))
+        self.object = add_user_force_object(mbs, nodes, self.n, self._force, self._jacobian)
 
     def absolute(self, q, q_t):
         """Absolute coordinates and rates from Exudyn's displacement coordinates."""
@@ -159,13 +95,8 @@ class ContactCoupling:
         qa, va = self.absolute(q, q_t)
         res = self._evaluate(t, qa, va, jacobian=self.jacobian_with_force)
         self.force_calls += 1
-        Q = res.generalized_force
-        if self.damper is not None:
-            Q = Q + self.damper.force(t, va)
-        if self.guide is not None:
-            Q = Q + self.guide.force(np.asarray(q, dtype=float), va)
         self.user_time_s += time.perf_counter() - t0
-        return Q
+        return res.generalized_force
 
     def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
         t0 = time.perf_counter()
@@ -175,11 +106,6 @@ class ContactCoupling:
         # LHS derivative: the contact force is on the right-hand side, hence the minus sign.
         blocks = -(f_q * res.jac_q_blocks + f_v * res.jac_qt_blocks)
         vals = np.bincount(self._inverse, weights=blocks.reshape(-1), minlength=self._n_unique)
-        if self.damper is not None:
-            vals[self._diag_index] -= f_v * self.damper.rate_jacobian_diagonal(t)
-        if self.guide is not None:
-            g = self.guide
-            vals[self._guide_index] += (f_q * g.k + f_v * g.c) * g.P.ravel()
         nz = vals != 0.0  # Exudyn's sparse triplets must not contain zeros
         m = exu.MatrixContainer()
         if nz.any():

@@ -24,7 +24,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["CableLayout", "lay_cable", "contact_offsets", "extended_point", "extended_tangent"]
+__all__ = ["CableLayout", "InitialLayout", "initial_layout", "lay_cable", "contact_offsets", "extended_point", "extended_tangent"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -311,3 +311,153 @@ def _second_derivative_at_nodes(coef, Le):
     out[1:] += right
     cnt[1:] += 1
     return out / cnt
+
+
+@dataclass(frozen=True, eq=False)
+class InitialLayout:
+    """Where and how a scenario's cable starts (Exudyn-free): see :func:`initial_layout`.
+
+    Attributes
+    ----------
+    conduit : exucable.geometry.Conduit
+        The conduit oriented so that the leading (pulled) end is at the end of its centreline.
+    rope : exucable.rope.RopeSolution
+        The quasi-static rope solution the start is pre-tensioned to (also the reference).
+    cable : CableLayout
+        Nodal coordinates and rates, nodes numbered from the trailing end.
+    weight_per_length_N_per_m : float
+        ρA·g [N/m].
+    exit_tangent, entry_tangent : ndarray (3,)
+        Unit tangents of the centreline at the leading end and at the trailing end's start position.
+    mesh : exucable.mesh.MeshPlan or None
+        The cable mesh (elements, check points per element) by the rule of :mod:`exucable.mesh`
+        or the scenario's override, with its warnings.
+    """
+
+    conduit: object
+    rope: object
+    cable: CableLayout
+    weight_per_length_N_per_m: float
+    exit_tangent: np.ndarray
+    entry_tangent: np.ndarray
+    mesh: object = None
+
+    @property
+    def leading_position_m(self) -> np.ndarray:
+        """Start position of the leading end [m] (where a user's body joins it)."""
+        return self.cable.position_m[-1].copy()
+
+    @property
+    def trailing_position_m(self) -> np.ndarray:
+        """Start position of the trailing end [m]."""
+        return self.cable.position_m[0].copy()
+
+
+def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: float):
+    """The rope with clearance for the start of a velocity-controlled pull, or None (force-controlled,
+    no clearance, or a cable that runs slack somewhere)."""
+    from ..errors import ModelError
+    from ..rope_clearance import solve_rope_with_clearance
+
+    if scenario.pull.force_N is not None or clearance_m <= 0.0:
+        return None
+    try:
+        return solve_rope_with_clearance(centreline, clearance_m, scenario.contact.friction, w_N_per_m,
+                                         scenario.pull.back_tension_N, cable_length_m=scenario.cable_length_m)
+    except ModelError:
+        return None
+
+
+def plan_cable_mesh(scenario, conduit, rope, refine: float = 1.0, check_points_per_element: int | None = None):
+    """The scenario's cable mesh by the rule of :mod:`exucable.mesh` (or its override, checked).
+
+    ``refine`` divides the element length (``exucable converge``); ``check_points_per_element``
+    overrides the scenario's ``contact.check_points_per_element``."""
+    from ..mesh import plan_mesh
+
+    c = scenario.cable
+    k = check_points_per_element if check_points_per_element is not None else scenario.contact.check_points_per_element
+    return plan_mesh(conduit.centreline, conduit.inner_radius_m - c.radius_m, scenario.cable_length_m,
+                     c.bending_stiffness_N_m2, float(np.max(rope.tension_N)) if rope is not None else 0.0,
+                     elements=None if "elements" in c.derived_keys else c.elements,
+                     element_length_m=c.element_length_m,
+                     check_points_per_element=k, refine=refine)
+
+
+def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
+                   check_points_per_element: int | None = None) -> InitialLayout:
+    """The start state of ``scenario``'s cable, without Exudyn.
+
+    Pre-stretched to the rope solution's tension, on its bearing wall, sliding at the pull speed
+    (paper Sect. 2.1's pull, started near its quasi-static state, which makes runs ~100× cheaper
+    than starting at rest); with ``solver.pretension = false`` on the centreline, unloaded, at rest.
+
+    Parameters
+    ----------
+    scenario : exucable.scenario.Scenario
+    with_contact : bool
+        False: on the centreline even when pre-tensioned (no wall to bear on).
+    refine : float
+        Divides the mesh rule's element length (``exucable converge``).
+    check_points_per_element : int, optional
+        Overrides ``contact.check_points_per_element``.
+
+    Returns
+    -------
+    InitialLayout
+    """
+    from ..rope import solve_rope, solve_rope_for_pull_force
+
+    sc = scenario
+    conduit = sc.build_conduit()
+    if sc.pull.direction == "reverse":
+        conduit = conduit.reversed()
+    centre = conduit.centreline
+    c = sc.cable
+    L_cable = sc.cable_length_m
+    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
+    w = c.mass_per_length_kg_per_m * g
+    common = dict(friction=sc.contact.friction, weight_per_length_N_per_m=w, cable_length_m=L_cable)
+    if sc.pull.force_N is not None:
+        rope = solve_rope_for_pull_force(centre, pull_force_N=sc.pull.force_N, **common)
+    else:
+        rope = solve_rope(centre, trailing_tension_N=sc.pull.back_tension_N, **common)
+    clearance = conduit.inner_radius_m - c.radius_m
+    mesh = plan_cable_mesh(sc, conduit, rope, refine, check_points_per_element)
+    n_el = mesh.elements
+    if sc.solver.pretension:
+        s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * n_el + 1))
+        T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
+        L_e = L_cable / n_el
+        # blend over the length on which a tensioned beam leaves the wall, √(EJ/T), but at least
+        # half an element so the nodes can follow it
+        T_ref = max(float(np.max(rope.tension_N)), 1e-6)
+        blend = max(0.5 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
+        free = _clearance_rope_start(sc, centre, w, clearance) if with_contact else None
+        path = {}
+        if free is not None:
+            # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
+            # free spans across the clearance, and a start pressed onto the wall the centreline rope's
+            # load points to rang for a second as those spans formed (issue 10, item 3).
+            T_grid = np.interp(s_grid, free.s_conduit_m, free.tension_N)
+            path = {"path_offset_m": np.stack([np.interp(s_grid, free.s_conduit_m, free.offset_m[:, j])
+                                               for j in range(3)], axis=1),
+                    "path_pressure_N_per_m": np.interp(s_grid, free.s_conduit_m, free.sidewall_pressure_N_per_m)}
+        off = contact_offsets(centre, s_grid, T_grid, w, clearance,
+                              sc.contact.stiffness / sc.contact.reference_spacing_m,
+                              sc.contact.exponent, blend, **path) if with_contact else np.zeros((len(s_grid), 3))
+
+        def tension_fn(s):
+            return np.interp(s, s_grid, T_grid)
+
+        def offset_fn(s):
+            return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
+
+        cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, tension_fn,
+                          offset_fn, clearance_m=clearance if with_contact else None)
+    else:
+        cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, 0.0)
+    t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
+    t_entry = np.asarray(centre.tangent(centre.length_m - L_cable), dtype=float)
+    return InitialLayout(conduit=conduit, rope=rope, cable=cable, weight_per_length_N_per_m=w,
+                         exit_tangent=t_exit, entry_tangent=t_entry, mesh=mesh)

@@ -15,10 +15,10 @@ from typing import Callable
 import numpy as np
 import exudyn as exu
 from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, MarkerNodeCoordinate,
-                                  MarkerNodeCoordinates, MarkerNodePosition, NodePointGround,
+                                  MarkerNodeCoordinates, MarkerNodePosition, NodePointGround, ObjectGenericODE2,
                                   ObjectConnectorCoordinateVector)
 
-__all__ = ["Drive", "Guide", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
+__all__ = ["Drive", "Guide", "add_guide", "add_reel", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
            "smooth_ramp", "ramped_displacement"]
 
 
@@ -49,12 +49,14 @@ class Drive:
 
     constraints: tuple[int, int, int]
     direction: np.ndarray
+    # Exudyn's multiplier is the force on the node with the opposite sign when the node's
+    # coordinate is the constraint's second marker (checked: a cable held back by 100 N gives
+    # -100 on the drive along +x); +1 when it is the first marker (a reel, add_reel).
+    sign: float = -1.0
 
     def force_N(self, mbs) -> float:
         lam = np.array([mbs.GetObjectOutput(c, exu.OutputVariableType.Force) for c in self.constraints])
-        # Exudyn's multiplier is the force on the node with the opposite sign (checked: a cable
-        # held back by 100 N gives -100 on the drive along +x).
-        return float(-lam @ self.direction)
+        return float(self.sign * (lam @ self.direction))
 
 
 def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: float = 0.0) -> Drive:
@@ -77,6 +79,22 @@ def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: floa
     return Drive(constraints=tuple(cons), direction=d)
 
 
+def add_reel(mbs, node: int, direction, coordinate_marker: int, radius_m: float) -> Drive:
+    """Reel ``node`` in along unit ``direction`` d by ``radius_m`` × a user's coordinate (a drum's
+    rotation angle [rad]): u_k = d_k·R·φ for each position coordinate k (three
+    ``CoordinateConstraint``, the node's coordinate first, ``factor1 = d_k R``), so the drum
+    feels the cable's pull as the torque R·F. Returns the :class:`Drive` (``force_N`` = F)."""
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    cons = []
+    for k in range(3):
+        m = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=k))
+        cons.append(mbs.AddObject(CoordinateConstraint(
+            markerNumbers=[m, coordinate_marker], factor1=float(d[k] * radius_m),
+            visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]})))
+    return Drive(constraints=tuple(cons), direction=d, sign=1.0)
+
+
 def add_end_force(mbs, node: int, force_vector_N, factor: Callable[[float], float] | None = None) -> int:
     """A force [N] on a node's position (back tension, or the pull of a force-controlled rig),
     optionally scaled in time by ``factor(t)``."""
@@ -90,28 +108,54 @@ def add_end_force(mbs, node: int, force_vector_N, factor: Callable[[float], floa
 
 
 
+@dataclass(frozen=True)
 class Guide:
-    """A sheave on the exit tangent for a force-controlled pull: node ``node`` is held near the
-    line through its start position along unit ``direction`` by a stiff lateral spring-damper
+    """The sheave of a force-controlled pull (see :func:`add_guide`).
+
+    Attributes
+    ----------
+    object : int
+        Exudyn object index.
+    node_index : int
+        Index of the guided node within the cable (0 = trailing end).
+    k : float
+        Lateral stiffness [N/m].
+    c : float
+        Lateral damping [N s/m].
+    """
+
+    object: int
+    node_index: int
+    k: float
+    c: float
+
+
+def add_guide(mbs, node: int, direction, stiffness_N_per_m: float, damping_N_s_per_m: float,
+              node_index: int = -1) -> Guide:
+    """A sheave on the exit tangent for a force-controlled pull: ``node`` is held near the line
+    through its start position along unit ``direction`` d by a stiff lateral spring-damper
     (force −k·P·u − c·P·v with P = I − d dᵀ, u its displacement), free to move along it.
 
-    Applied through the contact coupling's user function (Exudyn 1.13's
-    ObjectConnectorCoordinateVector enforced only the first of two such rows in our tests)."""
-
-    def __init__(self, node_index: int, direction, stiffness_N_per_m: float, damping_N_s_per_m: float):
-        d = np.asarray(direction, dtype=float)
-        d = d / np.linalg.norm(d)
-        self.node_index = int(node_index)      # index of the node within the cable (0 = trailing)
-        self.P = np.eye(3) - np.outer(d, d)
-        self.k = float(stiffness_N_per_m)
-        self.c = float(damping_N_s_per_m)
-
-    def force(self, q_disp, v) -> np.ndarray:
-        """Generalized force on the cable coordinates (displacements ``q_disp`` from the start)."""
-        Q = np.zeros_like(v)
-        i = 6 * self.node_index
-        Q[i:i + 3] = -self.P @ (self.k * q_disp[i:i + 3] + self.c * v[i:i + 3])
-        return Q
+    A mass-free ``ObjectGenericODE2`` on the node with constant stiffness k·P and damping c·P
+    (Exudyn 1.13's ObjectConnectorCoordinateVector enforced only the first of two such rows in
+    our tests). ``node_index`` is the node's index within the cable (for the record).
+    """
+    d = np.asarray(direction, dtype=float)
+    d = d / np.linalg.norm(d)
+    P = np.eye(3) - np.outer(d, d)
+    K = np.zeros((6, 6))
+    D = np.zeros((6, 6))
+    K[:3, :3] = float(stiffness_N_per_m) * P
+    D[:3, :3] = float(damping_N_s_per_m) * P
+    M, Kc, Dc = (exu.MatrixContainer() for _ in range(3))
+    M.Initialize(6, 6, False)
+    Kc.SetWithDenseMatrix(K, False)
+    Dc.SetWithDenseMatrix(D, False)
+    obj = mbs.AddObject(ObjectGenericODE2(
+        nodeNumbers=[node], massMatrix=M, stiffnessMatrix=Kc, dampingMatrix=Dc,
+        visualization={"show": False, "color": [-1.0, -1.0, -1.0, -1.0], "triangleMesh": [],
+                       "showNodes": False, "graphicsDataUserFunction": 0}))
+    return Guide(object=obj, node_index=int(node_index), k=float(stiffness_N_per_m), c=float(damping_N_s_per_m))
 
 
 @dataclass(frozen=True)

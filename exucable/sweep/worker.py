@@ -27,7 +27,7 @@ import time
 import traceback
 from pathlib import Path
 
-from .. import __version__
+from ..version import __version__
 from ..io import atomic_write_bytes, atomic_write_text
 from ..scenario import parse_scenario
 from .store import (CASE_JSON, RECORD_OUTPUTS, install_case, is_finished, read_record, temp_dir,
