@@ -475,13 +475,22 @@ class ContactKernel:
             raise ValueError(f"{name} must have shape ({self.n_coordinates},), got {x.shape}")
         return x
 
+    #: True when the check points' velocities are a function of q (see :meth:`_velocity_map`)
+    velocity_from_coordinates = False
+
+    def _velocity_map(self, shape, q, q_t):
+        """(shape table, coordinates) whose product gives the check points' velocities:
+        v = S(ξ) q̇ (Eq. 8). Subclasses may derive v from q instead (steady sliding)."""
+        return shape, q_t
+
     def _state_numpy(self, q, q_t, jacobian):
         n_el, n_k = self.n_elements, self.n_check_points
         shape = np.broadcast_to(self._nh, (n_el, n_k, 4)).copy()
         shape[:, :, 1] *= self.element_length_m[:, None]
         shape[:, :, 3] *= self.element_length_m[:, None]
         p = np.einsum("ekA,eAi->eki", shape, _element_values(q))  # Eq. 2
-        v = np.einsum("ekA,eAi->eki", shape, _element_values(q_t))  # Eq. 8
+        rate_shape, rate_source = self._velocity_map(shape, q, q_t)
+        v = np.einsum("ekA,eAi->eki", rate_shape, _element_values(rate_source))  # Eq. 8
         offsets, indices = self.candidates(q)
         segment = np.full((n_el, n_k), -1, dtype=np.int64)
         t = np.full((n_el, n_k), np.nan)
@@ -511,7 +520,7 @@ class ContactKernel:
         law = _point_law(residual.reshape(-1, 3), v.reshape(-1, 3), axis_inside.reshape(-1, 3),
                          w.reshape(-1), self.law, self.gap_m, jacobian)
         return {"p": p.reshape(-1, 3), "v": v.reshape(-1, 3), "segment": segment.reshape(-1),
-                "t": t.reshape(-1), "shape": shape, "law": law, "phi": phi}
+                "t": t.reshape(-1), "shape": shape, "rate_shape": rate_shape, "law": law, "phi": phi}
 
     def _evaluate_numpy(self, q, q_t, jacobian):
         st = self._state_numpy(q, q_t, jacobian)
@@ -534,5 +543,10 @@ class ContactKernel:
             jv = law["jv"].reshape(n_el, n_k, 3, 3)
             # (N Nᵀ) ⊗ J per point, summed over the element's points
             jq = np.einsum("ekA,ekB,ekij->eAiBj", shape, shape, jp).reshape(n_el, 12, 12)
-            jqt = np.einsum("ekA,ekB,ekij->eAiBj", shape, shape, jv).reshape(n_el, 12, 12)
+            jv_blocks = np.einsum("ekA,ekB,ekij->eAiBj", shape, st["rate_shape"], jv).reshape(n_el, 12, 12)
+            if self.velocity_from_coordinates:   # v depends on q, not on q̇
+                jq += jv_blocks
+                jqt = np.zeros_like(jq)
+            else:
+                jqt = jv_blocks
         return ContactResult(force, jq, jqt, n_contact, max_pen)
