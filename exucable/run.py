@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -17,7 +18,7 @@ from .errors import ExucableError
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
 from .solve import Progress, simulate, steady_quantity
-from .tension import detect_steady_state, tension_profile
+from .tension import SteadyState, detect_steady_state, tension_profile
 
 __all__ = ["run_scenario", "contact_profile", "add_arguments", "main"]
 
@@ -53,7 +54,7 @@ def contact_profile(model, max_rows: int = 5000) -> tuple[dict | None, float]:
 
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
-                 steady_stop: bool | None = None) -> RunResult:
+                 steady_stop: bool | None = None, mode: str | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
@@ -63,21 +64,32 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     from .model.build import build_model
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if mode is not None and mode != sc.solver.mode:
+        sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
     t_start = time.perf_counter()
     model = build_model(sc)
     build_s = time.perf_counter() - t_start
-    progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
-    out = simulate(model, progress=progress, steady_stop=steady_stop)
-    h = out.history.arrays()
     sp = sc.solver
-    st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
-    i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
+    if sp.mode == "steady":
+        from .solve_steady import solve_steady
+        out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
+        h = out.history.arrays()
+        # one static state: the result is the last (converged) load step's
+        st = SteadyState(out.status != "failed", 0.0, 0.0, 0.0, 0.0)
+        i0 = max(len(h["time_s"]) - 1, 0)
+    else:
+        progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
+        out = simulate(model, progress=progress, steady_stop=steady_stop)
+        h = out.history.arrays()
+        st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
+        i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
     cprof, peak_pressure = contact_profile(model)
     rope = model.rope
     summary = {
         "name": sc.name,
+        "mode": sp.mode,
         "status": out.status,
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
@@ -122,6 +134,9 @@ def add_arguments(p) -> None:
     p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    p.add_argument("--mode", choices=("dynamic", "steady"), default=None,
+                   help="dynamic time integration or one static solve of steady sliding "
+                        "(overrides solver.mode)")
     p.add_argument("--steady-stop", dest="steady_stop", action="store_true", default=None,
                    help="stop once the pulling force is steady (overrides solver.steady_stop)")
     p.add_argument("--no-steady-stop", dest="steady_stop", action="store_false",
@@ -135,7 +150,8 @@ def _f(value, fmt=".6g") -> str:
 def main(args) -> int:
     sc = load_scenario(args.scenario)
     out_dir = Path(args.out) if args.out else Path("out") / sc.name
-    res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop)
+    res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
+                       mode=args.mode)
     s = res.summary
     rope = s.get("rope_pull_force_N")
     print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
@@ -147,8 +163,12 @@ def main(args) -> int:
         ref, got, what = rope, s["pull_force_N"], "pulling force"
     if ref is not None and got is not None and np.isfinite(got):
         print(f"  rope reference: {what} {ref:.6g} N ({100 * (got / ref - 1):+.3f} %)")
-    print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
-          f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    if s["mode"] == "steady":
+        print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} load steps, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    else:
+        print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
     if s["status"] == "failed":
         print(f"  FAILED: {s['message']} (at t = {_f(s.get('failed_at_s'))} s); "

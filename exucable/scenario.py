@@ -350,6 +350,9 @@ class SolverSpec:
         Relative drift/scatter bound of the pulling force in that window [-].
     pretension : bool
         Start from the rope solution's tension profile near contact equilibrium.
+    mode : {"dynamic", "steady"}
+        ``"dynamic"``: integrate the paper's dynamics in time; ``"steady"``: solve the steady
+        sliding state in one static solve (:mod:`exucable.solve_steady`).
     """
 
     end_time_s: float
@@ -365,6 +368,7 @@ class SolverSpec:
     newton_tolerance: float = 1.0e-7
     startup_time_s: float = 0.05
     startup_damping_1_per_s: float = 200.0
+    mode: str = "dynamic"
 
     def to_dict(self) -> dict:
         """The ``[solver]`` table in TOML key names, defaults filled in."""
@@ -382,6 +386,7 @@ class SolverSpec:
             "steady_window": self.steady_window_s,
             "steady_tolerance": self.steady_tolerance,
             "pretension": self.pretension,
+            "mode": self.mode,
         }
 
 
@@ -1034,6 +1039,9 @@ def _parse_gravity(data) -> GravitySpec:
     return GravitySpec(g_m_per_s2=t.number("g", "m/s^2", ge=0.0))
 
 
+SOLVER_MODES = ("dynamic", "steady")
+
+
 def _parse_solver(data) -> SolverSpec:
     t = _Table(
         data,
@@ -1041,7 +1049,7 @@ def _parse_solver(data) -> SolverSpec:
         {
             "end_time", "step", "min_step", "spectral_radius", "newton_max_iterations", "newton_tolerance",
             "output_interval", "startup_time", "startup_damping",
-            "steady_stop", "steady_window", "steady_tolerance", "pretension",
+            "steady_stop", "steady_window", "steady_tolerance", "pretension", "mode",
         },
     )
     end_time = t.number("end_time", "s", gt=0.0)
@@ -1065,6 +1073,7 @@ def _parse_solver(data) -> SolverSpec:
         steady_window_s=t.number("steady_window", "s", default=0.2, gt=0.0),
         steady_tolerance=t.number("steady_tolerance", "", default=1.0e-3, gt=0.0),
         pretension=t.boolean("pretension", default=True),
+        mode=t.choice("mode", SOLVER_MODES, default="dynamic"),
     )
 
 

@@ -23,6 +23,8 @@ damping's share, whose entry and exit contributions cancel along a contact zone.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numba import njit
 
@@ -64,6 +66,17 @@ class SteadySlidingKernel(ContactKernel):
         self._dnh = hermite_unit_derivative(self.xi)
         if self._fast is not None:
             self._fast = _SteadyFast(self._fast, self._dnh, self.speed_m_per_s)
+
+    def set_friction_scale(self, scale: float) -> None:
+        """Scale μ_k and μ_s by ``scale`` [-] (a continuation parameter; 1 = the scenario's law)."""
+        if not hasattr(self, "_base_law"):
+            self._base_law = self.law
+        base = self._base_law
+        law = replace(base, friction=scale * base.friction,
+                      static_friction=None if base.static_friction is None else scale * base.static_friction)
+        self.law = law
+        if self._fast is not None:
+            self._fast.fast.law = law
 
     def _velocity_map(self, shape, q, q_t):
         # V ∂r/∂x: positions' columns dN/dξ / L, slopes' columns dN/dξ (L N_unit differentiated)

@@ -17,7 +17,7 @@ from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, contact_offsets, lay_cable
 from .rig import Drive, Guide, add_drive, add_end_force, add_tangential_drive, smooth_ramp
 
-__all__ = ["Model", "build_model", "pull_oriented_conduit"]
+__all__ = ["LoadScale", "Model", "build_model", "pull_oriented_conduit"]
 
 
 @dataclass(eq=False)
@@ -36,6 +36,7 @@ class Model:
     applied_pull_force_N: float | None   # force-controlled pull
     back_tension_N: float
     rope: RopeSolution | None
+    load_scale: "LoadScale" = None
     coupling: object | None = None
     kernel: object | None = None
     ode2_index: np.ndarray = field(default=None)
@@ -66,6 +67,21 @@ class Model:
         if self.trail_drive is None:
             return None
         return -self.trail_drive.force_N(self.mbs)
+
+
+class LoadScale:
+    """Scale factors [-] of the loads in a steady (static) solve: the continuation parameters of
+    :func:`exucable.solve_steady.solve_steady`. All 1 = the scenario's loads."""
+
+    def __init__(self):
+        self.gravity = 1.0
+        self.end_force = 1.0
+
+    def gravity_factor(self, t: float) -> float:
+        return self.gravity
+
+    def end_force_factor(self, t: float) -> float:
+        return self.end_force
 
 
 def pull_oriented_conduit(scenario):
@@ -155,30 +171,43 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     mbs = SC.AddSystem()
     cable = add_cable(mbs, layout.coordinates, layout.element_length_m, props, layout.velocities,
                       draw_radius_m=c.radius_m)
+    # steady mode: a static solve of the steady sliding state; the rig holds the leading end
+    # (or, for a force-controlled pull, the trailing end) where the start put it, and the loads'
+    # scale is the continuation parameter of exucable.solve_steady, not time
+    steady = sc.solver.mode == "steady"
     ramp_time = sc.pull.ramp_time_s
-    factor = None if ramp_time <= 0 else (lambda t: smooth_ramp(t, ramp_time))
+    load_scale = LoadScale()
+    if steady:
+        factor = load_scale.gravity_factor
+    else:
+        factor = None if ramp_time <= 0 else (lambda t: smooth_ramp(t, ramp_time))
     if g > 0:
         add_gravity(mbs, cable, [0.0, 0.0, -g], factor)
+    end_factor = load_scale.end_force_factor if steady else factor
+    rig_speed = 0.0 if steady else speed
     t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
     s_trail = centre.length_m - L_cable
     t_entry = np.asarray(centre.tangent(s_trail), dtype=float)
     lead_drive = trail_drive = None
     applied = None
     if sc.pull.force_N is None:
-        lead_drive = add_drive(mbs, cable.nodes[-1], t_exit, speed, ramp_time)
+        lead_drive = add_drive(mbs, cable.nodes[-1], t_exit, rig_speed, ramp_time)
         if sc.pull.back_tension_N > 0:
-            add_end_force(mbs, cable.nodes[0], -sc.pull.back_tension_N * t_entry, factor)
+            add_end_force(mbs, cable.nodes[0], -sc.pull.back_tension_N * t_entry, end_factor)
     else:
         applied = sc.pull.force_N
-        add_end_force(mbs, cable.nodes[-1], applied * t_exit, factor)
-        if ramp_time > 0.0:
+        add_end_force(mbs, cable.nodes[-1], applied * t_exit, end_factor)
+        if steady:
+            trail_drive = add_drive(mbs, cable.nodes[0], t_entry, 0.0)
+        elif ramp_time > 0.0:
             trail_drive = add_drive(mbs, cable.nodes[0], t_entry, speed, ramp_time)
         else:
             trail_drive = add_tangential_drive(mbs, cable.nodes[0], t_entry, speed)
 
     model = Model(scenario=sc, system_container=SC, mbs=mbs, conduit=conduit, cable=cable, layout=layout,
                   properties=props, lead_drive=lead_drive, trail_drive=trail_drive,
-                  applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope)
+                  applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope,
+                  load_scale=load_scale)
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
         from .coupling import ContactCoupling, StartupDamper
@@ -187,14 +216,18 @@ def build_model(scenario, with_contact: bool = True) -> Model:
                          static_friction=ct.static_friction, stribeck_velocity_m_per_s=ct.stribeck_velocity_m_per_s,
                          regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s,
                          damping_onset_m=ct.damping_onset_m)
-        kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
-                               ct.check_points_per_element, rule=ct.check_point_rule,
-                               reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
-                               surface=ct.surface, centreline=centre)
+        kernel_type, extra = ContactKernel, {}
+        if steady:
+            from ..contact.steady import SteadySlidingKernel
+            kernel_type, extra = SteadySlidingKernel, {"speed_m_per_s": speed}
+        kernel = kernel_type(conduit.segments, layout.element_length_m, c.radius_m, law,
+                             ct.check_points_per_element, rule=ct.check_point_rule,
+                             reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
+                             surface=ct.surface, centreline=centre, **extra)
         model.kernel = kernel
         damper = None
         sp = sc.solver
-        if sp.pretension and sp.startup_time_s > 0.0:
+        if sp.pretension and sp.startup_time_s > 0.0 and not steady:
             Le = layout.element_length_m
             lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
             damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
