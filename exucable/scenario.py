@@ -1057,6 +1057,11 @@ def _parse_solver(data) -> SolverSpec:
     min_step = t.number("min_step", "s", default=min(_DEFAULT_MIN_STEP_S, step), gt=0.0)
     if min_step > step:
         raise ScenarioError("solver.min_step", f"must be <= solver.step ({step!r} s), got {min_step!r}")
+    mode = t.choice("mode", SOLVER_MODES, default="dynamic")
+    pretension = t.boolean("pretension", default=True)
+    if mode == "steady" and not pretension:
+        raise ScenarioError("solver.pretension", 'solver.mode = "steady" starts from the rope solution\'s '
+                            "tension profile near the steady state; set it to true (or use the dynamic mode)")
     return SolverSpec(
         end_time_s=end_time,
         step_s=step,
@@ -1072,8 +1077,8 @@ def _parse_solver(data) -> SolverSpec:
         steady_stop=t.boolean("steady_stop", default=False),
         steady_window_s=t.number("steady_window", "s", default=0.2, gt=0.0),
         steady_tolerance=t.number("steady_tolerance", "", default=1.0e-3, gt=0.0),
-        pretension=t.boolean("pretension", default=True),
-        mode=t.choice("mode", SOLVER_MODES, default="dynamic"),
+        pretension=pretension,
+        mode=mode,
     )
 
 

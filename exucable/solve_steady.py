@@ -14,16 +14,20 @@ contact law, smooth wall, broad phase, gravity, back tension), built by
 
 and solved from the pre-tensioned start (the rope solution) with Exudyn's static solver.
 
-Why load steps: the start is near equilibrium, but a full Newton step from it overshoots into
-the wall (Hertz contact is stiff, 1e5-1e6 N/m per node, and the free spans are soft), and the
-iterates then bounce between contact states. Exudyn's static solver can add a mass-proportional
-term to the Jacobian that fades out over the load steps (``stabilizerODE2term``, scaled by
-1 - λ², λ the load step's factor): a damped Newton that turns into plain Newton at the last step.
+Why pseudo-time steps: the start is near equilibrium, but a full Newton step from it overshoots
+into the wall (Hertz contact is stiff, 1e5-1e6 N/m per node, the free spans are soft), and the
+iterates then bounce between contact states. Where the cable continues a bend's inner wall along
+a straight it grazes that wall with δ → 0 over a long stretch, the Hertz stiffness ∝ δ^(1/2)
+vanishes there, and plain Newton 2-cycles (a check point in contact is pushed out, out of contact
+it falls back in): the "stall near 1e-5" of the first probe. So the solve is pseudo-transient
+continuation (Kelley & Keyes 1998): each static solve adds a spring c·m_k·(q_k - q̄_k) to every
+coordinate, anchored at the previous solve's state q̄ (m_k the lumped nodal mass, times L_e² for
+slopes), which makes every Newton problem well posed; c starts at an element's axial stiffness
+per mass and falls by 4 after each converged solve (rises by 4 after a failed one). The spring's
+force c·m·(q - q̄) at convergence is exactly the residual of the unregularised equilibrium, so the
+solve stops once its norm is below ``STATIC_TOLERANCE`` times the rope solution's largest tension.
 Where that does not converge, the loads themselves are ramped (friction, gravity and end forces
-scaled by λ, ``continuation``) with steps halved on failure.
-
-Convergence: Newton's residual relative to its largest value in the step; see
-``reference/README.md`` for the stall near 1e-5 and the tolerance chosen here.
+scaled by λ) with the increment halved on failure.
 """
 
 from __future__ import annotations
@@ -38,42 +42,41 @@ from .tension import tension_at, tension_profile
 
 __all__ = ["solve_steady", "static_settings", "STATIC_TOLERANCE"]
 
-#: Newton's relative residual tolerance of the static solve [-]. Newton stalls near 1e-5 on the
-#: paper's examples (the Hertz law's infinite curvature at first touch, see reference/README.md);
-#: 1e-4 moves the pulling force by < 1e-5 relative there (measured: tests/test_steady.py).
-STATIC_TOLERANCE = 1e-4
+#: Residual of the steady equilibrium at which the solve stops, relative to the largest tension of
+#: the rope solution [-]: the spring force c·m·(q - q̄) left at the last pseudo-time step.
+STATIC_TOLERANCE = 1e-6
 
-#: Load steps over which the Jacobian stabiliser fades out in one static solve.
-LOAD_STEPS = 10
+#: Newton's relative tolerance inside one pseudo-time step (its problem is well posed).
+NEWTON_TOLERANCE = 1e-8
+
+#: Pseudo-time steps before the solve is declared failed.
+MAX_PSEUDO_STEPS = 80
 
 #: Smallest continuation increment of the load scale before the solve is declared failed.
-MIN_CONTINUATION_STEP = 1.0 / 64.0
+MIN_CONTINUATION_STEP = 1.0 / 16.0
 
 
-def stabilizer(model) -> float:
-    """Mass-proportional Jacobian term [1/s²] of the first load step: an element's axial
-    stiffness EA/L_e per its mass ρA·L_e, E/(ρ L_e²) — of the order of the contact stiffness per
-    node, so the first steps are short and the iterates do not jump through the wall."""
+def initial_spring_rate(model) -> float:
+    """c0 [1/s²]: an element's axial stiffness EA/L_e per its mass ρA·L_e, E/(ρ L_e²) — of the
+    order of the contact stiffness per node, so the first steps are short."""
     L_e = float(np.min(model.layout.element_length_m))
     return model.axial_stiffness_N / (model.properties.mass_per_length_kg_per_m * L_e * L_e)
 
 
-def static_settings(model, load_steps: int = LOAD_STEPS, tolerance: float = STATIC_TOLERANCE,
-                    max_iterations: int = 25) -> exu.SimulationSettings:
-    """Exudyn's static solver settings of one steady solve (loads are scaled by us, not by
-    Exudyn's load factor; the load steps only fade the stabiliser)."""
+def static_settings(tolerance: float = NEWTON_TOLERANCE, max_iterations: int = 12,
+                    absolute_tolerance_N: float = 1e-10) -> exu.SimulationSettings:
+    """Exudyn's static solver settings of one pseudo-time step: one load step, plain Newton."""
     s = exu.SimulationSettings()
     ss = s.staticSolver
-    ss.numberOfLoadSteps = int(load_steps)
+    ss.numberOfLoadSteps = 1
     ss.loadStepDuration = 1.0
     ss.useLoadFactor = False
-    ss.stabilizerODE2term = stabilizer(model)
-    ss.adaptiveStep = True
-    ss.minimumStepSize = 1e-4
+    ss.stabilizerODE2term = 0.0
+    ss.adaptiveStep = False
     ss.verboseMode = 0
     ss.newton.useModifiedNewton = False
     ss.newton.relativeTolerance = tolerance
-    ss.newton.absoluteTolerance = 1e-10
+    ss.newton.absoluteTolerance = absolute_tolerance_N
     ss.newton.maxIterations = int(max_iterations)
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     s.solution.file.write = False
@@ -81,6 +84,57 @@ def static_settings(model, load_steps: int = LOAD_STEPS, tolerance: float = STAT
     s.show.computationTime = False
     s.show.statistics = False
     return s
+
+
+class PseudoTimeSpring:
+    """The pseudo-transient term c·m_k·(q_k - q̄_k) on the cable coordinates, as an
+    ``ObjectGenericODE2`` with a force and a (diagonal, sparse) Jacobian user function.
+
+    m_k: lumped nodal mass [kg] for positions, times L_e² [kg·m²] for slopes.
+    """
+
+    def __init__(self, model):
+        from exudyn.itemInterface import ObjectGenericODE2
+
+        Le = np.asarray(model.layout.element_length_m, dtype=float)
+        rho_a = model.properties.mass_per_length_kg_per_m
+        m_node = rho_a * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
+        L_node = np.maximum(np.concatenate([Le, [0.0]]), np.concatenate([[0.0], Le]))
+        w = np.empty((len(m_node), 6))
+        w[:, :3] = m_node[:, None]
+        w[:, 3:] = (m_node * L_node**2)[:, None]
+        self.mass = w.reshape(-1)
+        self.n = self.mass.size
+        self.rate = 0.0                       # c [1/s²]
+        self.anchor = np.zeros(self.n)        # q̄ (displacement coordinates)
+        self._diag = np.column_stack([np.arange(self.n, dtype=float), np.arange(self.n, dtype=float),
+                                      np.zeros(self.n)])
+        empty = [exu.MatrixContainer() for _ in range(3)]
+        for m in empty:
+            m.Initialize(self.n, self.n, False)
+        mbs = model.mbs
+        self.object = mbs.AddObject(ObjectGenericODE2(
+            nodeNumbers=list(model.cable.nodes), massMatrix=empty[0], stiffnessMatrix=empty[1],
+            dampingMatrix=empty[2], forceUserFunction=self._force, jacobianUserFunction=self._jacobian,
+            visualization={"show": False, "color": [-1.0, -1.0, -1.0, -1.0], "triangleMesh": [],
+                           "showNodes": False, "graphicsDataUserFunction": 0}))
+        mbs.Assemble()
+
+    def force(self, q) -> np.ndarray:
+        """Generalized force -c·m·(q - q̄) [N, N·m]."""
+        return -self.rate * self.mass * (np.asarray(q, dtype=float) - self.anchor)
+
+    def _force(self, mbs, t, item, q, q_t):
+        return self.force(q)
+
+    def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
+        m = exu.MatrixContainer()
+        if self.rate == 0.0 or f_q == 0.0:
+            m.Initialize(self.n, self.n, False)
+            return m
+        self._diag[:, 2] = f_q * self.rate * self.mass
+        m.SetWithSparseMatrix(self._diag, self.n, self.n, False)
+        return m
 
 
 class _StateStore:
@@ -126,91 +180,135 @@ def steady_forces(model) -> tuple[float, float, float]:
     return float(pull), float(trail), float(np.max(N))
 
 
+def _outside_points(model) -> int:
+    """Check points with no conduit segment within R of them (outside the conduit, or beyond
+    its open ends where the rig holds the cable)."""
+    q, _ = model.coordinates()
+    q = q.reshape(-1)
+    return int(np.count_nonzero(model.kernel.points(q, np.zeros_like(q)).segment < 0))
+
+
 def _set_scale(model, lam: float) -> None:
-    model.load_scale.gravity = lam
-    model.load_scale.end_force = lam
+    model.load_scale.apply(model.mbs, gravity=lam, end_force=lam)
     model.kernel.set_friction_scale(lam)
 
 
 def solve_steady(model, progress: Progress | None = None) -> SolveOutcome:
     """Solve ``model`` (built with ``solver.mode = "steady"``) for its steady sliding state.
 
-    First one static solve at the full loads; if it fails, continuation from the start in the
-    load scale λ (friction, gravity, end forces), doubling the increment after a success and
-    halving it after a failure. The history has one row per converged load step, its
-    ``time_s`` column holding the continuation parameter (stage - 1 + load step factor) [-].
+    Pseudo-transient continuation from the pre-tensioned start at the full loads; if that fails,
+    continuation in the load scale λ (friction, gravity, end forces) from the start, each stage
+    solved the same way, the increment doubled after a success and halved after a failure. The
+    history has one row per converged pseudo-time step; its ``time_s`` column holds the step's
+    number [-] (not a time: a static solve has none).
 
     Never raises for a diverging solve: the outcome has ``status == "failed"`` and the message.
     """
     mbs = model.mbs
     history = History()
+    spring = PseudoTimeSpring(model)
     store = _StateStore(mbs)
-    stage = [0]
+    start = store.saved
     counters = {"newton": 0, "jacobian": 0, "steps": 0}
+    scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
+                  model.back_tension_N, 1.0)
+    tolerance_N = STATIC_TOLERANCE * scale_N
+    settings = static_settings(absolute_tolerance_N=1e-3 * tolerance_N)
+    c0 = initial_spring_rate(model)
     t_wall = time.perf_counter()
+    total = [0]
 
-    def post_step(mbs_, t):
-        if t <= 0.0:       # Exudyn's call for the start state: not a solved load step
-            return True
-        pull, trail, tmax = steady_forces(model)
-        history.time_s.append(stage[0] + float(t))
-        history.pull_force_N.append(pull)
-        history.trailing_tension_N.append(trail)
-        history.max_tension_N.append(tmax)
-        if progress is not None:
-            progress.update(stage[0] + float(t), f"F = {pull:.4g} N")
-        return True
-
-    mbs.SetPostStepUserFunction(post_step)
-
-    def attempt(lam: float) -> tuple[bool, str]:
-        _set_scale(model, lam)
+    def one_solve() -> tuple[bool, str]:
         solver = exu.MainSolverStatic()
-        n_rows = len(history.time_s)
         try:
-            ok = solver.SolveSystem(mbs, static_settings(model))
+            ok = solver.SolveSystem(mbs, settings)
             message = "" if ok else (solver.GetErrorString() or "Newton did not converge")
         except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
             ok, message = False, f"{type(exc).__name__}: {exc}".strip()
         counters["newton"] += int(solver.it.newtonStepsCount)
         counters["jacobian"] += int(solver.it.newtonJacobiCount)
-        counters["steps"] += int(solver.it.currentStepIndex)
-        if not ok:
-            del history.time_s[n_rows:], history.pull_force_N[n_rows:]
-            del history.trailing_tension_N[n_rows:], history.max_tension_N[n_rows:]
         return ok, message
 
+    def relax(lam: float) -> tuple[bool, str]:
+        """Pseudo-time steps at load scale ``lam`` from the stored state until the equilibrium
+        residual is below the tolerance."""
+        _set_scale(model, lam)
+        c = c0
+        message = ""
+        for _ in range(MAX_PSEUDO_STEPS):
+            store.restore_as_initial()
+            spring.anchor = _cable_part(model, store.saved[0])
+            spring.rate = c
+            ok, message = one_solve()
+            counters["steps"] += 1
+            if not ok:
+                c *= 4.0
+                if c > 1e6 * c0:
+                    return False, message
+                continue
+            q_now = _cable_part(model, np.array(mbs.systemData.GetODE2Coordinates()))
+            residual = float(np.linalg.norm(spring.force(q_now)))
+            store.save()
+            total[0] += 1
+            pull, trail, tmax = steady_forces(model)
+            history.time_s.append(float(total[0]))
+            history.pull_force_N.append(pull)
+            history.trailing_tension_N.append(trail)
+            history.max_tension_N.append(tmax)
+            if progress is not None:
+                progress.update(min(1.0, tolerance_N / max(residual, 1e-300)),
+                                f"λ = {lam:.3g}, residual {residual:.2e} N, F = {pull:.5g} N")
+            if residual <= tolerance_N:
+                return True, ""
+            c /= 4.0
+        return False, f"no equilibrium after {MAX_PSEUDO_STEPS} pseudo-time steps"
+
     status, message = "ok", ""
-    ok, first_message = attempt(1.0)
+    outside_at_start = _outside_points(model)
+    ok, first_message = relax(1.0)
     if ok:
-        message = "direct static solve"
+        message = f"{total[0]} pseudo-time steps"
     else:
-        # continuation from the start in the load scale
-        store.restore_as_initial()
-        lam, step = 0.0, 0.25
+        store.saved = start
+        lam, step, stages = 0.0, 0.5, 0
         while lam < 1.0:
             target = min(1.0, lam + step)
-            stage[0] += 1
-            ok, msg = attempt(target)
+            before = store.saved
+            ok, msg = relax(target)
+            stages += 1
             if ok:
                 lam = target
-                store.save()
-                store.restore_as_initial()
                 step = min(2.0 * step, 1.0)
             else:
-                store.restore_as_initial()
+                store.saved = before
                 step *= 0.5
                 if step < MIN_CONTINUATION_STEP:
                     status = "failed"
                     message = (f"no steady state found: continuation stalled at load scale {lam:.4g} "
-                               f"(direct solve: {first_message}; last: {msg})")
+                               f"(at full load: {first_message}; last: {msg})")
                     break
         if status == "ok":
-            message = f"continuation in {stage[0]} stages (direct solve failed: {first_message})"
-    mbs.SetPostStepUserFunction(0)
+            message = (f"continuation in the load scale, {stages} stages, {total[0]} pseudo-time steps "
+                       f"(at full load from the start: {first_message})")
+    store.restore_as_initial()
+    spring.rate = 0.0
+    if status == "ok":
+        # an equilibrium with the cable pulled out of the conduit (straight across its walls) is
+        # a solution of the same equations, but not the steady pull
+        outside = _outside_points(model) - outside_at_start
+        if outside > model.kernel.n_check_points:
+            status = "failed"
+            message = (f"the static solve found an equilibrium with {outside} more check points outside "
+                       f"the conduit than at the start: the cable left the conduit (start too far from "
+                       f"the steady state?)")
     wall = time.perf_counter() - t_wall
     if progress is not None:
         progress.close()
     return SolveOutcome(history=history, status=status, message=message, end_time_s=0.0,
                         steps=counters["steps"], newton_iterations=counters["newton"],
                         jacobian_updates=counters["jacobian"], wall_time_s=wall)
+
+
+def _cable_part(model, q_all) -> np.ndarray:
+    """The cable's displacement coordinates out of the system's ODE2 vector."""
+    return np.asarray(q_all, dtype=float)[model.ode2_index]

@@ -70,18 +70,30 @@ class Model:
 
 
 class LoadScale:
-    """Scale factors [-] of the loads in a steady (static) solve: the continuation parameters of
-    :func:`exucable.solve_steady.solve_steady`. All 1 = the scenario's loads."""
+    """Scale factors [-] of the loads of a steady (static) solve, the continuation parameters of
+    :func:`exucable.solve_steady.solve_steady`: gravity and the end forces (back tension or the
+    applied pull). All 1 = the scenario's loads. The loads carry no user function (Exudyn would
+    call it once per element and residual); :meth:`apply` rewrites their load vectors instead."""
 
     def __init__(self):
         self.gravity = 1.0
         self.end_force = 1.0
+        self._gravity_loads: list[tuple[int, list]] = []
+        self._end_loads: list[tuple[int, list]] = []
 
-    def gravity_factor(self, t: float) -> float:
-        return self.gravity
+    def track(self, gravity_loads=(), end_loads=(), vectors=None) -> None:
+        """Remember loads (indices) and their full-scale vectors [N or m/s²]."""
+        for i in gravity_loads:
+            self._gravity_loads.append((i, vectors[i]))
+        for i in end_loads:
+            self._end_loads.append((i, vectors[i]))
 
-    def end_force_factor(self, t: float) -> float:
-        return self.end_force
+    def apply(self, mbs, gravity: float, end_force: float) -> None:
+        """Set the factors and rewrite the loads' vectors."""
+        self.gravity, self.end_force = float(gravity), float(end_force)
+        for loads, f in ((self._gravity_loads, self.gravity), (self._end_loads, self.end_force)):
+            for i, vec in loads:
+                mbs.SetLoadParameter(i, "loadVector", [f * x for x in vec])
 
 
 def pull_oriented_conduit(scenario):
@@ -175,15 +187,16 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     # (or, for a force-controlled pull, the trailing end) where the start put it, and the loads'
     # scale is the continuation parameter of exucable.solve_steady, not time
     steady = sc.solver.mode == "steady"
+    if steady and not sc.solver.pretension:
+        raise ModelError("solver.pretension", 'solver.mode = "steady" starts from the rope solution near the '
+                         "steady state; set it to true (or use the dynamic mode)")
     ramp_time = sc.pull.ramp_time_s
     load_scale = LoadScale()
-    if steady:
-        factor = load_scale.gravity_factor
-    else:
-        factor = None if ramp_time <= 0 else (lambda t: smooth_ramp(t, ramp_time))
+    factor = None if (steady or ramp_time <= 0) else (lambda t: smooth_ramp(t, ramp_time))
     if g > 0:
-        add_gravity(mbs, cable, [0.0, 0.0, -g], factor)
-    end_factor = load_scale.end_force_factor if steady else factor
+        gravity_vector = [0.0, 0.0, -g]
+        loads = add_gravity(mbs, cable, gravity_vector, factor)
+        load_scale.track(gravity_loads=loads, vectors={i: gravity_vector for i in loads})
     rig_speed = 0.0 if steady else speed
     t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
     s_trail = centre.length_m - L_cable
@@ -193,10 +206,14 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     if sc.pull.force_N is None:
         lead_drive = add_drive(mbs, cable.nodes[-1], t_exit, rig_speed, ramp_time)
         if sc.pull.back_tension_N > 0:
-            add_end_force(mbs, cable.nodes[0], -sc.pull.back_tension_N * t_entry, end_factor)
+            vec = list(-sc.pull.back_tension_N * t_entry)
+            i = add_end_force(mbs, cable.nodes[0], vec, factor)
+            load_scale.track(end_loads=[i], vectors={i: vec})
     else:
         applied = sc.pull.force_N
-        add_end_force(mbs, cable.nodes[-1], applied * t_exit, end_factor)
+        vec = list(applied * t_exit)
+        i = add_end_force(mbs, cable.nodes[-1], vec, factor)
+        load_scale.track(end_loads=[i], vectors={i: vec})
         if steady:
             trail_drive = add_drive(mbs, cable.nodes[0], t_entry, 0.0)
         elif ramp_time > 0.0:
