@@ -14,27 +14,19 @@ from .errors import ExucableError
 
 __all__ = ["main", "SUBCOMMANDS"]
 
-# name -> (module with add_arguments(parser) and main(args) -> int, one-line help)
+# name -> (module in exucable.commands with add_arguments(parser) and main(args) -> int, one-line help)
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
-    "route": ("exucable.route", "draw a scenario's conduit route and print its table"),
-    "run": ("exucable.run", "simulate one scenario and write its results"),
-    "validate": ("exucable.validate", "run the paper's examples against their references"),
-    "sweep": ("exucable.sweep", "run a parameter sweep (local pool or Dask)"),
-    "compare": ("exucable.compare", "compare two result sets (yours and ours)"),
+    "route": ("exucable.commands.route", "draw a scenario's conduit route and print its table"),
+    "run": ("exucable.commands.run", "simulate one scenario and write its results"),
+    "validate": ("exucable.commands.validate", "run the paper's examples against their references"),
+    "sweep": ("exucable.commands.sweep", "run a parameter sweep (local pool or Dask)"),
+    "compare": ("exucable.commands.compare", "compare two result sets (yours and ours)"),
+    "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
 }
 
 
-def _load(module_name: str):
-    try:
-        return importlib.import_module(module_name)
-    except ModuleNotFoundError as exc:
-        if exc.name == module_name:
-            return None
-        raise
-
-
 class _VersionAction(argparse.Action):
-    """``--version``: imports Exudyn only when asked (it costs a second at start-up)."""
+    """``--version``: prints exucable's and Exudyn's versions (read from the installed metadata)."""
 
     def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
         super().__init__(option_strings=option_strings, dest=dest, default=default, nargs=0, help=help)
@@ -54,15 +46,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help="print exucable's and Exudyn's versions and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (module_name, help_text) in SUBCOMMANDS.items():
-        mod = _load(module_name)
-        p = sub.add_parser(name, help=help_text if mod else f"{help_text} (not built yet)",
-                           description=help_text)
-        if mod is not None:
-            mod.add_arguments(p)
-            p.set_defaults(_main=mod.main)
-        else:
-            p.add_argument("rest", nargs=argparse.REMAINDER)
-            p.set_defaults(_main=None)
+        mod = importlib.import_module(module_name)
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        mod.add_arguments(p)
+        p.set_defaults(_main=mod.main)
     return parser
 
 
@@ -72,9 +59,6 @@ def main(argv=None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
-    if args._main is None:
-        print(f"exucable {args.command}: not built yet", file=sys.stderr)
-        return 3
     try:
         return int(args._main(args) or 0)
     except ExucableError as exc:

@@ -1,7 +1,7 @@
 """Closed-form tensions of a rope (no bending stiffness) pulled through simple conduits.
 
 Each function is an exact solution of the rope equation used by :mod:`exucable.rope`
-(``/work/shared/paper/NOTES.md``, "Independent reference"),
+(``reference/README.md``, "The rope equation behind the closed forms"),
 
     dT/ds = μ · |T κn − w (e_z − (e_z·t) t)| + w (e_z·t),
 

@@ -1,7 +1,7 @@
 """Independent quasi-static rope solution: a cable without bending stiffness sliding through a 3D conduit.
 
 This is the project's reference against which the multibody model is checked (see
-``/work/shared/paper/NOTES.md``, "Independent reference"). It uses numpy and scipy only; it knows nothing
+``reference/README.md``, "The rope equation behind the closed forms"). It uses numpy and scipy only; it knows nothing
 of Exudyn or of the contact kernel.
 
 A cable with unit tangent ``t``, curvature vector ``κn`` [1/m] and weight per length ``w = ρAg`` [N/m]

@@ -1,10 +1,16 @@
-"""Scenario files: TOML → validated, frozen dataclasses; every error names its key.
+"""Scenarios: one problem definition, validated wherever it is made (TOML file or Python).
 
 A scenario describes one pulling simulation: the cable (paper Sect. 2.2), the conduit
 route (Sect. 2.3), the cable–conduit contact law (Sect. 2.4, Eqs. 17–23), the pulling
-rig (Sect. 2.1, Eq. 1), gravity and the time integration settings. The keys, their
-units and defaults are listed in ``scenarios/README.md``; SI units throughout, angles in
-degrees.
+rig (Sect. 2.1, Eq. 1), gravity and the time integration settings. SI units throughout,
+angles in degrees.
+
+Every key, its unit, default and check is one row of
+:data:`exucable.scenario_fields.FIELDS`; that table drives the TOML parser, the checks the
+dataclasses run when built in Python, their ``to_dict`` and the key tables of
+``scenarios/README.md``. So ``PullSpec(speed_m_per_s=-0.1)``, ``PullSpec.from_keys(speed=-0.1)``
+and ``speed = -0.1`` in a file all raise the same
+``ScenarioError: pull.speed: must be > 0 (m/s), got -0.1``.
 
 Every problem with the input (unknown key, missing key, wrong type, non-physical value,
 a route that cannot be built) raises ONE :class:`~exucable.errors.ScenarioError` whose
@@ -14,16 +20,18 @@ says what is allowed and what was given.
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import math
 import numbers
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from exucable import geometry as _geo
 from exucable.errors import GeometryError, ScenarioError
+from exucable.scenario_fields import FIELDS, REQUIRED, Field, fields_of
 
 __all__ = [
     "CableSpec",
@@ -31,22 +39,149 @@ __all__ = [
     "ContactSpec",
     "PullSpec",
     "GravitySpec",
+    "OutputSpec",
     "SolverSpec",
     "Scenario",
     "load_scenario",
     "parse_scenario",
+    "default_elements",
 ]
 
-# Defaults of optional keys (TOML key names). Values marked "ours" in the README are not
-# in the paper; they are the project's choices.
-_DEFAULT_MAX_SEGMENT_ANGLE_DEG = 1.0
-# Kelvin-Voigt retardation time [s]: damps the element-scale axial modes of the paper's
-# cables (omega ~ 1e3..1e4 rad/s -> damping ratio tau*omega/2 ~ 0.5..5) while the
-# steady-state damping force tau*EA*d(eps)/dt stays negligible (material strain rate is tiny).
-_DEFAULT_DAMPING_TIME_S = 1.0e-3
 _DEFAULT_MIN_STEP_S = 1.0e-8
+#: Default mesh rule: each element turns at most this angle [rad] on the tightest bend
+#: (half the 0.5 rad that exucable.model.build.check_resolution allows) ...
+_DEFAULT_ELEMENT_TURN_RAD = 0.25
+#: ... and a cable has at least this many elements.
+_DEFAULT_MIN_ELEMENTS = 10
 
-_REQUIRED = object()  # sentinel: the key has no default
+_FIELD_BY_KEY: dict[str, Field] = {f.key: f for f in FIELDS}
+
+
+def _default(key: str):
+    """The dataclass default of a table row: its plain default, else None."""
+    d = _FIELD_BY_KEY[key].default
+    return None if d is REQUIRED else d
+
+
+def _what(f: Field) -> str:
+    """What a missing key needs, as the message says it."""
+    return {
+        "float": f"a number{_unit(f.unit)}",
+        "int": "an integer",
+        "bool": "true or false",
+        "str": "a string",
+    }.get(f.kind, "a value")
+
+
+def _coerce(f: Field, value):
+    """Check ``value`` against its table row and return it in canonical form (float, tuple)."""
+    key = f.key
+    if f.kind == "float":
+        v = _as_float(key, value, f.unit)
+        _check_range(key, v, f.unit, **f.bounds)
+        return v
+    if f.kind == "int":
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise ScenarioError(key, f"must be an integer, got {_describe(value)}")
+        v = int(value)
+        _check_range(key, v, "", **f.bounds)
+        return v
+    if f.kind == "bool":
+        if not isinstance(value, bool):
+            raise ScenarioError(key, f"must be true or false, got {_describe(value)}")
+        return value
+    if f.kind == "str":
+        if not isinstance(value, str):
+            raise ScenarioError(key, f"must be a string, got {_describe(value)}")
+        return value
+    if f.kind == "choice":
+        if not isinstance(value, str) or value not in f.choices:
+            allowed = ", ".join(f'"{c}"' for c in f.choices)
+            raise ScenarioError(key, f"must be one of {allowed}, got {_describe(value)}")
+        return value
+    if f.kind == "vector3":
+        return _vector3(key, value, f.unit, nonzero=f.nonzero)
+    return value  # "custom": checked by the section's own code
+
+
+def _toml_value(value):
+    """A dataclass value in TOML form (tuples as lists)."""
+    if isinstance(value, tuple):
+        return [_toml_value(v) for v in value]
+    return value
+
+
+class _Spec:
+    """Validation, ``to_dict``, ``from_keys`` and ``replace`` of one section, from :data:`FIELDS`.
+
+    Subclasses are frozen dataclasses whose attributes are the ``attr`` of the section's rows
+    (plus derived ones) and set ``_SECTION``. ``__post_init__`` checks every value against
+    its row (type, bounds, choices; required ones present), fills plain defaults, then runs
+    the subclass's ``_check`` for cross-field rules and derived defaults.
+    """
+
+    _SECTION: ClassVar[str] = ""
+    #: Attributes ``to_dict`` leaves out (derived from another key that is echoed).
+    _NOT_ECHOED: ClassVar[frozenset[str]] = frozenset()
+
+    def __post_init__(self):
+        derived = set()
+        for f in fields_of(self._SECTION):
+            if f.kind == "custom":
+                continue
+            value = getattr(self, f.attr)
+            if value is None:
+                if f.default is REQUIRED:
+                    raise ScenarioError(f.key, f"required key is missing: give {_what(f)}")
+                if f.derived:
+                    derived.add(f.attr)
+                continue
+            object.__setattr__(self, f.attr, _coerce(f, value))
+        # Not a dataclass field: no part in equality, hashing or repr.
+        object.__setattr__(self, "_derived", frozenset(derived))
+        self._check()
+
+    def _check(self) -> None:
+        """Cross-field rules and derived defaults (override)."""
+
+    @property
+    def derived_keys(self) -> frozenset[str]:
+        """TOML names of the keys whose value was derived from others (not given)."""
+        by_attr = {f.attr: f.name for f in fields_of(self._SECTION)}
+        return frozenset(by_attr[a] for a in self.__dict__.get("_derived", ()))
+
+    def to_dict(self) -> dict:
+        """The table in TOML key names, defaults filled in (absent optional keys left out)."""
+        d: dict[str, Any] = {}
+        for f in fields_of(self._SECTION):
+            value = getattr(self, f.attr)
+            if value is not None and f.attr not in self._NOT_ECHOED:
+                d[f.name] = _toml_value(value)
+        return d
+
+    @classmethod
+    def from_keys(cls, **keys):
+        """Build the section from TOML key names, e.g. ``PullSpec.from_keys(speed=0.1)``.
+
+        Raises
+        ------
+        ScenarioError
+            Unknown key (with a close match suggested) or any invalid value, naming the dotted key.
+        """
+        return _PARSERS[cls._SECTION](keys)
+
+    def replace(self, **keys):
+        """A copy with some keys changed, given by TOML name (``friction=0.3``); validated.
+
+        Derived defaults (e.g. ``solver.output_interval``) are derived again from the new values.
+        """
+        d = self.to_dict()
+        for name in self.derived_keys:
+            d.pop(name, None)
+        d.update(keys)
+        return self.from_keys(**d)
+
+    with_ = replace
 
 
 # --------------------------------------------------------------------------------------
@@ -55,7 +190,7 @@ _REQUIRED = object()  # sentinel: the key has no default
 
 
 @dataclass(frozen=True)
-class CableSpec:
+class CableSpec(_Spec):
     """The cable (paper Sect. 2.2, Eqs. 2–10).
 
     Attributes
@@ -65,28 +200,46 @@ class CableSpec:
     mass_per_length_kg_per_m : float
         Mass per unit length ρA [kg/m] (from ``density`` when that was given).
     density_kg_per_m3 : float or None
-        Density ρ [kg/m³] if the scenario gave it, else None (``mass_per_length`` was given).
+        Density ρ [kg/m³] if given, else None (``mass_per_length`` was given).
     youngs_modulus_Pa : float
         Young's modulus E [Pa].
-    elements : int
-        Number of cable finite elements.
+    elements : int or None
+        Number of cable finite elements; None until a :class:`Scenario` applies the default
+        rule (:func:`default_elements`).
     length_m : float or None
         Cable length [m]; None means the conduit's centreline length.
+    damping_time_s : float
+        Kelvin–Voigt retardation time τ [s]; internal damping = τ × stiffness.
     integration : str
         Exudyn's quadrature of the element's internal forces: ``"lobatto"`` (default),
         ``"reduced"`` or ``"full"`` (useReducedOrderIntegration 2, 1, 0).
-    damping_time_s : float
-        Kelvin–Voigt retardation time τ [s]; internal damping = τ × stiffness.
     """
 
-    radius_m: float
-    mass_per_length_kg_per_m: float
-    density_kg_per_m3: float | None
-    youngs_modulus_Pa: float
-    elements: int
-    length_m: float | None
-    damping_time_s: float
-    integration: str = "lobatto"
+    _SECTION: ClassVar[str] = "cable"
+
+    radius_m: float = _default("cable.radius")
+    mass_per_length_kg_per_m: float | None = _default("cable.mass_per_length")
+    density_kg_per_m3: float | None = _default("cable.density")
+    youngs_modulus_Pa: float = _default("cable.youngs_modulus")
+    elements: int | None = _default("cable.elements")
+    length_m: float | None = _default("cable.length")
+    damping_time_s: float = _default("cable.damping_time")
+    integration: str = _default("cable.integration")
+
+    def _check(self) -> None:
+        if self.density_kg_per_m3 is None and self.mass_per_length_kg_per_m is None:
+            raise ScenarioError("cable.density", "required: give density (kg/m^3) or mass_per_length (kg/m)")
+        if self.density_kg_per_m3 is not None:
+            from_density = self.density_kg_per_m3 * self.area_m2
+            given = self.mass_per_length_kg_per_m
+            if given is not None and not math.isclose(given, from_density, rel_tol=1e-12):
+                raise ScenarioError("cable.mass_per_length", "give either density or mass_per_length, not both")
+            object.__setattr__(self, "mass_per_length_kg_per_m", from_density)
+
+    @property
+    def _NOT_ECHOED(self) -> frozenset[str]:  # type: ignore[override]
+        # mass_per_length follows from density when that was given
+        return frozenset({"mass_per_length_kg_per_m"}) if self.density_kg_per_m3 is not None else frozenset()
 
     @property
     def area_m2(self) -> float:
@@ -113,25 +266,12 @@ class CableSpec:
         """Bending damping τ·EJ [N m² s] (moment per unit curvature rate)."""
         return self.damping_time_s * self.bending_stiffness_N_m2
 
-    def to_dict(self) -> dict:
-        """The ``[cable]`` table in TOML key names, defaults filled in."""
-        d: dict[str, Any] = {"radius": self.radius_m}
-        if self.density_kg_per_m3 is not None:
-            d["density"] = self.density_kg_per_m3
-        else:
-            d["mass_per_length"] = self.mass_per_length_kg_per_m
-        d["youngs_modulus"] = self.youngs_modulus_Pa
-        d["elements"] = self.elements
-        if self.length_m is not None:
-            d["length"] = self.length_m
-        d["damping_time"] = self.damping_time_s
-        d["integration"] = self.integration
-        return d
-
 
 @dataclass(frozen=True)
-class ConduitSpec:
+class ConduitSpec(_Spec):
     """The conduit route (paper Sect. 2.3): a path of primitives or survey points.
+
+    Build it with :class:`exucable.Route` in Python or the ``[conduit]`` table of a file.
 
     Attributes
     ----------
@@ -158,15 +298,37 @@ class ConduitSpec:
         Absolute path of the survey CSV the points were read from, or None.
     """
 
-    inner_radius_m: float
-    start_m: tuple[float, float, float]
-    heading: tuple[float, float, float]
-    max_segment_angle_deg: float | None
-    segments_per_bend: int | None
-    path: tuple | None
-    points_m: tuple[tuple[float, float, float], ...] | None
-    bend_radius_m: float | tuple[float, ...] | None
-    points_csv: str | None
+    _SECTION: ClassVar[str] = "conduit"
+
+    inner_radius_m: float = _default("conduit.inner_radius")
+    start_m: tuple[float, float, float] = _default("conduit.start")
+    heading: tuple[float, float, float] = _default("conduit.heading")
+    max_segment_angle_deg: float | None = None
+    segments_per_bend: int | None = _default("conduit.segments_per_bend")
+    path: tuple[_geo.Straight | _geo.Bend | _geo.Helix, ...] | None = None
+    points_m: tuple[tuple[float, float, float], ...] | None = None
+    bend_radius_m: float | tuple[float, ...] | None = None
+    points_csv: str | None = None
+
+    def __post_init__(self):
+        # max_segment_angle defaults to 1 deg only when segments_per_bend is not given.
+        if self.segments_per_bend is not None:
+            if self.max_segment_angle_deg is not None:
+                raise ScenarioError(
+                    "conduit.segments_per_bend", "give either max_segment_angle or segments_per_bend, not both"
+                )
+            super().__post_init__()
+            object.__setattr__(self, "max_segment_angle_deg", None)
+            return
+        if self.max_segment_angle_deg is None:
+            object.__setattr__(self, "max_segment_angle_deg", _FIELD_BY_KEY["conduit.max_segment_angle"].default)
+        super().__post_init__()
+
+    def _check(self) -> None:
+        if self.path is None and self.points_m is None:
+            raise ScenarioError("conduit.path", "required: give path (a list of pieces), points or points_csv")
+        if self.path is not None and self.points_m is not None:
+            raise ScenarioError("conduit.points", "give only one of path, points, points_csv; got path and points")
 
     def to_dict(self) -> dict:
         """The ``[conduit]`` table in TOML key names, defaults filled in."""
@@ -190,9 +352,14 @@ class ConduitSpec:
             )
         return d
 
+    @classmethod
+    def from_keys(cls, **keys):
+        """Build from TOML key names (``points_csv`` relative to the working directory)."""
+        return _parse_conduit(keys, Path("."))
+
 
 @dataclass(frozen=True)
-class ContactSpec:
+class ContactSpec(_Spec):
     """Cable–conduit contact law (paper Sect. 2.4, Eqs. 17–23).
 
     Attributes
@@ -227,45 +394,32 @@ class ContactSpec:
         ``"segments"``: on the straight segments, as the paper (see exucable.contact.smooth).
     """
 
-    stiffness: float
-    damping: float
-    exponent: float
-    friction: float
-    static_friction: float | None
-    stribeck_velocity_m_per_s: float
-    friction_regularisation_velocity_m_per_s: float
-    check_points_per_element: int
-    check_point_rule: str
-    reference_spacing_m: float
-    broad_phase: str
-    surface: str = "smooth"
-    damping_onset_m: float = 1.0e-5
+    _SECTION: ClassVar[str] = "contact"
 
-    def to_dict(self) -> dict:
-        """The ``[contact]`` table in TOML key names, defaults filled in."""
-        d: dict[str, Any] = {
-            "stiffness": self.stiffness,
-            "damping": self.damping,
-            "exponent": self.exponent,
-            "friction": self.friction,
-        }
-        if self.static_friction is not None:
-            d["static_friction"] = self.static_friction
-        d.update(
-            stribeck_velocity=self.stribeck_velocity_m_per_s,
-            friction_regularisation_velocity=self.friction_regularisation_velocity_m_per_s,
-            check_points_per_element=self.check_points_per_element,
-            check_point_rule=self.check_point_rule,
-            reference_spacing=self.reference_spacing_m,
-            broad_phase=self.broad_phase,
-            surface=self.surface,
-            damping_onset=self.damping_onset_m,
-        )
-        return d
+    stiffness: float = _default("contact.stiffness")
+    damping: float = _default("contact.damping")
+    exponent: float = _default("contact.exponent")
+    friction: float = _default("contact.friction")
+    static_friction: float | None = _default("contact.static_friction")
+    stribeck_velocity_m_per_s: float = _default("contact.stribeck_velocity")
+    friction_regularisation_velocity_m_per_s: float = _default("contact.friction_regularisation_velocity")
+    check_points_per_element: int = _default("contact.check_points_per_element")
+    check_point_rule: str = _default("contact.check_point_rule")
+    reference_spacing_m: float = _default("contact.reference_spacing")
+    broad_phase: str = _default("contact.broad_phase")
+    surface: str = _default("contact.surface")
+    damping_onset_m: float = _default("contact.damping_onset")
+
+    def _check(self) -> None:
+        if self.static_friction is not None and self.static_friction < self.friction:
+            raise ScenarioError(
+                "contact.static_friction",
+                f"must be >= the kinetic friction {self.friction!r} (contact.friction), got {self.static_friction!r}",
+            )
 
 
 @dataclass(frozen=True)
-class PullSpec:
+class PullSpec(_Spec):
     """The pulling rig (paper Sect. 2.1, Eq. 1) and the far-end load.
 
     Attributes
@@ -282,27 +436,25 @@ class PullSpec:
         Time over which speed and loads ramp up from the start state [s].
     """
 
-    speed_m_per_s: float
-    direction: str
-    back_tension_N: float
-    force_N: float | None
-    ramp_time_s: float
+    _SECTION: ClassVar[str] = "pull"
 
-    def to_dict(self) -> dict:
-        """The ``[pull]`` table in TOML key names, defaults filled in."""
-        d: dict[str, Any] = {
-            "speed": self.speed_m_per_s,
-            "direction": self.direction,
-            "back_tension": self.back_tension_N,
-        }
-        if self.force_N is not None:
-            d["force"] = self.force_N
-        d["ramp_time"] = self.ramp_time_s
-        return d
+    speed_m_per_s: float = _default("pull.speed")
+    direction: str = _default("pull.direction")
+    back_tension_N: float = _default("pull.back_tension")
+    force_N: float | None = _default("pull.force")
+    ramp_time_s: float = _default("pull.ramp_time")
+
+    def _check(self) -> None:
+        if self.force_N is not None and self.back_tension_N != 0.0:
+            raise ScenarioError(
+                "pull.force",
+                f"a prescribed pulling force cannot be combined with a nonzero pull.back_tension "
+                f"({self.back_tension_N!r} N); give one of them",
+            )
 
 
 @dataclass(frozen=True)
-class GravitySpec:
+class GravitySpec(_Spec):
     """Gravity along −z.
 
     Attributes
@@ -311,15 +463,52 @@ class GravitySpec:
         Gravitational acceleration [m/s²].
     """
 
-    g_m_per_s2: float
+    _SECTION: ClassVar[str] = "gravity"
 
-    def to_dict(self) -> dict:
-        """The ``[gravity]`` table in TOML key names."""
-        return {"g": self.g_m_per_s2}
+    g_m_per_s2: float = _default("gravity.g")
 
 
 @dataclass(frozen=True)
-class SolverSpec:
+class OutputSpec(_Spec):
+    """What is written besides the histories and final profiles.
+
+    Attributes
+    ----------
+    snapshots_s : tuple of float
+        Times at which the whole state is written (snapshot files) [s], sorted, each >= 0 (and
+        <= ``solver.end_time``, checked by the scenario).
+    snapshot_interval_s : float or None
+        Also a snapshot every this many seconds, at k·interval, k = 1, 2, … [s].
+    """
+
+    _SECTION: ClassVar[str] = "output"
+
+    snapshots_s: tuple = ()
+    snapshot_interval_s: float | None = None
+
+    def _check(self) -> None:
+        raw = self.snapshots_s
+        if not isinstance(raw, (list, tuple)):
+            raise ScenarioError("output.snapshots", f"must be an array of times [s], got {_describe(raw)}")
+        times = []
+        for i, value in enumerate(raw):
+            key = f"output.snapshots[{i}]"
+            v = _as_float(key, value, "s")
+            _check_range(key, v, "s", ge=0.0)
+            times.append(v)
+        object.__setattr__(self, "snapshots_s", tuple(sorted(set(times))))
+
+    def times_s(self, end_time_s: float) -> tuple:
+        """All snapshot times up to ``end_time_s`` [s], sorted, duplicates merged."""
+        times = set(self.snapshots_s)
+        if self.snapshot_interval_s is not None:
+            n = int(math.floor(end_time_s / self.snapshot_interval_s * (1 + 1e-12)))
+            times.update(k * self.snapshot_interval_s for k in range(1, n + 1))
+        return tuple(sorted(t for t in times if t <= end_time_s))
+
+
+@dataclass(frozen=True)
+class SolverSpec(_Spec):
     """Time integration settings.
 
     Attributes
@@ -329,7 +518,7 @@ class SolverSpec:
     step_s : float
         Initial and maximum time step [s].
     min_step_s : float
-        Smallest step the adaptive controller may take [s].
+        Smallest step the adaptive controller may take [s] (default min(1e-8 s, step)).
     spectral_radius : float
         Generalized-α ρ∞ [-] in [0, 1].
     newton_max_iterations : int
@@ -341,7 +530,7 @@ class SolverSpec:
     startup_damping_1_per_s : float
         Its initial rate c0 [1/s] (mass-proportional).
     output_interval_s : float
-        Interval between stored output states [s].
+        Interval between stored output states [s] (default max(step, end_time/1000)).
     steady_stop : bool
         Stop once the pulling force is steady.
     steady_window_s : float
@@ -355,68 +544,145 @@ class SolverSpec:
         sliding state in one static solve (:mod:`exucable.solve_steady`).
     """
 
-    end_time_s: float
-    step_s: float
-    min_step_s: float
-    spectral_radius: float
-    newton_max_iterations: int
-    output_interval_s: float
-    steady_stop: bool
-    steady_window_s: float
-    steady_tolerance: float
-    pretension: bool
-    newton_tolerance: float = 1.0e-7
-    startup_time_s: float = 0.05
-    startup_damping_1_per_s: float = 200.0
-    mode: str = "dynamic"
+    _SECTION: ClassVar[str] = "solver"
 
-    def to_dict(self) -> dict:
-        """The ``[solver]`` table in TOML key names, defaults filled in."""
-        return {
-            "end_time": self.end_time_s,
-            "step": self.step_s,
-            "min_step": self.min_step_s,
-            "spectral_radius": self.spectral_radius,
-            "newton_max_iterations": self.newton_max_iterations,
-            "newton_tolerance": self.newton_tolerance,
-            "startup_time": self.startup_time_s,
-            "startup_damping": self.startup_damping_1_per_s,
-            "output_interval": self.output_interval_s,
-            "steady_stop": self.steady_stop,
-            "steady_window": self.steady_window_s,
-            "steady_tolerance": self.steady_tolerance,
-            "pretension": self.pretension,
-            "mode": self.mode,
-        }
+    end_time_s: float = _default("solver.end_time")
+    step_s: float = _default("solver.step")
+    min_step_s: float = _default("solver.min_step")
+    spectral_radius: float = _default("solver.spectral_radius")
+    newton_max_iterations: int = _default("solver.newton_max_iterations")
+    newton_tolerance: float = _default("solver.newton_tolerance")
+    startup_time_s: float = _default("solver.startup_time")
+    startup_damping_1_per_s: float = _default("solver.startup_damping")
+    output_interval_s: float = _default("solver.output_interval")
+    steady_stop: bool = _default("solver.steady_stop")
+    steady_window_s: float = _default("solver.steady_window")
+    steady_tolerance: float = _default("solver.steady_tolerance")
+    pretension: bool = _default("solver.pretension")
+    mode: str = _default("solver.mode")
+
+    def _check(self) -> None:
+        if self.mode == "steady" and not self.pretension:
+            raise ScenarioError("solver.pretension", 'solver.mode = "steady" starts from the rope solution '
+                                "near the steady state; set it to true (or use the dynamic mode)")
+        if self.min_step_s is None:
+            object.__setattr__(self, "min_step_s", min(_DEFAULT_MIN_STEP_S, self.step_s))
+        elif self.min_step_s > self.step_s:
+            raise ScenarioError("solver.min_step", f"must be <= solver.step ({self.step_s!r} s), got {self.min_step_s!r}")
+        if self.output_interval_s is None:
+            object.__setattr__(self, "output_interval_s", max(self.step_s, self.end_time_s / 1000.0))
+
+
+def default_elements(cable_length_m: float, max_curvature_1_per_m: float) -> int:
+    """The default number of cable elements: max(10, ⌈L·κ_max / 0.25⌉).
+
+    Each element then turns at most 0.25 rad on the tightest bend, half of what
+    :func:`exucable.model.build.check_resolution` allows (the paper's Examples 2–4 use 0.07–0.25 rad).
+
+    Parameters
+    ----------
+    cable_length_m : float
+        Cable length L [m].
+    max_curvature_1_per_m : float
+        Largest curvature κ_max of the route's centreline [1/m] (0 for a straight route).
+    """
+    return max(_DEFAULT_MIN_ELEMENTS, math.ceil(cable_length_m * max_curvature_1_per_m / _DEFAULT_ELEMENT_TURN_RAD))
 
 
 @dataclass(frozen=True)
 class Scenario:
     """One validated pulling simulation.
 
+    Built from a file (:func:`load_scenario`) or in Python, where every part not given has its
+    default (``contact``: :class:`ContactSpec` defaults; ``gravity``: none)::
+
+        Scenario(route=Route(inner_radius=3.5e-3).straight(1.0), cable=CableSpec.from_keys(...),
+                 pull=PullSpec(speed_m_per_s=0.1), solver=SolverSpec(end_time_s=0.5))
+
     Attributes
     ----------
     name : str
-        Scenario name (default: the file stem).
+        Scenario name (default: the file stem, or ``"scenario"``).
     description : str
         Free text.
     cable, conduit, contact, pull : CableSpec, ConduitSpec, ContactSpec, PullSpec
+        ``cable.elements`` is filled in from :func:`default_elements` when not given.
     gravity : GravitySpec or None
         None: no gravity.
     solver : SolverSpec
+    output : OutputSpec
+        Snapshot times (default: none).
     source_path : Path or None
         File the scenario was read from (provenance only; not compared).
+    route : exucable.Route, optional
+        Init-only: the conduit as a route builder (instead of ``conduit``).
     """
 
-    name: str
-    description: str
-    cable: CableSpec
-    conduit: ConduitSpec
-    contact: ContactSpec
-    pull: PullSpec
-    gravity: GravitySpec | None
-    solver: SolverSpec
+    name: str | None = None
+    description: str = ""
+    cable: CableSpec | None = None
+    conduit: ConduitSpec | None = None
+    contact: ContactSpec = field(default_factory=ContactSpec)
+    pull: PullSpec | None = None
+    gravity: GravitySpec | None = None
+    solver: SolverSpec | None = None
+    output: OutputSpec = field(default_factory=OutputSpec)
     source_path: Path | None = field(default=None, compare=False)
+    route: InitVar[Any] = None
+
+    def __post_init__(self, route):
+        if route is not None:
+            if self.conduit is not None:
+                raise ScenarioError("conduit", "give either route or conduit, not both")
+            object.__setattr__(self, "conduit", route.to_spec())
+        if self.name is None:
+            object.__setattr__(self, "name", "scenario")
+        _coerce(_FIELD_BY_KEY["name"], self.name)
+        if not self.name.strip():
+            raise ScenarioError("name", "must be a non-empty string")
+        _coerce(_FIELD_BY_KEY["description"], self.description)
+        for part, cls, how in (
+            ("cable", CableSpec, "exucable.Cable(...)"),
+            ("conduit", ConduitSpec, "route=exucable.Route(...)"),
+            ("contact", ContactSpec, "exucable.Contact(...)"),
+            ("pull", PullSpec, "exucable.Pull(...)"),
+            ("solver", SolverSpec, "exucable.Solver(...)"),
+        ):
+            value = getattr(self, part)
+            if value is None:
+                raise ScenarioError(part, f"required: give the [{part}] table, or {part}={how} in Python")
+            if not isinstance(value, cls):
+                raise ScenarioError(part, f"must be a {cls.__name__} ({how}), got {_describe(value)}")
+        if not isinstance(self.output, OutputSpec):
+            raise ScenarioError("output", f"must be an OutputSpec, got {_describe(self.output)}")
+        late = [t for t in self.output.snapshots_s if t > self.solver.end_time_s]
+        if late:
+            i = self.output.snapshots_s.index(late[0])
+            raise ScenarioError(f"output.snapshots[{i}]", f"must be <= solver.end_time = "
+                                f"{self.solver.end_time_s!r} s, got {late[0]!r}")
+        if self.gravity is not None and not isinstance(self.gravity, GravitySpec):
+            raise ScenarioError("gravity", f"must be a GravitySpec (exucable.Gravity(...)) or None, got "
+                                           f"{_describe(self.gravity)}")
+        if self.conduit.inner_radius_m <= self.cable.radius_m:
+            raise ScenarioError(
+                "conduit.inner_radius",
+                f"must be > the cable radius {self.cable.radius_m!r} m (cable.radius), got {self.conduit.inner_radius_m!r}",
+            )
+        conduit = self.build_conduit()  # route errors surface here, keyed
+        conduit_length_m = _conduit_length_m(conduit)
+        # A relative tolerance absorbs float round-off when the length is written as the sum
+        # of the route's pieces (e.g. ex1: 50 m cable in a 50 m conduit).
+        if self.cable.length_m is not None and self.cable.length_m > conduit_length_m * (1.0 + 1e-9):
+            raise ScenarioError(
+                "cable.length",
+                f"must be <= the conduit centreline length {conduit_length_m:.6g} m, got {self.cable.length_m!r}",
+            )
+        if self.cable.elements is None:
+            kappa = 1.0 / conduit.centreline.min_bend_radius_m
+            n = default_elements(self.cable_length_m, kappa)
+            cable = dataclasses.replace(self.cable, elements=n)
+            object.__setattr__(cable, "_derived", frozenset({"elements"}))
+            object.__setattr__(self, "cable", cable)
 
     def build_conduit(self):
         """The conduit built from :attr:`conduit` (cached on this instance).
@@ -461,7 +727,46 @@ class Scenario:
         if self.gravity is not None:
             d["gravity"] = self.gravity.to_dict()
         d["solver"] = self.solver.to_dict()
+        d["output"] = self.output.to_dict()
         return d
+
+    def replace(self, **changes) -> "Scenario":
+        """A copy with values changed by dotted key, validated like a file.
+
+        Parameters
+        ----------
+        **changes
+            Dotted keys as in ``scenarios/README.md`` and error messages:
+            ``sc.replace(**{"contact.friction": 0.3, "conduit.path[1].radius": 0.8})``; a whole
+            table may be given as a dict (``gravity={"g": 9.81}``) or ``None`` to remove an
+            optional table (``gravity=None``). Derived defaults (``cable.elements``,
+            ``solver.min_step``, ``solver.output_interval``) are derived again.
+
+        Raises
+        ------
+        ScenarioError
+            Naming the dotted key of the first bad value.
+        """
+        from .sweep.dotted import parse_key, set_value  # pure-dict helpers shared with sweeps
+
+        d = self.to_dict()
+        for part in ("cable", "solver"):
+            for name in getattr(self, part).derived_keys:
+                d[part].pop(name, None)
+        for key, value in changes.items():
+            tokens = parse_key(key, key)
+            if value is None and len(tokens) == 1 and tokens[0] in d:
+                del d[tokens[0]]
+                continue
+            if hasattr(value, "to_dict"):
+                value = value.to_dict()
+            set_value(d, tokens, value, key)
+        base_dir = self.source_path.parent if self.source_path is not None else Path(".")
+        new = parse_scenario(d, base_dir, default_name=self.name)
+        object.__setattr__(new, "source_path", self.source_path)
+        return new
+
+    with_ = replace
 
 
 # --------------------------------------------------------------------------------------
@@ -534,21 +839,24 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     ScenarioError
         The first problem found, naming its full dotted key.
     """
-    top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver"})
+    top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver",
+                            "output"})
     name = top.string("name", default=default_name)
     if not name.strip():
         raise ScenarioError("name", "must be a non-empty string")
     description = top.string("description", default="")
 
     cable = _parse_cable(top.table("cable"))
-    conduit = _parse_conduit(top.table("conduit"), cable, Path(base_dir))
+    conduit = _parse_conduit(top.table("conduit"), Path(base_dir))
     contact = _parse_contact(top.table("contact", default={}))
     pull = _parse_pull(top.table("pull"))
     gravity_data = top.table("gravity", default=None)
     gravity = None if gravity_data is None else _parse_gravity(gravity_data)
     solver = _parse_solver(top.table("solver"))
-
-    scenario = Scenario(
+    output = _parse_output(top.table("output", default={}))
+    # Cross-section rules (inner radius > cable radius, cable length <= conduit length),
+    # the route build and the default mesh are the Scenario's own checks.
+    return Scenario(
         name=name,
         description=description,
         cable=cable,
@@ -557,16 +865,8 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
         pull=pull,
         gravity=gravity,
         solver=solver,
+        output=output,
     )
-    conduit_length_m = _conduit_length_m(scenario.build_conduit())
-    # A relative tolerance absorbs float round-off when the length is written as the sum
-    # of the route's pieces (e.g. ex1: 50 m cable in a 50 m conduit).
-    if cable.length_m is not None and cable.length_m > conduit_length_m * (1.0 + 1e-9):
-        raise ScenarioError(
-            "cable.length",
-            f"must be <= the conduit centreline length {conduit_length_m:.6g} m, got {cable.length_m!r}",
-        )
-    return scenario
 
 
 # --------------------------------------------------------------------------------------
@@ -674,11 +974,11 @@ class _Table:
     def _get(self, name: str, default, what: str = "a value"):
         if name in self.data:
             return self.data[name], True
-        if default is _REQUIRED:
+        if default is REQUIRED:
             raise ScenarioError(self.k(name), f"required key is missing: give {what}")
         return default, False
 
-    def number(self, name: str, unit: str, default=_REQUIRED, **bounds) -> float | None:
+    def number(self, name: str, unit: str, default=REQUIRED, **bounds) -> float | None:
         value, given = self._get(name, default, f"a number{_unit(unit)}")
         if not given and value is None:
             return None
@@ -686,7 +986,7 @@ class _Table:
         _check_range(self.k(name), v, unit, **bounds)
         return v
 
-    def integer(self, name: str, default=_REQUIRED, **bounds) -> int | None:
+    def integer(self, name: str, default=REQUIRED, **bounds) -> int | None:
         value, given = self._get(name, default, "an integer")
         if not given and value is None:
             return None
@@ -696,19 +996,19 @@ class _Table:
         _check_range(self.k(name), v, "", **bounds)
         return v
 
-    def boolean(self, name: str, default=_REQUIRED) -> bool:
+    def boolean(self, name: str, default=REQUIRED) -> bool:
         value, _ = self._get(name, default, "true or false")
         if not isinstance(value, bool):
             raise ScenarioError(self.k(name), f"must be true or false, got {_describe(value)}")
         return value
 
-    def string(self, name: str, default=_REQUIRED) -> str:
+    def string(self, name: str, default=REQUIRED) -> str:
         value, _ = self._get(name, default, "a string")
         if not isinstance(value, str):
             raise ScenarioError(self.k(name), f"must be a string, got {_describe(value)}")
         return value
 
-    def choice(self, name: str, choices: tuple[str, ...], default=_REQUIRED) -> str | None:
+    def choice(self, name: str, choices: tuple[str, ...], default=REQUIRED) -> str | None:
         value, given = self._get(name, default)
         if not given and value is None:
             return None
@@ -717,13 +1017,13 @@ class _Table:
             raise ScenarioError(self.k(name), f"must be one of {allowed}, got {_describe(value)}")
         return value
 
-    def vector3(self, name: str, unit: str, default=_REQUIRED, nonzero: bool = False):
+    def vector3(self, name: str, unit: str, default=REQUIRED, nonzero: bool = False):
         value, given = self._get(name, default)
         if not given and value is None:
             return None
         return _vector3(self.k(name), value, unit, nonzero=nonzero)
 
-    def table(self, name: str, default=_REQUIRED):
+    def table(self, name: str, default=REQUIRED):
         value, given = self._get(name, default, f"a table [{self.k(name)}]")
         if given and not isinstance(value, dict):
             raise ScenarioError(self.k(name), f"must be a table [{self.k(name)}], got {_describe(value)}")
@@ -731,38 +1031,43 @@ class _Table:
 
 
 # --------------------------------------------------------------------------------------
-# Sections
+# Sections: the TOML front end of the dataclasses
 # --------------------------------------------------------------------------------------
 
 
+def _parse_table(section: str, data, cls):
+    """A section whose keys are all scalar rows of FIELDS: unknown keys refused, the rest checked
+    by the dataclass."""
+    rows = fields_of(section)
+    t = _Table(data, section, {f.name for f in rows})
+    return cls(**{f.attr: t.data[f.name] for f in rows if f.name in t.data})
+
+
 def _parse_cable(data) -> CableSpec:
-    t = _Table(
-        data,
-        "cable",
-        {"radius", "density", "mass_per_length", "youngs_modulus", "elements", "length", "damping_time",
-         "integration"},
-    )
-    radius = t.number("radius", "m", gt=0.0)
-    if t.has("density") and t.has("mass_per_length"):
+    if isinstance(data, dict) and "density" in data and "mass_per_length" in data:
+        _Table(data, "cable", {f.name for f in fields_of("cable")})  # unknown keys first
         raise ScenarioError("cable.mass_per_length", "give either density or mass_per_length, not both")
-    if not t.has("density") and not t.has("mass_per_length"):
-        raise ScenarioError("cable.density", "required: give density (kg/m^3) or mass_per_length (kg/m)")
-    if t.has("density"):
-        density = t.number("density", "kg/m^3", gt=0.0)
-        mass_per_length = density * math.pi * radius**2
-    else:
-        density = None
-        mass_per_length = t.number("mass_per_length", "kg/m", gt=0.0)
-    return CableSpec(
-        radius_m=radius,
-        mass_per_length_kg_per_m=mass_per_length,
-        density_kg_per_m3=density,
-        youngs_modulus_Pa=t.number("youngs_modulus", "Pa", gt=0.0),
-        elements=t.integer("elements", ge=1),
-        length_m=t.number("length", "m", default=None, gt=0.0),
-        damping_time_s=t.number("damping_time", "s", default=_DEFAULT_DAMPING_TIME_S, ge=0.0),
-        integration=t.choice("integration", ("lobatto", "reduced", "full"), default="lobatto"),
-    )
+    return _parse_table("cable", data, CableSpec)
+
+
+def _parse_contact(data) -> ContactSpec:
+    return _parse_table("contact", data, ContactSpec)
+
+
+def _parse_pull(data) -> PullSpec:
+    return _parse_table("pull", data, PullSpec)
+
+
+def _parse_gravity(data) -> GravitySpec:
+    return _parse_table("gravity", data, GravitySpec)
+
+
+def _parse_solver(data) -> SolverSpec:
+    return _parse_table("solver", data, SolverSpec)
+
+
+def _parse_output(data) -> OutputSpec:
+    return _parse_table("output", data, OutputSpec)
 
 
 _PATH_KINDS: dict[str, set[str]] = {
@@ -774,29 +1079,14 @@ _BEND_TURNS = ("left", "right", "up", "down")
 _HELIX_TURNS = ("left", "right")
 
 
-def _parse_conduit(data, cable: CableSpec, base_dir: Path) -> ConduitSpec:
-    t = _Table(
-        data,
-        "conduit",
-        {
-            "inner_radius", "start", "heading", "max_segment_angle", "segments_per_bend",
-            "path", "points", "bend_radius", "points_csv",
-        },
-    )
-    inner_radius = t.number("inner_radius", "m", gt=0.0)
-    if inner_radius <= cable.radius_m:
-        raise ScenarioError(
-            "conduit.inner_radius",
-            f"must be > the cable radius {cable.radius_m!r} m (cable.radius), got {inner_radius!r}",
-        )
+def _parse_conduit(data, base_dir: Path) -> ConduitSpec:
+    t = _Table(data, "conduit", {f.name for f in fields_of("conduit")})
+    inner_radius = _coerce(_FIELD_BY_KEY["conduit.inner_radius"], t.data["inner_radius"]) if t.has(
+        "inner_radius") else t.number("inner_radius", "m")
     if t.has("max_segment_angle") and t.has("segments_per_bend"):
         raise ScenarioError(
             "conduit.segments_per_bend", "give either max_segment_angle or segments_per_bend, not both"
         )
-    segments_per_bend = t.integer("segments_per_bend", default=None, ge=1)
-    max_angle = None
-    if segments_per_bend is None:
-        max_angle = t.number("max_segment_angle", "deg", default=_DEFAULT_MAX_SEGMENT_ANGLE_DEG, gt=0.0, le=45.0)
 
     # Exactly one route source.
     sources = [s for s in ("path", "points", "points_csv") if t.has(s)]
@@ -807,19 +1097,20 @@ def _parse_conduit(data, cable: CableSpec, base_dir: Path) -> ConduitSpec:
             f"conduit.{sources[1]}", f"give only one of path, points, points_csv; got {' and '.join(sources)}"
         )
 
-    path = points = bend_radius = points_csv = None
+    route: dict[str, Any] = {}
     if t.has("path"):
         if t.has("bend_radius"):
             raise ScenarioError("conduit.bend_radius", "only used with points or points_csv, not with path")
-        start = t.vector3("start", "m", default=(0.0, 0.0, 0.0))
-        heading = t.vector3("heading", "", default=(1.0, 0.0, 0.0), nonzero=True)
-        path = _parse_path(t.data["path"], inner_radius)
+        for name in ("start", "heading"):
+            if t.has(name):
+                route[f"{name}_m" if name == "start" else name] = t.data[name]
+        route["path"] = _parse_path(t.data["path"], inner_radius)
     else:
         for path_key in ("start", "heading"):
             # Survey points fix the start and the initial direction themselves.
             if t.has(path_key):
                 raise ScenarioError(f"conduit.{path_key}", "only used with path; survey points set the route")
-        csv_radius = None
+        csv_radius = points_csv = None
         if t.has("points"):
             points = _parse_points("conduit.points", t.data["points"])
         else:
@@ -836,20 +1127,31 @@ def _parse_conduit(data, cable: CableSpec, base_dir: Path) -> ConduitSpec:
                 + (" (the CSV has no bend_radius column)" if points_csv is not None else ""),
             )
         # For the record: where the survey route starts and the direction of its first leg.
-        start = points[0]
-        heading = tuple(b - a for a, b in zip(points[0], points[1]))
+        route.update(
+            start_m=points[0],
+            heading=tuple(b - a for a, b in zip(points[0], points[1])),
+            points_m=points,
+            bend_radius_m=bend_radius,
+            points_csv=points_csv,
+        )
 
     return ConduitSpec(
         inner_radius_m=inner_radius,
-        start_m=start,
-        heading=heading,
-        max_segment_angle_deg=max_angle,
-        segments_per_bend=segments_per_bend,
-        path=path,
-        points_m=points,
-        bend_radius_m=bend_radius,
-        points_csv=points_csv,
+        max_segment_angle_deg=t.data.get("max_segment_angle"),
+        segments_per_bend=t.data.get("segments_per_bend"),
+        **route,
     )
+
+
+_PARSERS = {
+    "cable": _parse_cable,
+    "conduit": lambda data: _parse_conduit(data, Path(".")),
+    "contact": _parse_contact,
+    "pull": _parse_pull,
+    "gravity": _parse_gravity,
+    "solver": _parse_solver,
+    "output": _parse_output,
+}
 
 
 def _parse_path(value, inner_radius: float) -> tuple:
@@ -976,110 +1278,6 @@ def _read_points_csv(value: str, base_dir: Path, inner_radius: float):
                 )
     return str(path), pts, radius
 
-
-def _parse_contact(data) -> ContactSpec:
-    t = _Table(
-        data,
-        "contact",
-        {
-            "stiffness", "damping", "exponent", "friction", "static_friction", "stribeck_velocity",
-            "friction_regularisation_velocity", "check_points_per_element", "check_point_rule",
-            "reference_spacing", "broad_phase", "surface", "damping_onset",
-        },
-    )
-    friction = t.number("friction", "", default=0.0, ge=0.0)
-    static_friction = t.number("static_friction", "", default=None, ge=0.0)
-    if static_friction is not None and static_friction < friction:
-        raise ScenarioError(
-            "contact.static_friction",
-            f"must be >= the kinetic friction {friction!r} (contact.friction), got {static_friction!r}",
-        )
-    return ContactSpec(
-        stiffness=t.number("stiffness", "N/m^exponent", default=1.0e6, gt=0.0),
-        damping=t.number("damping", "N s/m", default=1.0e3, ge=0.0),
-        exponent=t.number("exponent", "", default=1.5, ge=1.0),
-        friction=friction,
-        static_friction=static_friction,
-        stribeck_velocity_m_per_s=t.number("stribeck_velocity", "m/s", default=0.01, gt=0.0),
-        friction_regularisation_velocity_m_per_s=t.number(
-            "friction_regularisation_velocity", "m/s", default=1.0e-3, gt=0.0
-        ),
-        check_points_per_element=t.integer("check_points_per_element", default=20, ge=1),
-        check_point_rule=t.choice("check_point_rule", ("gauss", "uniform"), default="gauss"),
-        reference_spacing_m=t.number("reference_spacing", "m", default=1.0e-3, gt=0.0),
-        broad_phase=t.choice("broad_phase", ("aabb", "none"), default="aabb"),
-        surface=t.choice("surface", ("smooth", "segments"), default="smooth"),
-        damping_onset_m=t.number("damping_onset", "m", default=1.0e-5, ge=0.0),
-    )
-
-
-def _parse_pull(data) -> PullSpec:
-    t = _Table(data, "pull", {"speed", "direction", "back_tension", "force", "ramp_time"})
-    speed = t.number("speed", "m/s", gt=0.0)
-    direction = t.choice("direction", ("forward", "reverse"), default="forward")
-    back_tension = t.number("back_tension", "N", default=0.0, ge=0.0)
-    force = t.number("force", "N", default=None, gt=0.0)
-    if force is not None and back_tension != 0.0:
-        raise ScenarioError(
-            "pull.force",
-            f"a prescribed pulling force cannot be combined with a nonzero pull.back_tension ({back_tension!r} N); "
-            "give one of them",
-        )
-    return PullSpec(
-        speed_m_per_s=speed,
-        direction=direction,
-        back_tension_N=back_tension,
-        force_N=force,
-        ramp_time_s=t.number("ramp_time", "s", default=0.0, ge=0.0),
-    )
-
-
-def _parse_gravity(data) -> GravitySpec:
-    t = _Table(data, "gravity", {"g"})
-    return GravitySpec(g_m_per_s2=t.number("g", "m/s^2", ge=0.0))
-
-
-SOLVER_MODES = ("dynamic", "steady")
-
-
-def _parse_solver(data) -> SolverSpec:
-    t = _Table(
-        data,
-        "solver",
-        {
-            "end_time", "step", "min_step", "spectral_radius", "newton_max_iterations", "newton_tolerance",
-            "output_interval", "startup_time", "startup_damping",
-            "steady_stop", "steady_window", "steady_tolerance", "pretension", "mode",
-        },
-    )
-    end_time = t.number("end_time", "s", gt=0.0)
-    step = t.number("step", "s", gt=0.0)
-    min_step = t.number("min_step", "s", default=min(_DEFAULT_MIN_STEP_S, step), gt=0.0)
-    if min_step > step:
-        raise ScenarioError("solver.min_step", f"must be <= solver.step ({step!r} s), got {min_step!r}")
-    mode = t.choice("mode", SOLVER_MODES, default="dynamic")
-    pretension = t.boolean("pretension", default=True)
-    if mode == "steady" and not pretension:
-        raise ScenarioError("solver.pretension", 'solver.mode = "steady" starts from the rope solution\'s '
-                            "tension profile near the steady state; set it to true (or use the dynamic mode)")
-    return SolverSpec(
-        end_time_s=end_time,
-        step_s=step,
-        min_step_s=min_step,
-        spectral_radius=t.number("spectral_radius", "", default=0.5, ge=0.0, le=1.0),
-        # 12 iterations and 1e-7: measured on Example 2, 735 -> 155 steps at the same pulling
-        # force (within 0.02 %) as 8 and 1e-8 (exudyn-findings had 8 with a different start)
-        newton_max_iterations=t.integer("newton_max_iterations", default=12, ge=1),
-        newton_tolerance=t.number("newton_tolerance", "", default=1.0e-7, gt=0.0, lt=1.0),
-        startup_time_s=t.number("startup_time", "s", default=0.05, ge=0.0),
-        startup_damping_1_per_s=t.number("startup_damping", "1/s", default=200.0, ge=0.0),
-        output_interval_s=t.number("output_interval", "s", default=max(step, end_time / 1000.0), gt=0.0),
-        steady_stop=t.boolean("steady_stop", default=False),
-        steady_window_s=t.number("steady_window", "s", default=0.2, gt=0.0),
-        steady_tolerance=t.number("steady_tolerance", "", default=1.0e-3, gt=0.0),
-        pretension=pretension,
-        mode=mode,
-    )
 
 
 # --------------------------------------------------------------------------------------

@@ -121,8 +121,12 @@ def record_state(model, t: float, history: History) -> None:
     history.max_tension_N.append(float(np.max(N)))
 
 
-def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None) -> SolveOutcome:
+def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None,
+             snapshots=None) -> SolveOutcome:
     """Integrate ``model`` to the scenario's end time (or to a steady pulling force).
+
+    ``snapshots`` (an :class:`exucable.snapshots.SnapshotRecorder`, optional) is fed the state at
+    the end of every step.
 
     Never raises for a diverging run: the outcome has ``status == "failed"``, the simulated time
     where it happened, and the history recorded until then.
@@ -138,6 +142,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     next_out[0] = out_dt
 
     def post_step(mbs, t):
+        if snapshots is not None:
+            snapshots.step(t, model.pull_force_N(t))
         if t >= next_out[0] - 1e-12 * max(1.0, t):
             record_state(model, t, history)
             next_out[0] = (np.floor(t / out_dt + 1e-9) + 1.0) * out_dt

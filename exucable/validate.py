@@ -13,28 +13,22 @@ from __future__ import annotations
 import csv
 import io
 import math
-import sys
 import time
-import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .results import atomic_write_text, read_csv
+from .data import data_path
+from .io import atomic_write_text
+from .plots.validation import plot_validation_figures
+from .reference import load_reference
 
-__all__ = ["Check", "load_reference", "validate", "add_arguments", "main", "ROOT"]
+__all__ = ["Check", "ModeDifference", "MODES", "ValidationRun", "validate", "format_table", "write_report", "TOLERANCES", "CASES"]
 
-ROOT = Path(__file__).resolve().parents[1]
-REFERENCE_FILE = ROOT / "reference" / "paper_values.toml"
-
-
-def load_reference(path=REFERENCE_FILE) -> dict:
-    """The reference values as a nested dict ``{section: {key: value}}``."""
-    with open(path, "rb") as f:
-        data = tomllib.load(f)
-    return {sec: {k: v["value"] for k, v in tab.items() if isinstance(v, dict) and "value" in v}
-            for sec, tab in data.items() if isinstance(tab, dict)}
+#: The validation cases, in the order they run.
+CASES = ("ex1", "ex2", "ex3", "fig12", "ex4")
 
 
 @dataclass(frozen=True)
@@ -100,6 +94,7 @@ TOLERANCES = {
     "ex4": (1e-2, 2e-2),
 }
 
+
 MODES = ("dynamic", "steady")
 
 
@@ -126,15 +121,18 @@ class ValidationRun:
         return out
 
 
-def _scenario(name: str, fast: bool) -> Path:
-    return ROOT / "scenarios" / ("fast" if fast else "") / f"{name}.toml"
+def _shipped(*parts: str, fast: bool) -> tuple[Path, str]:
+    """A shipped scenario file (its coarse variant in ``fast/`` beside it) and its name for messages."""
+    *dirs, name = parts
+    parts = (*dirs, "fast", name) if fast else parts
+    return data_path("scenarios", *parts), "/".join(("scenarios",) + parts)
 
 
-def _run(case, name, fast, out_dir, quiet, vr: ValidationRun, mode: str = "dynamic"):
+def _run(case, name, fast, out_dir, quiet, vr: ValidationRun, progress, mode: str = "dynamic"):
     from .run import run_scenario
-    path = _scenario(name, fast)
-    if not quiet:
-        print(f"validate: running {case} ({path.relative_to(ROOT)}, {mode})", flush=True)
+    path, shown = _shipped(f"{name}.toml", fast=fast)
+    if progress is not None:
+        progress(f"validate: running {case} ({shown}, {mode})")
     res = run_scenario(path, Path(out_dir) / name, quiet=quiet, plots=True, mode=mode)
     (vr.runs if mode == "dynamic" else vr.steady_runs)[case] = res
     if res.summary["status"] == "failed":
@@ -147,83 +145,98 @@ def _tol(key, fast):
 
 
 def _scatter(res, what="pull_force_N") -> float | None:
-    """Relative steady scatter std/mean of a run's result quantity (None for a steady solve)."""
+    """Relative steady scatter std/mean of a dynamic run's pulling force (None for a steady solve)."""
     s = res.summary
-    if s.get("mode") == "steady" or s.get(what) in (None, 0.0):
+    if s.get("mode") == "steady" or not s.get(what):
         return None
     std = s.get("pull_force_std_N") if what == "pull_force_N" else None
     return None if std is None else abs(std / s[what])
 
 
 def validate(fast: bool = False, out_dir="validation", quiet: bool = True, cases=None,
-             modes=MODES) -> ValidationRun:
-    """Run the validation set in each of ``modes``; returns the checks (see :class:`Check`) and,
-    where both modes ran, their differences (:attr:`ValidationRun.differences`).
+             progress: Callable[[str], None] | None = None, modes=MODES) -> ValidationRun:
+    """Run the validation set in each solver mode, write its table and figures into ``out_dir``;
+    returns the checks (see :class:`Check`) and, where both modes ran, their differences
+    (:attr:`ValidationRun.differences`).
 
-    Dynamic runs write to ``out_dir/<scenario>``, steady ones to ``out_dir/steady/<scenario>``.
+    Parameters
+    ----------
+    fast : bool
+        The coarse variants (``scenarios/fast``) with their looser tolerances.
+    out_dir : str or os.PathLike
+        Where ``validation.csv``, ``validation.md``, the figures and each run's results go
+        (dynamic runs in ``out_dir/<scenario>``, steady ones in ``out_dir/steady/<scenario>``).
+    quiet : bool
+        No progress bar in the runs.
+    cases : iterable of str, optional
+        A subset of :data:`CASES` (default: all).
+    progress : callable, optional
+        Called with one line of text as each case starts.
+    modes : iterable of {"dynamic", "steady"}
+        The solver modes to run (default both).
     """
     ref = load_reference()
     vr = ValidationRun()
     t0 = time.perf_counter()
-    wanted = set(cases or ("ex1", "ex2", "ex3", "fig12", "ex4"))
+    wanted = set(cases or CASES)
     out = Path(out_dir)
     for mode in modes:
         tm = time.perf_counter()
-        _mode_checks(ref, vr, wanted, fast, out if mode == "dynamic" else out / "steady", quiet, mode)
+        _mode_checks(ref, vr, wanted, fast, out if mode == "dynamic" else out / "steady", quiet, progress, mode)
         vr.mode_wall_time_s[mode] = time.perf_counter() - tm
     vr.wall_time_s = time.perf_counter() - t0
     write_report(vr, out, fast)
     return vr
 
 
-def _mode_checks(ref, vr, wanted, fast, out, quiet, mode):
+def _mode_checks(ref, vr, wanted, fast, out, quiet, progress, mode):
     def check(case, quantity, value, reference, tol, res, **kw):
         vr.checks.append(Check(case, quantity, value, reference, tol, mode=mode,
                                scatter=_scatter(res), **kw))
 
     if "ex1" in wanted:
-        r = _run("Ex. 1", "paper_ex1_incline", fast, out, quiet, vr, mode)
+        r = _run("Ex. 1", "paper_ex1_incline", fast, out, quiet, vr, progress, mode)
         T50 = ref["example1"]["pull_force_N"]
         slope = ref["example1"]["tension_slope_N_per_m"]
         check("Ex. 1", "pulling force at the top end [N]", r.summary["pull_force_N"], T50,
               _tol("ex1_top", fast), r, note="Eq. 25")
-        x = np.asarray(r.tension_profile["s_m"])
+        x = np.asarray(r.tension_profile["x_m"])
         N = np.asarray(r.tension_profile["tension_N"])
         worst = float(np.max(np.abs(N - slope * x)))
         check("Ex. 1", "max |T(x) - Eq. 25| along the cable / T(50 m)", T50 + worst, T50,
               _tol("ex1_profile", fast), r, scale=T50, note="Fig. 7")
     if "ex2" in wanted:
-        r = _run("Ex. 2", "paper_ex2_bend90", fast, out, quiet, vr, mode)
+        r = _run("Ex. 2", "paper_ex2_bend90", fast, out, quiet, vr, progress, mode)
         T1 = ref["example2"]["pull_force_N"]
         paper = abs(ref["example2"].get("pull_force_reported_N", float("nan")) / T1 - 1)
         check("Ex. 2", "pulling force T1 [N]", r.summary["pull_force_N"], T1,
               _tol("ex2", fast), r, paper_error=paper, note="Eq. 26, capstan")
     if "ex3" in wanted:
-        r = _run("Ex. 3", "paper_ex3_helix", fast, out, quiet, vr, mode)
+        r = _run("Ex. 3", "paper_ex3_helix", fast, out, quiet, vr, progress, mode)
         T2 = ref["example3"]["back_tension_N"]
         check("Ex. 3", "trailing tension T2 [N]", r.summary["trailing_tension_N"], T2,
               _tol("ex3", fast), r, paper_error=ref["example3"].get("relative_error_reported"),
               note="Eq. 26 with the exact helix angle")
     if "fig12" in wanted:
-        _fig12(ref, fast, out, quiet, vr, mode)
+        _fig12(ref, fast, out, quiet, vr, progress, mode)
     if "ex4" in wanted:
-        r = _run("Ex. 4", "paper_ex4_spatial", fast, out, quiet, vr, mode)
+        r = _run("Ex. 4", "paper_ex4_spatial", fast, out, quiet, vr, progress, mode)
         check("Ex. 4", "pulling force vs rope solver [N]", r.summary["pull_force_N"],
               r.summary["rope_pull_force_N"], _tol("ex4", fast), r,
               note="independent rope solution (paper: RecurDyn)")
 
 
-def _fig12(ref, fast, out, quiet, vr, mode="dynamic"):
+def _fig12(ref, fast, out, quiet, vr, progress, mode="dynamic"):
     from .scenario import read_toml
     from .sweep import run_sweep
     from .sweep.spec import parse_sweep
-    path = ROOT / "scenarios" / "sweeps" / ("fast" if fast else "") / "paper_fig12_coils.toml"
-    if not quiet:
-        print(f"validate: running Fig. 12 ({path.relative_to(ROOT)}, {mode})", flush=True)
+    path, shown = _shipped("sweeps", "paper_fig12_coils.toml", fast=fast)
+    if progress is not None:
+        progress(f"validate: running Fig. 12 ({shown}, {mode})")
     data = read_toml(path, "sweep")
     data.setdefault("set", {})["solver.mode"] = mode
-    sweep = parse_sweep(data, path.parent, default_name=path.stem)
-    object.__setattr__(sweep, "source_path", path.resolve())
+    sweep = parse_sweep(data, Path(path).parent, default_name=Path(path).stem)
+    object.__setattr__(sweep, "source_path", Path(path).resolve())
     rows = run_sweep(sweep, out / "fig12", quiet=quiet)
     if mode == "dynamic":
         vr.sweep_rows = rows
@@ -310,32 +323,4 @@ def write_report(vr: ValidationRun, out: Path, fast: bool) -> None:
     for case, msg in vr.failures:
         md.append(f"- {case}: run failed: {msg}")
     atomic_write_text(out / "validation.md", "\n".join(md) + "\n")
-    from .plots.validation import plot_validation_figures
-    plot_validation_figures(vr, out)
-
-
-def add_arguments(p) -> None:
-    p.add_argument("--fast", action="store_true", help="coarse variants (scenarios/fast), looser tolerances")
-    p.add_argument("--out", "-o", default="validation", help="output directory (default: validation/)")
-    p.add_argument("--quiet", "-q", action="store_true", help="no progress output")
-    p.add_argument("--case", action="append", choices=["ex1", "ex2", "ex3", "fig12", "ex4"],
-                   help="run only these cases (repeatable)")
-    p.add_argument("--mode", action="append", choices=list(MODES),
-                   help="run only these solver modes (repeatable; default: both, and their difference)")
-
-
-def main(args) -> int:
-    vr = validate(fast=args.fast, out_dir=args.out, quiet=args.quiet, cases=args.case,
-                  modes=tuple(args.mode) if args.mode else MODES)
-    print(format_table(vr))
-    for case, msg in vr.failures:
-        print(f"{case}: run failed: {msg}", file=sys.stderr)
-    n_fail = sum(not c.passed for c in vr.checks)
-    times = ", ".join(f"{m} {t:.1f} s" for m, t in vr.mode_wall_time_s.items())
-    print(f"\n{len(vr.checks) - n_fail}/{len(vr.checks)} checks passed in {vr.wall_time_s:.1f} s ({times}); "
-          f"table and figures in {args.out}/")
-    diffs = vr.differences
-    if diffs:
-        n_agree = sum(d.agrees for d in diffs)
-        print(f"steady and dynamic agree within 0.2 % on {n_agree}/{len(diffs)} checks")
-    return 1 if n_fail or vr.failures else 0
+    plot_validation_figures(vr, out, load_reference())

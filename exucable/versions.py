@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import platform
+from importlib.metadata import PackageNotFoundError, version
 
 from . import __version__
 
@@ -12,13 +13,16 @@ __all__ = ["versions", "version_line"]
 def versions() -> dict[str, str]:
     """exucable's, Exudyn's, numpy's and Python's versions.
 
-    Imports Exudyn, so it is called when a result is written or ``--version`` is asked for,
-    never at import time.
+    Exudyn's is its installed distribution's, read without importing it (only ``model/`` and
+    ``solve*`` import Exudyn; ``--version`` stays fast).
     """
-    import exudyn
     import numpy
 
-    return {"exucable": __version__, "exudyn": exudyn.__version__, "numpy": numpy.__version__,
+    try:
+        exudyn_version = version("exudyn")
+    except PackageNotFoundError:
+        exudyn_version = "not installed"
+    return {"exucable": __version__, "exudyn": exudyn_version, "numpy": numpy.__version__,
             "python": platform.python_version()}
 
 

@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from exucable.compare import add_arguments, compare_results, main
+from exucable.commands.compare import add_arguments, main
+from exucable.compare import compare_results, load_tolerances
 from exucable.errors import ExucableError
 
 # Differences of exactly representable synthetic data are computed to rounding: 1e-12 relative/absolute.
@@ -51,7 +52,7 @@ def test_identical_profiles_give_zero(tmp_path, s, capsys):
     a = profile(tmp_path / "a.csv", s, 1.0 + s**2)
     result = compare_results(a, a)
     (c,) = result["comparisons"]
-    assert c["max_abs_N"] == 0.0 and c["rms_abs_N"] == 0.0 and c["max_rel"] == 0.0 and result["passed"]
+    assert c["max_abs"] == 0.0 and c["rms_abs"] == 0.0 and c["max_rel"] == 0.0 and result["passed"]
     assert run(a, a) == 0
     assert "tension_N" in capsys.readouterr().out
 
@@ -60,8 +61,8 @@ def test_known_offset_gives_known_numbers_and_exit_codes(tmp_path, s):
     a = profile(tmp_path / "a.csv", s, 10.0 * s / 10.0)  # max |A| = 10 N
     b = profile(tmp_path / "b.csv", s, 10.0 * s / 10.0 + 0.5)
     (c,) = compare_results(a, b)["comparisons"]
-    assert c["max_abs_N"] == pytest.approx(0.5, abs=EXACT)
-    assert c["rms_abs_N"] == pytest.approx(0.5, abs=EXACT)
+    assert c["max_abs"] == pytest.approx(0.5, abs=EXACT)
+    assert c["rms_abs"] == pytest.approx(0.5, abs=EXACT)
     assert c["max_rel"] == pytest.approx(0.05, abs=EXACT)
     assert c["rms_rel"] == pytest.approx(0.05, abs=EXACT)
     assert run(a, b) == 1  # 5 % > default 1 %
@@ -77,9 +78,9 @@ def test_b_is_interpolated_onto_a_over_the_overlap(tmp_path, s):
     (c,) = compare_results(a, b)["comparisons"]
     assert c["range"] == (2.0, 10.0)
     assert c["n_points"] == 81
-    assert c["max_abs_N"] == pytest.approx(0.0, abs=1e-12)
+    assert c["max_abs"] == pytest.approx(0.0, abs=1e-12)
     # Relative differences are scaled by max |A| over the overlap (23 N at s = 10).
-    assert c["scale_N"] == pytest.approx(23.0, rel=EXACT)
+    assert c["scale"] == pytest.approx(23.0, rel=EXACT)
 
 
 def test_rms_of_a_sine_difference(tmp_path):
@@ -89,8 +90,8 @@ def test_rms_of_a_sine_difference(tmp_path):
     b = history(tmp_path / "b.csv", t, 20.0 + 0.1 * np.sin(2 * np.pi * t))
     (c,) = compare_results(a, b)["comparisons"]
     assert c["column"] == "pull_force_N" and c["abscissa"] == "time_s"
-    assert c["max_abs_N"] == pytest.approx(0.1, rel=1e-6)  # the sine's peaks are sample points
-    assert c["rms_abs_N"] == pytest.approx(0.1 / np.sqrt(2.0), rel=1e-3)  # endpoint weighting of 2001 samples
+    assert c["max_abs"] == pytest.approx(0.1, rel=1e-6)  # the sine's peaks are sample points
+    assert c["rms_abs"] == pytest.approx(0.1 / np.sqrt(2.0), rel=1e-3)  # endpoint weighting of 2001 samples
     assert c["max_rel"] == pytest.approx(0.1 / 20.0, rel=1e-6)
 
 
@@ -104,9 +105,9 @@ def test_result_directories_compare_every_common_column(tmp_path, s):
                 maximum=20.0 + t if name == "run_a" else None)
     result = compare_results(tmp_path / "run_a", tmp_path / "run_b")
     got = {(c["kind"], c["column"]): c for c in result["comparisons"]}
-    assert set(got) == {("profile", "tension_N"), ("history", "pull_force_N"), ("history", "trailing_tension_N")}
-    assert got[("history", "pull_force_N")]["max_abs_N"] == pytest.approx(0.2, abs=EXACT)
-    assert got[("profile", "tension_N")]["max_abs_N"] == 0.0
+    assert set(got) == {("tension_profile", "tension_N"), ("history", "pull_force_N"), ("history", "trailing_tension_N")}
+    assert got[("history", "pull_force_N")]["max_abs"] == pytest.approx(0.2, abs=EXACT)
+    assert got[("tension_profile", "tension_N")]["max_abs"] == 0.0
     assert result["skipped"] == [("history", "max_tension_N", "only in A")]
     # A directory against a single CSV compares what they share.
     single = compare_results(tmp_path / "run_a", tmp_path / "run_b" / "tension_profile.csv")
@@ -124,7 +125,7 @@ def test_overlay_plot_is_written_atomically(tmp_path, s, capsys):
 
 
 @pytest.mark.parametrize("content, message", [
-    ("x,y\n1,2\n2,3\n", "neither 's_m'"),
+    ("x,y\n1,2\n2,3\n", "no known abscissa"),
     ("s_m,force\n1,2\n2,3\n", "missing its value column"),
     ("time_s,speed\n1,2\n2,3\n", "missing its value column"),
     ("s_m,tension_N\n0,1\n1,abc\n", "not a number"),
@@ -144,7 +145,7 @@ def test_missing_inputs_and_mismatches_raise_clear_errors(tmp_path, s):
     with pytest.raises(ExucableError, match="no such file"):
         compare_results(a, tmp_path / "absent.csv")
     (tmp_path / "empty_dir").mkdir()
-    with pytest.raises(ExucableError, match="neither tension_profile.csv nor history.csv"):
+    with pytest.raises(ExucableError, match="result directory has none of"):
         compare_results(a, tmp_path / "empty_dir")
     h = history(tmp_path / "h.csv", s, s)
     with pytest.raises(ExucableError, match="nothing to compare"):
@@ -157,7 +158,59 @@ def test_missing_inputs_and_mismatches_raise_clear_errors(tmp_path, s):
 
 
 def test_module_entry_point_reports_errors_without_traceback(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "exucable.compare", str(tmp_path / "nope.csv"),
+    proc = subprocess.run([sys.executable, "-m", "exucable", "compare", str(tmp_path / "nope.csv"),
                            str(tmp_path / "nope.csv")], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2
     assert "no such file" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def snapshot_tension(path: Path, times, x, f) -> Path:
+    rows = [(t, e, 0.0, xx, f(t, xx)) for t in times for e, xx in enumerate(x)]
+    return write_csv(path, "time_s,element,xi,x_m,tension_N", np.array(rows).T)
+
+
+def test_snapshots_are_compared_time_by_time(tmp_path, s, capsys):
+    for name in ("a", "b"):
+        (tmp_path / name).mkdir()
+    a = snapshot_tension(tmp_path / "a" / "snapshot_tension.csv", [0.1, 0.2, 0.3], s, lambda t, x: 100.0 + t * x)
+    # B on every other station (linear in x: interpolation is exact), 0.5 N off at t = 0.2 s, no t = 0.3 s
+    b = snapshot_tension(tmp_path / "b" / "snapshot_tension.csv", [0.1, 0.2], s[::2],
+                         lambda t, x: 100.0 + t * x + (0.5 if t == 0.2 else 0.0))
+    result = compare_results(a.parent, b.parent)
+    (c,) = result["comparisons"]
+    assert (c["kind"], c["abscissa"], c["times"]) == ("snapshot_tension", "x_m", [0.1, 0.2])
+    assert c["max_abs"] == pytest.approx(0.5, abs=EXACT) and c["worst_at"][1] == 0.2
+    assert c["scale"] == pytest.approx(102.0, rel=EXACT)      # max |A| over the times compared
+    assert result["skipped"] == [("snapshot_tension", "*", "snapshot t = 0.3 s only in A")]
+    assert run(a.parent, b.parent, "--atol", "0.4", "--rtol", "0") == 1
+    assert run(a.parent, b.parent, "--atol", "0.6", "--rtol", "0", "--out", tmp_path / "figs") == 0
+    assert [p.name for p in (tmp_path / "figs").iterdir()] == ["compare_snapshot_tension_tension_N.png"]
+
+
+def test_per_quantity_tolerances_from_toml(tmp_path, capsys):
+    t = np.linspace(0.0, 1.0, 11)
+    a = history(tmp_path / "a.csv", t, 100.0 + t, trailing=np.full_like(t, 50.0))
+    b = history(tmp_path / "b.csv", t, 101.0 + t, trailing=np.full_like(t, 50.2))
+    tol = tmp_path / "tol.toml"
+    tol.write_text("[default]\nrtol = 0.0\natol = 0.25\n\n[pull_force_N]\nrtol = 0.02\n")
+    result = compare_results(a, b, tolerances=load_tolerances(tol))
+    got = {c["column"]: c for c in result["comparisons"]}
+    assert (got["pull_force_N"]["rtol"], got["pull_force_N"]["atol"]) == (0.02, 0.25)
+    assert got["pull_force_N"]["passed"] and got["trailing_tension_N"]["passed"]
+    tol.write_text("[history.trailing_tension_N]\natol = 0.1\nrtol = 0.0\n")
+    assert run(a, b, "--tolerances", tol, "--rtol", "0.02") == 1
+    assert "BEYOND" in capsys.readouterr().out
+    tol.write_text("[pull_force_N]\nrtol = -1\n")
+    with pytest.raises(ExucableError, match="pull_force_N.rtol: must be a finite number >= 0"):
+        load_tolerances(tol)
+
+
+def test_old_column_names_are_read_with_a_note_and_new_ones_directly(tmp_path, s, capsys):
+    old = profile(tmp_path / "tension_profile.csv", s, 1.0 + s)
+    new = write_csv(tmp_path / "new.csv", "x_m,tension_N", [s, 1.0 + s])
+    result = compare_results(new, old)
+    assert result["passed"] and result["comparisons"][0]["kind"] == "tension_profile"
+    assert result["notes"] == ["tension_profile.csv: read old column 's_m' as 'x_m' (old names are read for one release)"]
+    contact_old = write_csv(tmp_path / "c_old.csv", "s_m,normal_force_per_length_N_per_m", [s, s])
+    contact_new = write_csv(tmp_path / "c_new.csv", "s_conduit_m,normal_force_per_length_N_per_m", [s, s])
+    assert compare_results(contact_new, contact_old)["comparisons"][0]["kind"] == "contact_profile"

@@ -192,3 +192,49 @@ def test_damping_onset_jacobians_and_backends_agree():
     # and the force is continuous at first touch: the damping term vanishes with δ
     st = k.points(q, q_t)
     assert np.all(st.penetration_m < ONSET.damping_onset_m)
+
+
+@pytest.mark.parametrize("surface", ["segments", "smooth"])
+@pytest.mark.parametrize("kind", ["bend", "helix", "sbend"])
+def test_profiles_of_both_backends_agree(kind, surface):
+    """ContactKernel.points() goes to the kernel's backend like every other call: the compiled
+    profiles (segment, penetration, normal, arc length, forces, slip) equal the numpy reference's,
+    on a cable partly in contact, partly free, with its lead pulled out past the conduit's end."""
+    cond = conduit(kind)
+    length = cond.centreline.length_m
+    s_nodes = np.linspace(0.2 * length, 1.03 * length, 21)  # the last node 3 % past the open end
+    rng = np.random.default_rng(5)
+    # distance from the axis varies along the cable: in contact (δ up to 0.4 mm) and free
+    distance = GAP + rng.uniform(-3e-4, 4e-4, size=(s_nodes.size, 1))
+    c = cond.centreline
+    inside = np.minimum(s_nodes, length)
+    t = c.tangent(inside)
+    # offset in a random direction across the tangent
+    e1 = np.cross(t, [0.3, 0.2, 1.0])
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(t, e1)
+    angle = rng.uniform(0.0, 2.0 * np.pi, size=(s_nodes.size, 1))
+    u = np.cos(angle) * e1 + np.sin(angle) * e2
+    pos = c.point(inside) + distance * u + np.maximum(s_nodes - length, 0.0)[:, None] * t
+    q = np.hstack([pos, t]).reshape(-1)
+    q_t = np.hstack([0.1 * t + rng.normal(scale=0.02, size=t.shape),
+                     rng.normal(scale=0.05, size=t.shape)]).reshape(-1)
+    L = np.linalg.norm(np.diff(pos, axis=0), axis=1)
+    kw = dict(n_elements=L.size, surface=surface, centreline=c)
+    ref = ContactKernel(cond.segments, L, R_CABLE, LAW, 24, backend="numpy", **kw).points(q, q_t)
+    fast = ContactKernel(cond.segments, L, R_CABLE, LAW, 24, backend="numba", **kw).points(q, q_t)
+    assert ref.in_contact.sum() > 20 and (~ref.in_contact).sum() > 20
+    assert ((ref.s_conduit_m >= length - 1e-12) | (ref.segment < 0)).any()  # the lead is out
+    np.testing.assert_array_equal(fast.segment, ref.segment)
+    np.testing.assert_array_equal(fast.in_contact, ref.in_contact)
+    # same arithmetic up to the compiled kernel's reassociation: the residual P - Pc (mm) is a
+    # difference of positions of metres, rounded at ~1e-15 m, which is 1e-12 of a millimetre;
+    # normals, penetrations and forces inherit that: 1e-10 of each quantity's scale
+    for name, scale in (("position_m", 1.0), ("velocity_m_per_s", 1.0), ("normal", 1.0),
+                        ("s_conduit_m", length), ("penetration_m", GAP),
+                        ("normal_force_N", np.max(ref.normal_force_N)),
+                        ("normal_force_per_length_N_per_m", np.max(ref.normal_force_per_length_N_per_m)),
+                        ("sliding_velocity_m_per_s", 0.1), ("friction_force_N", np.max(ref.friction_force_N))):
+        a, b = getattr(fast, name), getattr(ref, name)
+        assert np.array_equal(np.isnan(a), np.isnan(b)), name
+        assert np.nanmax(np.abs(a - b)) <= 1e-10 * scale, name

@@ -28,12 +28,12 @@ def test_run_writes_the_documented_results(tmp_path):
     assert s["scenario"]["contact"]["friction"] == 0.3          # echoed with defaults filled in
     assert list(read_csv(tmp_path / "history.csv")) == ["time_s", "pull_force_N", "trailing_tension_N",
                                                          "max_tension_N"]
-    assert list(read_csv(tmp_path / "tension_profile.csv")) == ["s_m", "tension_N"]
+    assert list(read_csv(tmp_path / "tension_profile.csv")) == ["x_m", "tension_N"]
     contact = read_csv(tmp_path / "contact_profile.csv")
-    assert list(contact) == ["s_m", "normal_force_per_length_N_per_m", "penetration_m"]
+    assert list(contact) == ["s_conduit_m", "normal_force_per_length_N_per_m", "penetration_m"]
     # the sidewall pressure of a cable resting on an incline is w·cos θ (1e-3: binning at the ends)
     w = 1000 * np.pi * 0.0025**2 * 9.8
-    mid = (contact["s_m"] > 10) & (contact["s_m"] < 40)
+    mid = (contact["s_conduit_m"] > 10) & (contact["s_conduit_m"] < 40)
     np.testing.assert_allclose(contact["normal_force_per_length_N_per_m"][mid], w * np.cos(np.pi / 6), rtol=1e-3)
     for png in ("pull_force.png", "tension_profile.png"):
         assert (tmp_path / png).stat().st_size > 5000

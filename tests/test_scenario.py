@@ -72,7 +72,7 @@ BAD = [
     # missing required keys and tables
     ("no-cable", with_(base(), ("cable",), _DELETE), "cable", "required"),
     ("no-radius", with_(base(), ("cable", "radius"), _DELETE), "cable.radius", "required"),
-    ("no-elements", with_(base(), ("cable", "elements"), _DELETE), "cable.elements", "required"),
+    ("elements-float-zero", with_(base(), ("cable", "elements"), 0.0), "cable.elements", "integer"),
     ("no-speed", with_(base(), ("pull", "speed"), _DELETE), "pull.speed", "required"),
     ("no-end-time", with_(base(), ("solver", "end_time"), _DELETE), "solver.end_time", "required"),
     ("no-inner-radius", with_(base(), ("conduit", "inner_radius"), _DELETE), "conduit.inner_radius", "required"),

@@ -1,8 +1,9 @@
 """Cable-conduit contact (paper Sects. 2.4-2.5): check points, AABB broad phase, Hertz normal force,
 regularised Coulomb friction, generalized forces and their exact Jacobians.
 
-Pure numpy reference (:mod:`.kernel`) plus a numba fast path (:mod:`.fast`, the default). Nothing
-here imports Exudyn; the model layer wraps :class:`ContactKernel` in Exudyn user functions.
+:class:`ContactKernel` (:mod:`.kernel`) is the facade; one switch, its ``backend``, sends every call
+(profiles included) to the numpy reference (:mod:`.reference`, the tested definition) or the numba
+fast path (:mod:`.fast`, the default). Nothing here imports Exudyn; the model layer wraps :class:`ContactKernel` in Exudyn user functions.
 """
 
 from .checkpoints import check_points

@@ -263,6 +263,19 @@ def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, 
         az_in[k] = sb * (t1 * e1z + t2 * e2z + t3 * kz)
 
 
+@njit(inline="always", **_JIT)
+def _closest_points(tab, seg, cand, c0, c1, sel, open_first, open_last, smooth, seg_piece, pieces,
+                    seg_phi, n_newton):
+    """Closest point Pc of every check point of the element: nearest candidate segment, then on
+    the smooth wall refined onto the exact bend or helix (rows _BEST, _RX..., _AX..., _BEYOND)."""
+    _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
+                      tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ],
+                      open_first, open_last, tab[_BEYOND])
+    if smooth:
+        _refine_smooth(tab[_PX], tab[_PY], tab[_PZ], seg, sel, tab[_BEST], tab[_RX], tab[_RY],
+                       tab[_RZ], tab[_AX], tab[_AY], tab[_AZ], seg_piece, pieces, seg_phi, n_newton)
+
+
 @njit(**_JIT)
 def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open_first, open_last):
     """Contact search only (no force law): nearest segment of every check point, -1 if none."""
@@ -271,6 +284,57 @@ def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open
         _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, off[e], off[e + 1],
                           tab[_BEST], nearest[e], tab[_RX], tab[_RY], tab[_RZ], tab[_AX],
                           tab[_AY], tab[_AZ], open_first, open_last, tab[_BEYOND])
+
+
+@njit(**_JIT)
+def _points_kernel(q, qt, length, n1, n2, n3, n4, omega, seg, off, cand, gap, stiffness, damping,
+                   exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2, inv_href, tab, sel,
+                   open_first, open_last, smooth, seg_piece, pieces, seg_phi, n_newton, inv_onset,
+                   out_seg, out_p, out_v, out_res, out_f, out_g, out_hf):
+    """Per check point state for post-processing, by the same steps as :func:`_contact_kernel`:
+    nearest segment (-1 without candidates), P, v, residual P - Pc (NaN without candidates),
+    weighted normal force w f_n, |v_τ|² and μ w f_n/√(|v_τ|² + ε²)."""
+    n_k = n1.shape[0]
+    for e in range(length.shape[0]):
+        c0 = off[e]
+        c1 = off[e + 1]
+        le = length[e]
+        b = 6 * e
+        r0 = e * n_k
+        _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])  # Eq. 2
+        _positions(qt, b, le, n1, n2, n3, n4, tab[_VX], tab[_VY], tab[_VZ])  # Eq. 8
+        for k in range(n_k):
+            out_p[r0 + k, 0] = tab[_PX, k]
+            out_p[r0 + k, 1] = tab[_PY, k]
+            out_p[r0 + k, 2] = tab[_PZ, k]
+            out_v[r0 + k, 0] = tab[_VX, k]
+            out_v[r0 + k, 1] = tab[_VY, k]
+            out_v[r0 + k, 2] = tab[_VZ, k]
+        if c0 == c1:
+            for k in range(n_k):
+                out_seg[r0 + k] = -1
+                out_res[r0 + k, 0] = np.nan
+                out_res[r0 + k, 1] = np.nan
+                out_res[r0 + k, 2] = np.nan
+                out_f[r0 + k] = 0.0
+                out_g[r0 + k] = 0.0
+                out_hf[r0 + k] = 0.0
+            continue
+        _closest_points(tab, seg, cand, c0, c1, sel, open_first, open_last, smooth, seg_piece, pieces,
+                        seg_phi, n_newton)
+        _normals(tab, n_k, gap, -1.0)
+        _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
+                      exponent_mode, inv_onset)
+        _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
+        for k in range(n_k):
+            out_seg[r0 + k] = sel[k]
+            inside = 0.0 if tab[_BEYOND, k] != 0.0 else 1.0  # beyond an open end: Pc = P, as numpy
+            out_res[r0 + k, 0] = inside * tab[_RX, k]
+            out_res[r0 + k, 1] = inside * tab[_RY, k]
+            out_res[r0 + k, 2] = inside * tab[_RZ, k]
+            out_f[r0 + k] = tab[_F, k]
+            out_g[r0 + k] = tab[_G, k]
+            out_hf[r0 + k] = tab[_HF, k]
 
 
 @njit(**_JIT)
@@ -290,13 +354,8 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         le = length[e]
         b = 6 * e
         _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])  # Eq. 2
-        _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
-                          tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ],
-                          open_first, open_last, tab[_BEYOND])
-        if smooth:
-            _refine_smooth(tab[_PX], tab[_PY], tab[_PZ], seg, sel, tab[_BEST], tab[_RX], tab[_RY],
-                           tab[_RZ], tab[_AX], tab[_AY], tab[_AZ], seg_piece, pieces, seg_phi,
-                           n_newton)
+        _closest_points(tab, seg, cand, c0, c1, sel, open_first, open_last, smooth, seg_piece, pieces,
+                        seg_phi, n_newton)
         n_touch, max_d2 = _normals(tab, n_k, gap, max_d2)
         if n_touch == 0:
             continue
@@ -787,17 +846,47 @@ class FastKernel:
             jqt = np.zeros((self.n_el, 12, 12))
         else:
             jq = jqt = self._empty_blocks
-        law = self.law
         n1, n2, n3, n4 = self._n
         n_contact, max_pen = _contact_kernel(
             q, q_t, self.length, n1, n2, n3, n4, self.pair_t, _PAIRS, self.omega, self.seg, off,
-            cand,
-            self.gap, float(law.stiffness), float(law.damping), float(law.exponent),
-            _exponent_mode(law.exponent), float(law.friction), float(law.static_excess),
-            1.0 / law.stribeck_velocity_m_per_s**2, law.regularisation_velocity_m_per_s**2,
+            cand, self.gap, *self._law_arguments(),
             self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc,
             self.open_first, self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
-            NEWTON_ITERATIONS, 1.0 / law.damping_onset_m if law.damping_onset_m > 0.0 else 0.0)
+            NEWTON_ITERATIONS, self._inverse_onset())
         if not jacobian:
             jq = jqt = None
         return force, jq, jqt, int(n_contact), float(max_pen)
+
+    def _law_arguments(self):
+        """The law's numbers as both kernels take them: K, C, e, e's mode, μ_k, μ_s - μ_k, 1/v_s², ε²."""
+        law = self.law
+        return (float(law.stiffness), float(law.damping), float(law.exponent), _exponent_mode(law.exponent),
+                float(law.friction), float(law.static_excess), 1.0 / law.stribeck_velocity_m_per_s**2,
+                law.regularisation_velocity_m_per_s**2)
+
+    def _inverse_onset(self):
+        """1/δ_d of the damping onset [1/m], 0 for the paper's step."""
+        onset = self.law.damping_onset_m
+        return 1.0 / onset if onset > 0.0 else 0.0
+
+    def point_state(self, q, q_t):
+        """Per check point (element-major): nearest segment (-1: none), P [m], v [m/s], residual
+        P - Pc [m] (NaN without a segment), weighted normal force w·f_n [N], sliding speed |v_τ|
+        [m/s] and friction force [N] (both 0 where there is no force)."""
+        q = np.ascontiguousarray(q, dtype=float)
+        q_t = np.ascontiguousarray(q_t, dtype=float)
+        off, cand = self.candidates(q)
+        m = self.n_el * self.nh.shape[0]
+        segment = np.empty(m, dtype=np.int64)
+        p, v, res = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3))
+        f, g, hf = np.empty(m), np.empty(m), np.empty(m)
+        n1, n2, n3, n4 = self._n
+        _points_kernel(q, q_t, self.length, n1, n2, n3, n4, self.omega, self.seg, off, cand, self.gap,
+                       *self._law_arguments(), self.inv_href, self._tab, self._sel, self.open_first,
+                       self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
+                       NEWTON_ITERATIONS, self._inverse_onset(), segment, p, v, res, f, g, hf)
+        acting = f > 0.0
+        slip = np.where(acting, np.sqrt(g), 0.0)
+        return {"segment": segment, "position_m": p, "velocity_m_per_s": v, "residual_m": res,
+                "normal_force_N": np.where(acting, f, 0.0), "sliding_velocity_m_per_s": slip,
+                "friction_force_N": np.where(acting, hf * slip, 0.0)}

@@ -1,7 +1,10 @@
 """Cable-conduit contact kernel (paper Sects. 2.4-2.5): narrow phase, force law, Jacobians.
 
-This module holds the public :class:`ContactKernel` and its pure-numpy reference implementation;
-:mod:`exucable.contact.fast` is the compiled fast path (the default), tested against this one.
+This module holds the public :class:`ContactKernel`, a facade over two backends chosen by ONE
+switch (its ``backend`` argument) for every call: forces, Jacobians, candidate lists and the
+per-point profiles of :meth:`ContactKernel.points` alike. :mod:`exucable.contact.reference` is the
+numpy backend, the tested definition; :mod:`exucable.contact.fast` the compiled one (the default),
+tested against it.
 
 Per check point P at element coordinate ξ_k (weight ω_k) of element e:
 
@@ -29,10 +32,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.segments import Segments
-from .broadphase import candidates_all_pairs, candidates_all_segments, element_aabbs
-from .smooth import SmoothWall, refine_closest_points
 from .checkpoints import check_points, hermite_unit
-from .law import ContactLaw, damping_ramp, friction_coefficient
+from .law import ContactLaw
+from .reference import ReferenceKernel
+from .smooth import SmoothWall, refine_closest_points
 
 __all__ = [
     "ContactKernel",
@@ -157,127 +160,6 @@ def assemble_blocks_dense(blocks: np.ndarray) -> np.ndarray:
     return out
 
 
-# ---------------------------------------------------------------------------------------------
-# numpy reference
-# ---------------------------------------------------------------------------------------------
-
-def _element_values(q: np.ndarray) -> np.ndarray:
-    """Element coordinates as (n_el, 4, 3): r_i, r'_i, r_j, r'_j."""
-    nodes = q.reshape(-1, 6)
-    return np.stack([nodes[:-1, :3], nodes[:-1, 3:], nodes[1:, :3], nodes[1:, 3:]], axis=1)
-
-
-def _nearest(p, cand, seg_start, seg_end, seg_axis, seg_length, open_first=-1, open_last=-1):
-    """Closest point of each of the points ``p`` (m, 3) on the segments ``cand``.
-
-    Returns (segment index, clamped projection parameter t [m], residual P - Pc, inside flag);
-    the arithmetic mirrors the compiled kernel term by term so that both choose the same segment.
-    """
-    a = seg_axis[cand]
-    start = seg_start[cand]
-    end = seg_end[cand]
-    dx = p[:, None, 0] - start[None, :, 0]
-    dy = p[:, None, 1] - start[None, :, 1]
-    dz = p[:, None, 2] - start[None, :, 2]
-    t = dx * a[None, :, 0] + dy * a[None, :, 1] + dz * a[None, :, 2]
-    length = seg_length[cand][None, :]
-    low = t <= 0.0
-    high = ~low & (t >= length)
-    inside = ~low & ~high
-    ex = np.where(low, dx, np.where(high, p[:, None, 0] - end[None, :, 0], dx - t * a[None, :, 0]))
-    ey = np.where(low, dy, np.where(high, p[:, None, 1] - end[None, :, 1], dy - t * a[None, :, 1]))
-    ez = np.where(low, dz, np.where(high, p[:, None, 2] - end[None, :, 2], dz - t * a[None, :, 2]))
-    d2 = ex * ex + ey * ey + ez * ez
-    j = np.argmin(d2, axis=1)  # first minimum: ties keep the lower segment index
-    rows = np.arange(p.shape[0])
-    residual = np.stack([ex[rows, j], ey[rows, j], ez[rows, j]], axis=1)
-    # nearest to an open end's segment and past it: outside the conduit, no contact (residual 0,
-    # as the compiled kernel). Decided on the nearest segment: a point far from the ends may well
-    # lie behind the first segment's start plane.
-    beyond = (low & (cand == open_first)[None, :]) | (high & (cand == open_last)[None, :])
-    residual[beyond[rows, j]] = 0.0
-    t_clamped = np.clip(t[rows, j], 0.0, length[0, j])
-    return cand[j], t_clamped, residual, inside[rows, j]
-
-
-def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian):
-    """Force law on flat arrays of points (Eqs. 14-23) and its derivatives ∂F/∂P, ∂F/∂v.
-
-    ``p_res`` = P - Pc (NaN rows for points without a segment); ``axis_inside`` = segment axis
-    where the projection is inside the segment, 0 where it is clamped to a vertex.
-    """
-    m = p_res.shape[0]
-    out = {
-        "delta": np.full(m, np.nan),
-        "normal": np.full((m, 3), np.nan),
-        "f": np.zeros(m),
-        "f_unweighted": np.zeros(m),
-        "slip": np.zeros(m),
-        "friction": np.zeros(m),
-        "force": np.zeros((m, 3)),
-        "jp": np.zeros((m, 3, 3)) if jacobian else None,
-        "jv": np.zeros((m, 3, 3)) if jacobian else None,
-    }
-    with np.errstate(invalid="ignore"):
-        d = np.sqrt(np.sum(p_res * p_res, axis=1))
-        delta = d - gap  # Eq. 14
-    out["delta"] = delta
-    touch = np.nonzero(delta > 0.0)[0]  # NaN compares False: no segment, no contact
-    pos = d > 0.0
-    out["normal"][pos] = p_res[pos] / d[pos, None]
-    if touch.size == 0:
-        return out
-    dt = d[touch]
-    n = p_res[touch] / dt[:, None]  # Eq. 15
-    vt_ = v[touch]
-    vn = np.sum(n * vt_, axis=1)  # Eq. 16
-    dl = delta[touch]
-    ramp, dramp = damping_ramp(law, dl)
-    raw = law.stiffness * dl**law.exponent + law.damping * ramp * vn  # Eq. 18 (with the onset)
-    act = raw > 0.0
-    idx = touch[act]
-    n, vt_, vn, dl, dt, raw = n[act], vt_[act], vn[act], dl[act], dt[act], raw[act]
-    ramp, dramp = ramp[act], dramp[act]
-    wt = w[idx]
-    f = wt * raw
-    tau = vt_ - vn[:, None] * n  # Eq. 17
-    g = np.sum(tau * tau, axis=1)
-    sr = np.sqrt(g + law.regularisation_velocity_m_per_s**2)
-    mu, dmu_dg = friction_coefficient(law, g)
-    h = mu * f / sr
-    force = -f[:, None] * n - h[:, None] * tau  # Eqs. 19-23
-    out["f"][idx] = f
-    out["f_unweighted"][idx] = raw
-    out["slip"][idx] = np.sqrt(g)
-    out["friction"][idx] = h * np.sqrt(g)
-    out["force"][idx] = force
-    if not jacobian:
-        return out
-    eye = np.eye(3)
-    a = axis_inside[idx]
-    proj = eye - a[:, :, None] * a[:, None, :]  # Π
-    nn = n[:, :, None] * n[:, None, :]
-    mmat = (proj - nn) / dt[:, None, None]  # ∂n/∂P
-    mv = np.einsum("kij,kj->ki", mmat, vt_)
-    mt = np.einsum("kij,kj->ki", mmat, tau)
-    df_dp = wt[:, None] * ((law.stiffness * law.exponent * dl ** (law.exponent - 1.0)
-                            + law.damping * dramp * vn)[:, None] * n
-                           + (law.damping * ramp)[:, None] * mv)
-    df_dv = (wt * law.damping * ramp)[:, None] * n
-    dtau_dp = -n[:, :, None] * mv[:, None, :] - vn[:, None, None] * mmat
-    dtau_dv = eye - nn
-    dg_dp = -2.0 * vn[:, None] * mt
-    dg_dv = 2.0 * tau
-    cg = f * (dmu_dg / sr - 0.5 * mu / sr**3)  # ∂h/∂g at fixed f
-    u = n + (mu / sr)[:, None] * tau  # ∂h/∂f · τ + n
-    outer = lambda x, y: x[:, :, None] * y[:, None, :]  # noqa: E731
-    out["jp"][idx] = (-outer(u, df_dp) - f[:, None, None] * mmat
-                      - outer(tau, cg[:, None] * dg_dp) - h[:, None, None] * dtau_dp)
-    out["jv"][idx] = (-outer(u, df_dv) - outer(tau, cg[:, None] * dg_dv)
-                      - h[:, None, None] * dtau_dv)
-    return out
-
-
 class ContactKernel:
     """Contact between an ANCF cable and a conduit made of straight hollow cylinders.
 
@@ -370,15 +252,17 @@ class ContactKernel:
             except ImportError:  # pragma: no cover
                 backend = "numpy"
         self.backend = backend
-        self._fast = None
+        # the one switch: every call below goes to this object
         if backend == "numba":
             from .fast import FastKernel
 
-            self._fast = FastKernel(self._seg_start, self._seg_end, self._seg_axis,
+            self._impl = FastKernel(self._seg_start, self._seg_end, self._seg_axis,
                                     self._seg_length, self._seg_lo, self._seg_hi, length,
                                     self._nh, self.omega, law, self.gap_m, radius,
                                     self.reference_spacing_m, broad_phase, self.open_ends,
                                     self.wall)
+        else:
+            self._impl = ReferenceKernel(self)
 
     @property
     def n_elements(self) -> int:
@@ -400,16 +284,10 @@ class ContactKernel:
         """Candidate segments of each element (CSR offsets, indices; fresh arrays).
 
         The numpy backend tests every element box against every segment box; the numba backend
-        uses sort-and-sweep. Both give the same lists.
+        sorts and sweeps. Both give the same lists.
         """
-        q = self._check(q, "q")
-        if self.broad_phase == "none":
-            return candidates_all_segments(self.n_elements, self._seg_start.shape[0])
-        if self._fast is not None:
-            off, idx = self._fast.candidates(q)
-            return off.copy(), idx.copy()
-        elo, ehi = element_aabbs(q, self.element_length_m, self.cable_radius_m)
-        return candidates_all_pairs(elo, ehi, self._seg_lo, self._seg_hi)
+        off, idx = self._impl.candidates(self._check(q, "q"))
+        return off.copy(), idx.copy()
 
     # -- evaluation ----------------------------------------------------------------------------
     def evaluate(self, q, q_t, jacobian: bool = False) -> ContactResult:
@@ -430,123 +308,64 @@ class ContactKernel:
         """
         q = self._check(q, "q")
         q_t = self._check(q_t, "q_t")
-        if self._fast is not None:
-            force, jq, jqt, n_contact, max_pen = self._fast.evaluate(q, q_t, jacobian)
-            return ContactResult(force, jq, jqt, n_contact, max_pen)
-        return self._evaluate_numpy(q, q_t, jacobian)
+        return ContactResult(*self._impl.evaluate(q, q_t, jacobian))
 
     def points(self, q, q_t) -> CheckPointState:
-        """Per check point state for post-processing (numpy reference path)."""
-        q = self._check(q, "q")
-        q_t = self._check(q_t, "q_t")
-        st = self._state_numpy(q, q_t, jacobian=False)
+        """Per check point state for post-processing, from the kernel's backend.
+
+        Penetration, normal and the conduit arc length of Pc are derived here from each point's
+        nearest segment and residual P - Pc, the same way for both backends.
+        """
+        st = self._impl.point_state(self._check(q, "q"), self._check(q_t, "q_t"))
         seg = st["segment"]
-        has = seg >= 0
-        s_vertex = self.segments.s_vertex_m
-        s_conduit = np.full(seg.shape, np.nan)
-        sh = seg[has]
-        frac = st["t"][has] / self._seg_length[sh]
-        s_conduit[has] = s_vertex[sh] + frac * (s_vertex[sh + 1] - s_vertex[sh])
-        if st["phi"] is not None:  # on the smooth wall: the exact arc length of Pc
-            sm = np.isfinite(st["phi"])
-            piece = self.wall.seg_piece[seg[sm]]
-            s_conduit[sm] = self.wall.s_piece_start_m[piece] + st["phi"][sm] * self.wall.piece_speed_m_per_rad[piece]
-        law = st["law"]
+        p = st["position_m"]
+        residual = st["residual_m"]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            d = np.sqrt(np.sum(residual * residual, axis=1))
+            delta = d - self.gap_m  # Eq. 14 (NaN without a segment)
+            normal = np.where((d > 0.0)[:, None], residual / d[:, None], np.nan)  # Eq. 15
+        normal_force = st["normal_force_N"]
         share = (self.element_length_m[:, None] * self.omega[None, :]).reshape(-1)
         return CheckPointState(
             element=np.repeat(np.arange(self.n_elements), self.n_check_points),
             xi=np.tile(self.xi, self.n_elements),
             segment=seg,
-            position_m=st["p"],
-            velocity_m_per_s=st["v"],
-            normal=law["normal"],
-            s_conduit_m=s_conduit,
-            penetration_m=law["delta"],
-            normal_force_N=law["f"],
-            normal_force_per_length_N_per_m=law["f"] / share,
-            sliding_velocity_m_per_s=law["slip"],
-            friction_force_N=law["friction"],
-            in_contact=law["delta"] > 0.0,
+            position_m=p,
+            velocity_m_per_s=st["velocity_m_per_s"],
+            normal=normal,
+            s_conduit_m=self._arc_length(p, seg, residual),
+            penetration_m=delta,
+            normal_force_N=normal_force,
+            normal_force_per_length_N_per_m=normal_force / share,
+            sliding_velocity_m_per_s=st["sliding_velocity_m_per_s"],
+            friction_force_N=st["friction_force_N"],
+            in_contact=delta > 0.0,
         )
+
+    def _arc_length(self, p, seg, residual) -> np.ndarray:
+        """Centreline arc length of each point's closest point Pc [m] (NaN without a segment):
+        linear along the segment between its vertices' arc lengths, or on the smooth wall the
+        exact arc length of Pc on its bend or helix."""
+        has = seg >= 0
+        sh = seg[has]
+        d = p[has] - self._seg_start[sh]
+        a = self._seg_axis[sh]
+        t = np.full(seg.shape, np.nan)
+        t[has] = np.clip(d[:, 0] * a[:, 0] + d[:, 1] * a[:, 1] + d[:, 2] * a[:, 2], 0.0, self._seg_length[sh])
+        s_vertex = self.segments.s_vertex_m
+        s_conduit = np.full(seg.shape, np.nan)
+        s_conduit[has] = s_vertex[sh] + t[has] / self._seg_length[sh] * (s_vertex[sh + 1] - s_vertex[sh])
+        if self.wall is not None:
+            # beyond an open end the residual is zero: those points keep the segment's value
+            refine = np.where(np.any(residual != 0.0, axis=1), seg, -1)
+            mask, _, _, phi = refine_closest_points(p, refine, t, self._seg_length, self.wall)
+            sm = mask & np.isfinite(phi)
+            piece = self.wall.seg_piece[seg[sm]]
+            s_conduit[sm] = self.wall.s_piece_start_m[piece] + phi[sm] * self.wall.piece_speed_m_per_rad[piece]
+        return s_conduit
 
     def _check(self, x, name):
         x = np.ascontiguousarray(x, dtype=float)
         if x.shape != (self.n_coordinates,):
             raise ValueError(f"{name} must have shape ({self.n_coordinates},), got {x.shape}")
         return x
-
-    #: True when the check points' velocities are a function of q (see :meth:`_velocity_map`)
-    velocity_from_coordinates = False
-
-    def _velocity_map(self, shape, q, q_t):
-        """(shape table, coordinates) whose product gives the check points' velocities:
-        v = S(ξ) q̇ (Eq. 8). Subclasses may derive v from q instead (steady sliding)."""
-        return shape, q_t
-
-    def _state_numpy(self, q, q_t, jacobian):
-        n_el, n_k = self.n_elements, self.n_check_points
-        shape = np.broadcast_to(self._nh, (n_el, n_k, 4)).copy()
-        shape[:, :, 1] *= self.element_length_m[:, None]
-        shape[:, :, 3] *= self.element_length_m[:, None]
-        p = np.einsum("ekA,eAi->eki", shape, _element_values(q))  # Eq. 2
-        rate_shape, rate_source = self._velocity_map(shape, q, q_t)
-        v = np.einsum("ekA,eAi->eki", rate_shape, _element_values(rate_source))  # Eq. 8
-        offsets, indices = self.candidates(q)
-        segment = np.full((n_el, n_k), -1, dtype=np.int64)
-        t = np.full((n_el, n_k), np.nan)
-        residual = np.full((n_el, n_k, 3), np.nan)
-        axis_inside = np.zeros((n_el, n_k, 3))
-        for e in range(n_el):
-            cand = indices[offsets[e]:offsets[e + 1]]
-            if cand.size == 0:
-                continue
-            s, te, re, ins = _nearest(p[e], cand, self._seg_start, self._seg_end,
-                                      self._seg_axis, self._seg_length, *self._open)
-            segment[e], t[e], residual[e] = s, te, re
-            axis_inside[e] = np.where(ins[:, None], self._seg_axis[s], 0.0)
-        phi = None
-        if self.wall is not None:
-            # beyond an open end the residual is zero: leave those points alone
-            seg_flat = segment.reshape(-1).copy()
-            seg_flat[~np.any(residual.reshape(-1, 3) != 0.0, axis=1)] = -1
-            mask, r_s, ax_s, phi = refine_closest_points(p.reshape(-1, 3), seg_flat, t.reshape(-1),
-                                                         self._seg_length, self.wall)
-            res_flat = residual.reshape(-1, 3)
-            ax_flat = axis_inside.reshape(-1, 3)
-            res_flat[mask] = r_s[mask]
-            ax_flat[mask] = ax_s[mask]
-            phi = np.where(mask, phi, np.nan)
-        w = (self.element_length_m[:, None] * self.omega[None, :]) / self.reference_spacing_m
-        law = _point_law(residual.reshape(-1, 3), v.reshape(-1, 3), axis_inside.reshape(-1, 3),
-                         w.reshape(-1), self.law, self.gap_m, jacobian)
-        return {"p": p.reshape(-1, 3), "v": v.reshape(-1, 3), "segment": segment.reshape(-1),
-                "t": t.reshape(-1), "shape": shape, "rate_shape": rate_shape, "law": law, "phi": phi}
-
-    def _evaluate_numpy(self, q, q_t, jacobian):
-        st = self._state_numpy(q, q_t, jacobian)
-        n_el, n_k = self.n_elements, self.n_check_points
-        shape = st["shape"]
-        law = st["law"]
-        force_e = np.einsum("ekA,eki->eAi", shape, law["force"].reshape(n_el, n_k, 3))
-        force = np.zeros(self.n_coordinates)
-        nodes = force.reshape(-1, 6)
-        nodes[:-1] += force_e[:, 0:2].reshape(n_el, 6)
-        nodes[1:] += force_e[:, 2:4].reshape(n_el, 6)
-        delta = law["delta"]
-        with np.errstate(invalid="ignore"):
-            n_contact = int(np.count_nonzero(delta > 0.0))
-        finite = delta[np.isfinite(delta)]
-        max_pen = float(finite.max()) if finite.size else -np.inf
-        jq = jqt = None
-        if jacobian:
-            jp = law["jp"].reshape(n_el, n_k, 3, 3)
-            jv = law["jv"].reshape(n_el, n_k, 3, 3)
-            # (N Nᵀ) ⊗ J per point, summed over the element's points
-            jq = np.einsum("ekA,ekB,ekij->eAiBj", shape, shape, jp).reshape(n_el, 12, 12)
-            jv_blocks = np.einsum("ekA,ekB,ekij->eAiBj", shape, st["rate_shape"], jv).reshape(n_el, 12, 12)
-            if self.velocity_from_coordinates:   # v depends on q, not on q̇
-                jq += jv_blocks
-                jqt = np.zeros_like(jq)
-            else:
-                jqt = jv_blocks
-        return ContactResult(force, jq, jqt, n_contact, max_pen)

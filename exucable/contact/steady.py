@@ -30,6 +30,7 @@ from numba import njit
 
 from .checkpoints import hermite_unit
 from .kernel import ContactKernel
+from .reference import ReferenceKernel
 from .fast import (_JIT, _PAIRS, _J0, _PX, _PY, _PZ, _BEST, _RX, _RY, _RZ, _AX, _AY, _AZ, _BEYOND,
                    _VX, _VY, _VZ, _FX, _accumulate_blocks, _exponent_mode, _friction, _nearest_segments,
                    _normal_force, _normals, _point_jacobians, _positions, _refine_smooth)
@@ -54,37 +55,44 @@ class SteadySlidingKernel(ContactKernel):
     speed_m_per_s : float
         Pull speed V [m/s]; material flows toward the last node (the leading end).
 
-    ``evaluate(q, q_t)`` ignores ``q_t``; its ``jac_q_blocks`` are the full derivative (including
-    the velocity's dependence on q) and its ``jac_qt_blocks`` are zero.
+    ``evaluate(q, q_t)`` and ``points(q, q_t)`` ignore ``q_t``; the ``jac_q_blocks`` are the full
+    derivative (including the velocity's dependence on q) and the ``jac_qt_blocks`` are zero.
     """
-
-    velocity_from_coordinates = True
 
     def __init__(self, *args, speed_m_per_s: float, **kwargs):
         super().__init__(*args, **kwargs)
         self.speed_m_per_s = float(speed_m_per_s)
         self._dnh = hermite_unit_derivative(self.xi)
-        if self._fast is not None:
-            self._fast = _SteadyFast(self._fast, self._dnh, self.speed_m_per_s)
+        self._base_law = self.law
+        reference = _SteadyReference(self)
+        if self.backend == "numba":
+            self._impl = _SteadyFast(self._impl, self._dnh, self.speed_m_per_s, reference)
+        else:
+            self._impl = reference
 
     def set_friction_scale(self, scale: float) -> None:
         """Scale μ_k and μ_s by ``scale`` [-] (a continuation parameter; 1 = the scenario's law)."""
-        if not hasattr(self, "_base_law"):
-            self._base_law = self.law
         base = self._base_law
         law = replace(base, friction=scale * base.friction,
                       static_friction=None if base.static_friction is None else scale * base.static_friction)
         self.law = law
-        if self._fast is not None:
-            self._fast.fast.law = law
+        if isinstance(self._impl, _SteadyFast):
+            self._impl.fast.law = law
+
+
+class _SteadyReference(ReferenceKernel):
+    """numpy backend: v = V ∂r/∂x, its derivative folded into ∂Q/∂q."""
+
+    velocity_from_coordinates = True
 
     def _velocity_map(self, shape, q, q_t):
         # V ∂r/∂x: positions' columns dN/dξ / L, slopes' columns dN/dξ (L N_unit differentiated)
-        L = self.element_length_m[:, None]
-        d = np.broadcast_to(self._dnh, shape.shape).copy()
+        k = self.k
+        L = k.element_length_m[:, None]
+        d = np.broadcast_to(k._dnh, shape.shape).copy()
         d[:, :, 0] /= L
         d[:, :, 2] /= L
-        return self.speed_m_per_s * d, q
+        return k.speed_m_per_s * d, q
 
 
 @njit(inline="always", **_JIT)
@@ -181,8 +189,9 @@ class _SteadyFast:
     """Compiled steady-sliding evaluation sharing a :class:`~exucable.contact.fast.FastKernel`'s
     tables, broad phase and work buffers."""
 
-    def __init__(self, fast, dnh_unit, speed_m_per_s):
+    def __init__(self, fast, dnh_unit, speed_m_per_s, reference):
         self.fast = fast
+        self.reference = reference
         self.speed = float(speed_m_per_s)
         self._d = [np.ascontiguousarray(dnh_unit[:, i]) for i in range(4)]
         nh = fast.nh
@@ -193,6 +202,10 @@ class _SteadyFast:
 
     def candidates(self, q):
         return self.fast.candidates(q)
+
+    def point_state(self, q, q_t):
+        """Per check point state (post-processing only: the numpy reference's)."""
+        return self.reference.point_state(q, q_t)
 
     def evaluate(self, q, q_t, jacobian):
         """As :meth:`FastKernel.evaluate`; ``q_t`` is ignored and the q̇-blocks are zero."""

@@ -1,1 +1,4 @@
-"""Figures (matplotlib, Agg backend; files written atomically)."""
+"""Figures drawn from data: each function takes values (no solver, no file reading) and saves a
+:class:`matplotlib.figure.Figure` with :func:`exucable.io.save_figure` (atomic; no pyplot, no
+backend switch). Modules here import nothing above them but :mod:`exucable.io` and
+:mod:`exucable.reference`."""

@@ -2,32 +2,17 @@
 
 from __future__ import annotations
 
-import io
+from ..io import new_figure, save_figure
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..results import atomic_write_bytes  # noqa: E402
-
-__all__ = ["plot_pull_force", "plot_tension_profile", "save_figure"]
-
-
-def save_figure(fig, path) -> None:
-    """Save a matplotlib figure as PNG atomically and close it."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    atomic_write_bytes(path, buf.getvalue())
+__all__ = ["plot_pull_force", "plot_tension_profile"]
 
 
 def plot_pull_force(path, result) -> None:
     """Pulling force and trailing tension [N] against time [s], with the steady window and the
     rope reference when there is one."""
     h, s = result.history, result.summary
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig = new_figure(figsize=(7, 4))
+    ax = fig.subplots()
     ax.plot(h["time_s"], h["pull_force_N"], label="pulling force (leading end)")
     ax.plot(h["time_s"], h["trailing_tension_N"], label="trailing-end tension")
     rope = s.get("rope_pull_force_N")
@@ -44,21 +29,22 @@ def plot_pull_force(path, result) -> None:
                  f"{'n/a' if pull is None else format(pull, '.4g')} N{status}")
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    save_figure(fig, path)
+    save_figure(fig, path, bbox_inches="tight")
 
 
 def plot_tension_profile(path, result) -> None:
     """Tension [N] along the cable (arc length from the trailing end [m]) at the final time,
     beside the rope reference."""
     p = result.tension_profile
-    fig, ax = plt.subplots(figsize=(7, 4))
-    ax.plot(p["s_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
+    fig = new_figure(figsize=(7, 4))
+    ax = fig.subplots()
+    ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
     rp = result.rope_profile
-    if rp is not None and "s_cable_m" in result.extras:
-        ax.plot(result.extras["s_cable_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
-    ax.set_xlabel("arc length from the trailing end [m]")
+    if rp is not None and "x_m" in result.extras:
+        ax.plot(result.extras["x_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
+    ax.set_xlabel("x: material coordinate from the trailing end [m]")
     ax.set_ylabel("tension [N]")
     ax.set_title(f"{result.summary.get('name', '')}: tension along the cable")
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    save_figure(fig, path)
+    save_figure(fig, path, bbox_inches="tight")

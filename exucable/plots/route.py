@@ -7,15 +7,13 @@ and without a display.
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
+
+from ..io import new_figure, save_figure
 
 __all__ = ["plot_route", "route_table"]
 
@@ -103,8 +101,7 @@ def plot_route(conduit, path, title: str | None = None) -> Path:
     """
     out = Path(path)
     c = conduit.centreline
-    fig = Figure(figsize=(10.0, 7.0), dpi=110)
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(10.0, 7.0), dpi=110)
     ax = fig.add_axes((0.0, 0.02, 0.68, 0.90), projection="3d")
     extent = float(np.ptp(np.concatenate([_piece_polyline(p) for p in c.pieces]), axis=0).max())
 
@@ -154,20 +151,6 @@ def plot_route(conduit, path, title: str | None = None) -> Path:
                       label="bend / helix (dots: ends)")]
     fig.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.685, 0.56), fontsize=8.5, frameon=False)
 
-    _save_atomically(fig, out)
+    save_figure(fig, out, dpi=None)
     return out
 
-
-def _save_atomically(fig: Figure, out: Path) -> None:
-    # Write beside the target and rename, so a reader never sees a half-written PNG.
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent or ".")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            fig.savefig(f, format="png")
-        os.replace(tmp, out)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise

@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from .results import save_figure  # noqa: E402
+from ..io import new_figure, save_figure
+from ..reference import load_reference
 
 __all__ = ["plot_validation_figures"]
 
@@ -23,15 +20,25 @@ def _ends_against_time(ax, res, title):
     ax.grid(alpha=0.3)
 
 
-def plot_validation_figures(vr, out) -> list:
-    """Write fig07 … fig14 PNGs for the cases present in ``vr``; returns their paths."""
-    from ..validate import load_reference
-    ref = load_reference()
+def plot_validation_figures(vr, out, ref: dict | None = None) -> list:
+    """Write fig07 … fig14 PNGs for the cases present in ``vr``; returns their paths.
+
+    Parameters
+    ----------
+    vr : exucable.validate.ValidationRun
+        Its ``runs`` (case → result) and ``sweep_rows`` (Fig. 12).
+    out : pathlib.Path
+        Directory to write into.
+    ref : dict, optional
+        Reference values as :func:`exucable.reference.load_reference` returns them (read if not given).
+    """
+    ref = load_reference() if ref is None else ref
     written = []
     r = vr.runs.get("Ex. 1")
     if r is not None:
-        fig, ax = plt.subplots(figsize=(7, 4))
-        x = np.asarray(r.tension_profile["s_m"])
+        fig = new_figure(figsize=(7, 4))
+        ax = fig.subplots()
+        x = np.asarray(r.tension_profile["x_m"])
         ax.plot(x, r.tension_profile["tension_N"], ".", ms=3, label="exucable")
         xs = np.linspace(0, x.max(), 50)
         ax.plot(xs, ref["example1"]["tension_slope_N_per_m"] * xs, "k-", lw=1, label="Eq. 25")
@@ -40,7 +47,7 @@ def plot_validation_figures(vr, out) -> list:
         ax.set_title("Fig. 7: tension along the 30° incline (Example 1)")
         ax.grid(alpha=0.3)
         ax.legend()
-        save_figure(fig, out / "fig07_ex1_tension_along_incline.png")
+        save_figure(fig, out / "fig07_ex1_tension_along_incline.png", bbox_inches="tight")
         written.append(out / "fig07_ex1_tension_along_incline.png")
     for case, name, title, refline in (
             ("Ex. 2", "fig09_ex2_end_tensions.png", "Fig. 9: end tensions, 90° bend (Example 2)",
@@ -50,11 +57,12 @@ def plot_validation_figures(vr, out) -> list:
         r = vr.runs.get(case)
         if r is None:
             continue
-        fig, ax = plt.subplots(figsize=(7, 4))
+        fig = new_figure(figsize=(7, 4))
+        ax = fig.subplots()
         _ends_against_time(ax, r, title)
         ax.axhline(refline[1], color="k", ls="--", lw=1, label=f"{refline[0]} {refline[1]:.5g} N")
         ax.legend(fontsize=8)
-        save_figure(fig, out / name)
+        save_figure(fig, out / name, bbox_inches="tight")
         written.append(out / name)
     if vr.sweep_rows:
         key = next(k for k in vr.sweep_rows[0] if k.endswith("helix_turns"))
@@ -62,7 +70,8 @@ def plot_validation_figures(vr, out) -> list:
         F = np.array([float(row["pull_force_N"]) if row.get("status") in ("ok", "steady") else np.nan
                       for row in vr.sweep_rows])
         order = np.argsort(n)
-        fig, ax = plt.subplots(figsize=(7, 4))
+        fig = new_figure(figsize=(7, 4))
+        ax = fig.subplots()
         nn = np.linspace(0.5, n.max() + 0.5, 100)
         coils = np.asarray(ref["fig12"]["coils"], dtype=float)
         law = np.asarray(ref["fig12"]["pull_force_N"], dtype=float)
@@ -75,11 +84,12 @@ def plot_validation_figures(vr, out) -> list:
         ax.set_title("Fig. 12: pulling force against coils (T2 = 10 N, μ = 0.1)")
         ax.grid(alpha=0.3, which="both")
         ax.legend()
-        save_figure(fig, out / "fig12_coils.png")
+        save_figure(fig, out / "fig12_coils.png", bbox_inches="tight")
         written.append(out / "fig12_coils.png")
     r = vr.runs.get("Ex. 4")
     if r is not None:
-        fig, ax = plt.subplots(figsize=(7, 4))
+        fig = new_figure(figsize=(7, 4))
+        ax = fig.subplots()
         h = r.history
         ax.plot(h["time_s"], h["pull_force_N"], label="exucable")
         rope = r.summary.get("rope_pull_force_N")
@@ -90,6 +100,6 @@ def plot_validation_figures(vr, out) -> list:
         ax.set_title("Fig. 14: pulling force, spatial conduit (Example 4)")
         ax.grid(alpha=0.3)
         ax.legend()
-        save_figure(fig, out / "fig14_ex4_pull_force.png")
+        save_figure(fig, out / "fig14_ex4_pull_force.png", bbox_inches="tight")
         written.append(out / "fig14_ex4_pull_force.png")
     return written

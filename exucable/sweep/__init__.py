@@ -10,15 +10,14 @@ Dask distributed cluster (``--scheduler tcp://HOST:PORT``), each case in its own
 Modules: :mod:`~exucable.sweep.dotted` (dotted keys), :mod:`~exucable.sweep.spec` (sweep files),
 :mod:`~exucable.sweep.store` (the directory), :mod:`~exucable.sweep.worker` (one case),
 :mod:`~exucable.sweep.execute` (pool/Dask), :mod:`~exucable.sweep.plot`,
-:mod:`~exucable.sweep.progress`, :mod:`~exucable.sweep.command` (CLI).
+:mod:`~exucable.sweep.progress`; the command line is :mod:`exucable.commands.sweep`.
 """
 
-from .command import add_arguments, main
 from .execute import default_workers, plan, run_sweep, worker_context
 from .spec import Case, Sweep, load_sweep, parse_sweep, scenario_hash
 from .store import read_table, rows_from_disk
 
 __all__ = [
     "Case", "Sweep", "load_sweep", "parse_sweep", "scenario_hash", "run_sweep", "plan",
-    "default_workers", "worker_context", "read_table", "rows_from_disk", "add_arguments", "main",
+    "default_workers", "worker_context", "read_table", "rows_from_disk",
 ]

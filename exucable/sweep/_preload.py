@@ -5,14 +5,10 @@ from this clean, import-only state, never from one that has run a model.
 """
 
 try:  # a failed import only costs start-up time in the workers; it must not kill the forkserver
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import exudyn  # noqa: F401
-
+    import matplotlib.backends.backend_agg  # noqa: F401  (figures use their own Agg canvas)
     import exucable.contact  # noqa: F401  (numba, imported lazily by model building)
     import exucable.contact.fast  # noqa: F401
-    import exucable.model.build  # noqa: F401
+    import exucable.model.build  # noqa: F401  (and Exudyn with it)
     import exucable.plots.results  # noqa: F401
     import exucable.run  # noqa: F401
     import exucable.sweep.worker  # noqa: F401

@@ -30,6 +30,7 @@ import multiprocessing
 import os
 import sys
 import uuid
+import warnings
 from pathlib import Path
 
 from ..errors import ExucableError
@@ -179,7 +180,7 @@ def _run_sweep(sweep, out: Path, workers, client, retry_failed, quiet, plots, ru
                 from .plot import plot_sweep
                 plot_sweep(out / PLOT, rows(), keys, sweep.output, sweep.mode, title=sweep.name)
             except Exception as exc:  # a figure must not hide the run's outcome
-                print(f"exucable sweep: warning: {PLOT} not written: {type(exc).__name__}: {exc}", file=sys.stderr)
+                warnings.warn(f"{PLOT} not written: {type(exc).__name__}: {exc}", RuntimeWarning, stacklevel=2)
         return rows()
 
 

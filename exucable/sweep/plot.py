@@ -7,13 +7,10 @@ import json
 import math
 import numbers
 
-import matplotlib
+from matplotlib import rcParams
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from ..plots.results import save_figure  # noqa: E402
-from .spec import OUTPUTS  # noqa: E402
+from ..io import new_figure, save_figure
+from .spec import OUTPUTS
 
 __all__ = ["plot_sweep"]
 
@@ -61,8 +58,9 @@ def plot_sweep(path, rows: list[dict], keys, output: str = "pull_force_N", mode:
         label = "" if (mode == "zip" or not others) else ", ".join(f"{k} = {json.dumps(r[k])}" for k in others)
         groups.setdefault(label, []).append(r)
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = new_figure(figsize=(7.5, 4.5))
+    ax = fig.subplots()
+    colours = rcParams["axes.prop_cycle"].by_key()["color"]
     missing_x = []
     for n, (label, grp) in enumerate(groups.items()):
         c = colours[n % len(colours)]
@@ -90,4 +88,4 @@ def plot_sweep(path, rows: list[dict], keys, output: str = "pull_force_N", mode:
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=8)
-    save_figure(fig, path)
+    save_figure(fig, path, bbox_inches="tight")

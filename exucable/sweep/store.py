@@ -25,7 +25,7 @@ import shutil
 from pathlib import Path
 
 from ..errors import ExucableError
-from ..results import atomic_write_text
+from ..io import atomic_write_text
 
 __all__ = [
     "CASES_DIR", "CASE_JSON", "MANIFEST", "TABLE", "FINISHED", "RESULT_COLUMNS", "RECORD_OUTPUTS",

@@ -28,7 +28,7 @@ import traceback
 from pathlib import Path
 
 from .. import __version__
-from ..results import atomic_write_bytes, atomic_write_text
+from ..io import atomic_write_bytes, atomic_write_text
 from ..scenario import parse_scenario
 from .store import (CASE_JSON, RECORD_OUTPUTS, install_case, is_finished, read_record, temp_dir,
                     write_record)

@@ -9,9 +9,10 @@ import sys
 from pathlib import Path
 
 from ..errors import ExucableError
-from .execute import PLOT, plan, run_sweep
-from .spec import load_sweep
-from .store import TABLE, _extra_columns, is_finished, make_row, table_columns, write_table
+from ..sweep.execute import PLOT, plan, run_sweep
+from ..sweep.plot import plot_sweep
+from ..sweep.spec import OUTPUTS, load_sweep
+from ..sweep.store import TABLE, _extra_columns, is_finished, make_row, table_columns, write_table
 
 __all__ = ["add_arguments", "main", "load_runner"]
 
@@ -76,8 +77,6 @@ def _print_table(rows, keys, output: str, rope_key: str | None) -> None:
 
 
 def main(args) -> int:
-    from .spec import OUTPUTS
-
     sweep = load_sweep(args.sweep)
     out_dir = Path(args.out) if args.out else Path("out") / sweep.name
     rope_key = OUTPUTS.get(sweep.output)
@@ -92,7 +91,6 @@ def main(args) -> int:
             if not out_dir.is_dir():
                 raise ExucableError(f"--collect: {out_dir} does not exist")
             write_table(out_dir / TABLE, rows, table_columns(sweep.keys, sweep.output))
-            from .plot import plot_sweep
             plot_sweep(out_dir / PLOT, rows, sweep.keys, sweep.output, sweep.mode, title=sweep.name)
             print(f"{sweep.name}: {out_dir / TABLE} and {out_dir / PLOT} rebuilt from {n} case(s) on disk")
         else:

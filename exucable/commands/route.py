@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .scenario import load_scenario
+from ..plots.route import plot_route, route_table
+from ..scenario import load_scenario
 
 __all__ = ["add_arguments", "main"]
 
@@ -15,8 +16,6 @@ def add_arguments(p) -> None:
 
 
 def main(args) -> int:
-    from .plots.route import plot_route, route_table
-
     sc = load_scenario(args.scenario)
     conduit = sc.build_conduit()
     out = Path(args.out) if args.out else Path(f"{sc.name}_route.png")

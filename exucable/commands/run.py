@@ -1,0 +1,61 @@
+"""``exucable run``: simulate one scenario and write its results."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..run import run_scenario
+from ..scenario import load_scenario
+
+__all__ = ["add_arguments", "main"]
+
+
+def add_arguments(p) -> None:
+    p.add_argument("scenario", help="scenario file (TOML)")
+    p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    p.add_argument("--mode", choices=("dynamic", "steady"), default=None,
+                   help="dynamic time integration or one static solve of steady sliding "
+                        "(overrides solver.mode)")
+    p.add_argument("--steady-stop", dest="steady_stop", action="store_true", default=None,
+                   help="stop once the pulling force is steady (overrides solver.steady_stop)")
+    p.add_argument("--no-steady-stop", dest="steady_stop", action="store_false",
+                   help="run to solver.end_time whatever the pulling force does")
+
+
+def _f(value, fmt=".6g") -> str:
+    return "n/a" if value is None or not np.isfinite(value) else format(value, fmt)
+
+
+def main(args) -> int:
+    sc = load_scenario(args.scenario)
+    out_dir = Path(args.out) if args.out else Path("out") / sc.name
+    res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
+                       mode=args.mode)
+    s = res.summary
+    rope = s.get("rope_pull_force_N")
+    print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
+          f"(± {_f(s['pull_force_std_N'], '.2g')}), trailing tension {_f(s['trailing_tension_N'])} N, "
+          f"max tension {_f(s['max_tension_N'])} N")
+    if s["steady_quantity"] == "trailing_tension_N":     # force-controlled: T2 is the result
+        ref, got, what = s.get("rope_trailing_tension_N"), s["trailing_tension_N"], "trailing tension"
+    else:
+        ref, got, what = rope, s["pull_force_N"], "pulling force"
+    if ref is not None and got is not None and np.isfinite(got):
+        print(f"  rope reference: {what} {ref:.6g} N ({100 * (got / ref - 1):+.3f} %)")
+    if s.get("mode") == "steady":
+        print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    else:
+        print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    print(f"  results in {out_dir}/")
+    if s["status"] == "failed":
+        print(f"  FAILED: {s['message']} (at t = {_f(s.get('failed_at_s'))} s); "
+              f"the results recorded until then are in {out_dir}/", file=sys.stderr)
+        return 1
+    return 0

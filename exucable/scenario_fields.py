@@ -1,0 +1,339 @@
+"""The one table of scenario keys: TOML key, dataclass attribute, unit, default, check, rule.
+
+Every key of a scenario is one :class:`Field` row in :data:`FIELDS`. The row drives
+
+- the TOML parser and the Python constructors (:mod:`exucable.scenario`): type, bounds,
+  default, the dotted key and unit in every error message;
+- ``to_dict`` of each spec dataclass (the TOML name of each attribute);
+- the key tables of ``scenarios/README.md``: :func:`markdown_table` renders them and a test
+  checks the README against it (``python -m exucable.scenario_fields`` rewrites them).
+
+To add a key: add a row here, the attribute to the section's dataclass, and rerun
+``python -m exucable.scenario_fields`` to update the README. Cross-field rules (e.g.
+``static_friction >= friction``) live in the dataclass's ``_check`` method; keys whose value is
+not a scalar (the conduit route) are ``kind="custom"`` and parsed by hand.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+__all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "markdown_table", "format_default",
+           "readme_with_tables"]
+
+
+class _Required:
+    """Sentinel: the key has no default."""
+
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+REQUIRED: Any = _Required()
+
+#: Sections in file order; "" is the top level.
+SECTIONS = ("", "cable", "conduit", "contact", "pull", "gravity", "solver", "output")
+
+#: Heading of each section's key table in scenarios/README.md.
+SECTION_HEADINGS = {
+    "": "## Top level",
+    "cable": "## `[cable]` (paper Sect. 2.2)",
+    "conduit": "## `[conduit]` (paper Sect. 2.3)",
+    "contact": "## `[contact]` (optional; paper Sect. 2.4–2.5, Eqs. 17–23)",
+    "pull": "## `[pull]` (paper Sect. 2.1, Eq. 1)",
+    "gravity": "## `[gravity]` (optional; absent = no gravity)",
+    "solver": "## `[solver]`",
+    "output": "## `[output]` (optional; snapshots, see docs/results-format.md)",
+}
+
+
+@dataclass(frozen=True)
+class Field:
+    """One scenario key.
+
+    Attributes
+    ----------
+    key : str
+        Dotted TOML key, e.g. ``"pull.speed"`` (top-level keys have no dot).
+    attr : str
+        Attribute of the section's dataclass, with its unit, e.g. ``"speed_m_per_s"``.
+    kind : str
+        ``"float"``, ``"int"``, ``"bool"``, ``"str"``, ``"choice"``, ``"vector3"`` or ``"custom"``
+        (parsed by hand; only documented here).
+    unit : str
+        Unit as written in error messages (ASCII, e.g. ``"kg/m^3"``); ``""`` for none.
+    default : Any
+        The default value, ``None`` (absent: the key is optional and has no value), or
+        :data:`REQUIRED`. A *derived* default (``derived=True``) is ``None`` here and computed
+        by the dataclass from other values.
+    rule : str
+        The README's "rule" column (Markdown).
+    default_doc : str
+        The README's "default" column when the default is not a plain value ("" = render
+        :attr:`default`).
+    unit_doc : str
+        The README's unit when it differs from :attr:`unit` (e.g. ``"kg/m³"``).
+    gt, ge, lt, le : float or None
+        Bounds checked for numbers.
+    choices : tuple of str
+        Allowed strings for ``kind="choice"``.
+    ours : bool
+        The key is not in the paper (marked *ours* in the README).
+    derived : bool
+        The default is computed from other values (so ``Scenario.replace`` re-derives it).
+    nonzero : bool
+        For ``vector3``: refuse [0, 0, 0].
+    """
+
+    key: str
+    attr: str
+    kind: str
+    unit: str = ""
+    default: Any = REQUIRED
+    rule: str = ""
+    default_doc: str = ""
+    unit_doc: str | None = None
+    gt: float | None = None
+    ge: float | None = None
+    lt: float | None = None
+    le: float | None = None
+    choices: tuple[str, ...] = ()
+    ours: bool = False
+    derived: bool = False
+    nonzero: bool = False
+
+    @property
+    def section(self) -> str:
+        """The table the key is in (``""`` for the top level)."""
+        return self.key.rpartition(".")[0]
+
+    @property
+    def name(self) -> str:
+        """The key inside its table."""
+        return self.key.rpartition(".")[2]
+
+    @property
+    def bounds(self) -> dict:
+        """The non-None bounds as keyword arguments."""
+        return {k: v for k, v in (("gt", self.gt), ("ge", self.ge), ("lt", self.lt), ("le", self.le))
+                if v is not None}
+
+    @property
+    def readme_unit(self) -> str:
+        return self.unit if self.unit_doc is None else self.unit_doc
+
+
+F = Field
+# Kelvin-Voigt retardation time [s]: damps the element-scale axial modes of the paper's
+# cables (omega ~ 1e3..1e4 rad/s -> damping ratio tau*omega/2 ~ 0.5..5) while the
+# steady-state damping force tau*EA*d(eps)/dt stays negligible (material strain rate is tiny).
+_DAMPING_TIME_S = 1.0e-3
+
+FIELDS: tuple[Field, ...] = (
+    # ---- top level
+    F("name", "name", "str", default=None, derived=True, default_doc="file stem", rule="non-empty string"),
+    F("description", "description", "str", default="", rule="string"),
+    # ---- cable (paper Sect. 2.2)
+    F("cable.radius", "radius_m", "float", "m", gt=0.0, rule="> 0"),
+    F("cable.density", "density_kg_per_m3", "float", "kg/m^3", None, unit_doc="kg/m³", gt=0.0, default_doc="—",
+      rule="> 0; give exactly one of `density`, `mass_per_length`"),
+    F("cable.mass_per_length", "mass_per_length_kg_per_m", "float", "kg/m", None, gt=0.0, default_doc="—",
+      rule="> 0"),
+    F("cable.youngs_modulus", "youngs_modulus_Pa", "float", "Pa", gt=0.0, rule="> 0"),
+    F("cable.elements", "elements", "int", "", None, ge=1, derived=True,
+      default_doc="max(10, ⌈L·κ_max / 0.25⌉)",
+      rule="integer ≥ 1; default: each element turns at most 0.25 rad on the tightest bend "
+           "(L cable length, κ_max the route's largest curvature), at least 10"),
+    F("cable.length", "length_m", "float", "m", None, gt=0.0, default_doc="conduit centreline length",
+      rule="> 0 and ≤ the conduit centreline length"),
+    F("cable.damping_time", "damping_time_s", "float", "s", _DAMPING_TIME_S, ge=0.0, ours=True,
+      rule="≥ 0; Kelvin–Voigt τ: axial damping τ·EA [N s], bending damping τ·EJ [N m² s]"),
+    F("cable.integration", "integration", "choice", "", "lobatto", choices=("lobatto", "reduced", "full"),
+      ours=True,
+      rule="Exudyn's quadrature of the element forces: `\"lobatto\"`, `\"reduced\"`, `\"full\"` "
+           "(useReducedOrderIntegration 2, 1, 0); full quadrature lets coarse elements on curves carry a "
+           "saw-tooth of axial force"),
+    # ---- conduit (paper Sect. 2.3)
+    F("conduit.inner_radius", "inner_radius_m", "float", "m", gt=0.0, rule="> `cable.radius`"),
+    F("conduit.start", "start_m", "vector3", "m", (0.0, 0.0, 0.0), rule="3 numbers; path routes only"),
+    F("conduit.heading", "heading", "vector3", "", (1.0, 0.0, 0.0), nonzero=True,
+      rule="3 numbers, nonzero; path routes only"),
+    F("conduit.max_segment_angle", "max_segment_angle_deg", "float", "deg", 1.0, gt=0.0, le=45.0,
+      rule="0 < a ≤ 45: turning per straight segment on curved parts"),
+    F("conduit.segments_per_bend", "segments_per_bend", "int", "", None, ge=1, default_doc="—",
+      rule="integer ≥ 1 segments per bend/helix/fillet; not with `max_segment_angle`"),
+    F("conduit.path", "path", "custom", "", None, default_doc="—",
+      rule="array of pieces (below); exactly one of `path`, `points`, `points_csv`"),
+    F("conduit.points", "points_m", "custom", "m", None, default_doc="—",
+      rule="array of ≥ 2 points `[x, y, z]` (survey polyline; interior vertices filleted)"),
+    F("conduit.points_csv", "points_csv", "custom", "", None, default_doc="—",
+      rule="CSV file relative to the scenario file; header `x,y,z` or `x,y,z,bend_radius`"),
+    F("conduit.bend_radius", "bend_radius_m", "custom", "m", None, default_doc="CSV column",
+      rule="one number or one per interior vertex, each > `inner_radius`; required with `points`, and with "
+           "`points_csv` unless the CSV has a `bend_radius` column (the scenario's value wins)"),
+    # ---- contact (paper Sect. 2.4-2.5, Eqs. 17-23)
+    F("contact.stiffness", "stiffness", "float", "N/m^exponent", 1.0e6, gt=0.0, rule="> 0"),
+    F("contact.damping", "damping", "float", "N s/m", 1.0e3, ge=0.0, rule="≥ 0"),
+    F("contact.exponent", "exponent", "float", "", 1.5, ge=1.0, rule="≥ 1"),
+    F("contact.friction", "friction", "float", "", 0.0, ge=0.0, rule="≥ 0 (kinetic μ)"),
+    F("contact.static_friction", "static_friction", "float", "", None, ge=0.0, ours=True, default_doc="none",
+      rule="≥ `friction`"),
+    F("contact.stribeck_velocity", "stribeck_velocity_m_per_s", "float", "m/s", 0.01, gt=0.0, ours=True,
+      rule="> 0"),
+    F("contact.friction_regularisation_velocity", "friction_regularisation_velocity_m_per_s", "float", "m/s",
+      1.0e-3, gt=0.0, ours=True, rule="> 0"),
+    F("contact.check_points_per_element", "check_points_per_element", "int", "", 20, ge=1,
+      rule="integer ≥ 1"),
+    F("contact.check_point_rule", "check_point_rule", "choice", "", "gauss", choices=("gauss", "uniform"),
+      ours=True, rule="`\"gauss\"` or `\"uniform\"`"),
+    F("contact.reference_spacing", "reference_spacing_m", "float", "m", 1.0e-3, gt=0.0, ours=True,
+      rule="> 0; each check point's force is scaled by its share of the element length / this"),
+    F("contact.broad_phase", "broad_phase", "choice", "", "aabb", choices=("aabb", "none"),
+      rule="`\"aabb\"` or `\"none\"`"),
+    F("contact.damping_onset", "damping_onset_m", "float", "m", 1.0e-5, ge=0.0, ours=True,
+      rule="≥ 0: penetration over which the damping term grows from 0, f_n = Kδ^e + C·min(δ/δ_d, 1)·δ̇; 0 is "
+           "the paper's Eq. 18, whose damping force jumps to C·δ̇ at first touch (each touch then cuts the "
+           "step: Example 4 took 7745 steps per 0.03 s with 0, 90 with 1e-5)"),
+    F("contact.surface", "surface", "choice", "", "smooth", choices=("smooth", "segments"), ours=True,
+      rule="`\"smooth\"`: closest points on the exact bends/helices (the segments still do the search); "
+           "`\"segments\"`: on the straight segments, as the paper (Sect. 2.3)"),
+    # ---- pull (paper Sect. 2.1, Eq. 1)
+    F("pull.speed", "speed_m_per_s", "float", "m/s", gt=0.0, rule="> 0"),
+    F("pull.direction", "direction", "choice", "", "forward", choices=("forward", "reverse"),
+      rule="`\"forward\"` (out at the end of the route) or `\"reverse\"`"),
+    F("pull.back_tension", "back_tension_N", "float", "N", 0.0, ge=0.0,
+      rule="≥ 0, at the trailing end along the conduit tangent"),
+    F("pull.force", "force_N", "float", "N", None, gt=0.0, default_doc="none",
+      rule="> 0: prescribed pulling force (force-controlled pull, Example 3); not with a nonzero "
+           "`back_tension`"),
+    F("pull.ramp_time", "ramp_time_s", "float", "s", 0.0, ge=0.0, ours=True,
+      rule="≥ 0: time over which speed/loads ramp up from the start state"),
+    # ---- gravity
+    F("gravity.g", "g_m_per_s2", "float", "m/s^2", unit_doc="m/s²", ge=0.0,
+      default_doc="required if the table is present", rule="≥ 0, acting along −z"),
+    # ---- solver
+    F("solver.end_time", "end_time_s", "float", "s", gt=0.0, rule="> 0"),
+    F("solver.step", "step_s", "float", "s", 1.0e-2, gt=0.0,
+      rule="> 0 (initial and maximum step; the adaptive controller cuts it where needed)"),
+    F("solver.min_step", "min_step_s", "float", "s", None, gt=0.0, ours=True, derived=True,
+      default_doc="min(1e-8, step)", rule="0 < min_step ≤ step"),
+    F("solver.spectral_radius", "spectral_radius", "float", "", 0.5, ge=0.0, le=1.0, ours=True,
+      rule="generalized-α ρ∞ in [0, 1]"),
+    # 12 iterations and 1e-7: measured on Example 2, 735 -> 155 steps at the same pulling
+    # force (within 0.02 %) as 8 and 1e-8 (exudyn-findings had 8 with a different start)
+    F("solver.newton_max_iterations", "newton_max_iterations", "int", "", 12, ge=1, ours=True,
+      rule="integer ≥ 1"),
+    F("solver.newton_tolerance", "newton_tolerance", "float", "", 1.0e-7, gt=0.0, lt=1.0, ours=True,
+      rule="0 < tol < 1: relative tolerance of Newton's residual"),
+    F("solver.startup_time", "startup_time_s", "float", "s", 0.05, ge=0.0, ours=True,
+      rule="≥ 0: a mass-proportional damper toward the start's sliding velocities settles the pre-tensioned "
+           "start and fades out over this time; the steady state is looked for after it"),
+    F("solver.startup_damping", "startup_damping_1_per_s", "float", "1/s", 200.0, ge=0.0, ours=True,
+      rule="≥ 0: its initial rate"),
+    F("solver.output_interval", "output_interval_s", "float", "s", None, gt=0.0, ours=True, derived=True,
+      default_doc="max(step, end_time/1000)", rule="> 0"),
+    F("solver.steady_stop", "steady_stop", "bool", "", False, ours=True,
+      rule="stop once the pulling force is steady"),
+    F("solver.steady_window", "steady_window_s", "float", "s", 0.2, gt=0.0, ours=True, rule="> 0"),
+    F("solver.steady_tolerance", "steady_tolerance", "float", "", 1.0e-3, gt=0.0, ours=True,
+      rule="> 0, relative drift/scatter bound"),
+    F("solver.pretension", "pretension", "bool", "", True, ours=True,
+      rule="start from the rope solution's tension profile near contact equilibrium"),
+    F("solver.mode", "mode", "choice", "", "dynamic", choices=("dynamic", "steady"), ours=True,
+      rule="`\"dynamic\"`: integrate the dynamics in time (paper Sect. 2.6); `\"steady\"`: one static solve "
+           "of the steady sliding state (friction along the cable's tangent, no start-up, no time history; "
+           "needs `solver.pretension = true`); the `solver` time keys are then unused"),
+    # ---- output
+    F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
+      rule="array of times in [0, `solver.end_time`]: the whole state is written at each "
+           "(interpolated between solver steps)"),
+    F("output.snapshot_interval", "snapshot_interval_s", "float", "s", None, gt=0.0, ours=True,
+      default_doc="none", rule="> 0: also a snapshot at every multiple of it up to `solver.end_time`"),
+)
+del F
+
+
+def fields_of(section: str) -> tuple[Field, ...]:
+    """The rows of one table (``""`` for the top level), in file order."""
+    return tuple(f for f in FIELDS if f.section == section)
+
+
+def format_default(value) -> str:
+    """A default as the README writes it: ``1e-3``, ``0.5``, ``"gauss"``, ``false``, ``[0, 0, 0]``."""
+    if isinstance(value, bool):
+        return f"`{str(value).lower()}`"
+    if isinstance(value, str):
+        return f'`"{value}"`'
+    if isinstance(value, tuple):
+        return "`[" + ", ".join(format_default(v).strip("`") for v in value) + "]`"
+    if isinstance(value, float) and value != 0.0 and not (1e-2 <= abs(value) < 1e3):
+        mantissa, exponent = f"{value:e}".split("e")
+        mantissa = mantissa.rstrip("0").rstrip(".")
+        return f"{mantissa}e{int(exponent)}"
+    return f"{value:g}"
+
+
+def _default_cell(f: Field) -> str:
+    if f.default_doc:
+        return f.default_doc
+    if f.default is REQUIRED:
+        return "required"
+    if f.default is None:
+        return "none"
+    return format_default(f.default)
+
+
+def markdown_table(section: str) -> str:
+    """The README key table of one section, rendered from :data:`FIELDS`."""
+    lines = ["| key | unit | default | rule |", "| --- | --- | --- | --- |"]
+    for f in fields_of(section):
+        key = f"`{f.name}`" + (" (*ours*)" if f.ours else "")
+        cells = (key, f.readme_unit, _default_cell(f), f.rule)
+        lines.append("|" + "|".join(f" {c} " if c else " " for c in cells) + "|")
+    return "\n".join(lines)
+
+
+_TABLE = re.compile(r"\| key \| unit \| default \| rule \|\n(?:\|.*\|\n?)*")
+
+
+def readme_with_tables(text: str) -> str:
+    """``text`` (scenarios/README.md) with the key table under each section heading regenerated.
+
+    Raises
+    ------
+    ValueError
+        If a section's heading or key table is missing.
+    """
+    for section in SECTIONS:
+        heading = SECTION_HEADINGS[section]
+        at = text.find(heading + "\n")
+        if at < 0:
+            raise ValueError(f"scenarios/README.md has no heading {heading!r}")
+        m = _TABLE.search(text, at)
+        if m is None:
+            raise ValueError(f"scenarios/README.md has no key table under {heading!r}")
+        end_newline = "\n" if m.group(0).endswith("\n") else ""
+        text = text[: m.start()] + markdown_table(section) + end_newline + text[m.end():]
+    return text
+
+
+def main(argv=None) -> int:
+    """Rewrite the key tables of scenarios/README.md from :data:`FIELDS` (a developer tool)."""
+    argv = sys.argv[1:] if argv is None else argv
+    path = Path(argv[0]) if argv else Path(__file__).resolve().parent.parent / "scenarios" / "README.md"
+    old = path.read_text(encoding="utf-8")
+    new = readme_with_tables(old)
+    if new != old:
+        path.write_text(new, encoding="utf-8")
+        print(f"updated the key tables of {path}")
+    else:
+        print(f"{path} is up to date")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,242 @@
+"""The house rules, checked: no import cycles inside the package (lazy imports count too), only
+``model/`` and ``solve*`` import Exudyn, no module changes matplotlib's backend, no absolute paths
+of a development machine in the repository."""
+
+from __future__ import annotations
+
+import ast
+import os
+import re
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "exucable"
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _modules() -> dict[str, Path]:
+    return {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def _is_package(name: str, modules: dict[str, Path]) -> bool:
+    return modules[name].name == "__init__.py"
+
+
+def _imports(name: str, modules: dict[str, Path]) -> set[str]:
+    """exucable modules that module ``name`` imports anywhere (top level or inside a function)."""
+    tree = ast.parse(modules[name].read_text(encoding="utf-8"))
+    package = name if _is_package(name, modules) else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[:len(base) - (node.level - 1)]
+                stem = ".".join(base + ([node.module] if node.module else []))
+            else:
+                stem = node.module or ""
+            # `from pkg import sub` imports the module pkg.sub when there is one
+            targets = [stem] + [f"{stem}.{alias.name}" for alias in node.names]
+        else:
+            continue
+        found.update(t for t in targets if t in modules and t != name)
+    return found
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan)."""
+    index, low, stack, on_stack, result = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                result.append(sorted(component))
+
+    for v in graph:
+        if v not in index:
+            visit(v)
+    return result
+
+
+def test_the_import_graph_is_read():
+    modules = _modules()
+    graph = {m: _imports(m, modules) for m in modules}
+    # known edges, one relative and one lazy (inside a function), so that the cycle test below
+    # cannot pass by reading nothing
+    assert "exucable.io" in graph["exucable.results"]
+    assert "exucable.run" in graph["exucable.sweep.worker"]
+    assert "exucable.model.build" in graph["exucable.run"]
+
+
+def test_no_import_cycles_inside_the_package():
+    modules = _modules()
+    graph = {m: _imports(m, modules) for m in modules}
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]  # the detector works
+    assert _cycles(graph) == [], "import cycles (lazy imports count)"
+
+
+# Modules that may import Exudyn: the model layer and the solver driving it.
+EXUDYN_ALLOWED = re.compile(r"^exucable\.(model(\..+)?|solve\w*)$")
+
+
+def test_only_model_and_solve_import_exudyn_directly():
+    offenders = []
+    for name, path in _modules().items():
+        if EXUDYN_ALLOWED.match(name):
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                     else [node.module or ""] if isinstance(node, ast.ImportFrom) and not node.level else [])
+            if any(n == "exudyn" or n.startswith("exudyn.") for n in names):
+                offenders.append(f"{name} (line {node.lineno})")
+    assert offenders == []
+
+
+def _exudyn_free_modules() -> list[str]:
+    """Modules that must import with Exudyn absent: all but model/, solve*, and those importing them
+    at module level (run, commands that run models, the sweep's worker preload)."""
+    modules = _modules()
+    top_level = {}
+    for name, path in modules.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        package = name if _is_package(name, modules) else name.rpartition(".")[0]
+        deps = set()
+        for node in tree.body:  # module level only: lazy imports inside functions are allowed
+            if isinstance(node, ast.ImportFrom):
+                base = package.split(".")[:len(package.split(".")) - (node.level - 1)] if node.level else []
+                stem = ".".join(base + ([node.module] if node.module else [])) if node.level else node.module
+                deps.update(t for t in [stem] + [f"{stem}.{a.name}" for a in node.names] if t in modules)
+            elif isinstance(node, ast.Import):
+                deps.update(a.name for a in node.names if a.name in modules)
+        top_level[name] = deps
+    needs = {m for m in modules if EXUDYN_ALLOWED.match(m) or m == "exucable.sweep._preload"}
+    changed = True
+    while changed:
+        changed = False
+        for m, deps in top_level.items():
+            if m not in needs and deps & needs:
+                needs.add(m)
+                changed = True
+    return sorted(set(modules) - needs - {"exucable.__main__"})  # __main__ runs the command
+
+
+def test_exudyn_free_modules_import_with_exudyn_blocked():
+    free = _exudyn_free_modules()
+    for expected in ("exucable.geometry", "exucable.contact", "exucable.contact.fast", "exucable.rope",
+                     "exucable.closed_forms", "exucable.scenario", "exucable.tension", "exucable.results",
+                     "exucable.io", "exucable.reference", "exucable.plots.route", "exucable.compare",
+                     "exucable.validate", "exucable.sweep"):
+        assert expected in free, f"{expected} should not need Exudyn at import"
+    script = textwrap.dedent(f"""
+        import importlib, sys
+        class Block:
+            def find_spec(self, name, path=None, target=None):
+                if name == "exudyn" or name.startswith("exudyn."):
+                    raise ImportError("exudyn is blocked in this test")
+        sys.meta_path.insert(0, Block())
+        for name in {free!r}:
+            importlib.import_module(name)
+        assert not any(m == "exudyn" or m.startswith("exudyn.") for m in sys.modules)
+        print(len({free!r}))
+    """)
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                       cwd=ROOT, env=env)
+    assert p.returncode == 0, p.stderr
+    assert int(p.stdout.strip()) == len(free) > 20
+
+
+def test_importing_exucable_keeps_the_users_matplotlib_backend():
+    script = textwrap.dedent("""
+        import matplotlib
+        matplotlib.use("svg")
+        import importlib, pkgutil, exucable
+        for m in pkgutil.walk_packages(exucable.__path__, "exucable."):
+            if not m.name.endswith("__main__"):  # that one runs the command
+                importlib.import_module(m.name)
+        print(matplotlib.get_backend())
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=180, cwd=ROOT,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip().splitlines()[-1] == "svg"
+    offenders = [str(f.relative_to(ROOT)) for f in PACKAGE.rglob("*.py") if "matplotlib.use(" in f.read_text()]
+    assert offenders == []
+
+
+def test_no_absolute_paths_of_a_development_machine():
+    try:
+        files = subprocess.run(["git", "ls-files"], capture_output=True, text=True, cwd=ROOT,
+                               check=True).stdout.split()
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("not a git checkout")
+    pattern = re.compile(r"(?<![\w.])/(work|root|home|Users)/")
+    offenders = []
+    for rel in files:
+        path = ROOT / rel
+        if path.is_symlink() or not path.is_file() or path.suffix in (".png", ".pdf"):
+            continue
+        for n, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+            if pattern.search(line) and rel != "tests/test_architecture.py":
+                offenders.append(f"{rel}:{n}: {line.strip()[:80]}")
+    assert offenders == []
+
+
+def _layout_table() -> list[str]:
+    """Paths named in the first column of the README's layout table (``exucable/x.py``, ``y.py``:
+    a bare name continues the row's first directory)."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text[text.index("## Layout"):]
+    section = section[:section.index("\n## ", 3)]
+    paths = []
+    for line in section.splitlines():
+        cells = line.split("|")
+        if len(cells) < 3 or not cells[1].strip().startswith("`"):
+            continue
+        names = re.findall(r"`([^`]+)`", cells[1])
+        first = names[0].rstrip("/")
+        base = first.rsplit("/", 1)[0] + "/" if "/" in first else ""
+        paths += [names[0]] + [n if "/" in n.rstrip("/") else base + n for n in names[1:]]
+    return paths
+
+
+def test_readme_layout_table_matches_the_tree():
+    paths = _layout_table()
+    assert len(paths) > 10
+    missing = [p for p in paths if not (ROOT / p).exists()]
+    assert missing == [], "README's layout table names paths that do not exist"
+    named = {p.rstrip("/") for p in paths}
+    unlisted = [f"exucable/{p.name}" for p in sorted(PACKAGE.iterdir())
+                if (p.suffix == ".py" and p.name != "__init__.py" or (p / "__init__.py").is_file())
+                and f"exucable/{p.name}" not in named]
+    assert unlisted == [], "modules and packages missing from README's layout table (add a row)"
