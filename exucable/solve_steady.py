@@ -37,7 +37,7 @@ import time
 import numpy as np
 import exudyn as exu
 
-from .solve import History, Progress, SolveOutcome
+from .solve import History, Progress, SolveOutcome, quiet_sparse
 from .tension import tension_at, tension_profile
 
 __all__ = ["solve_steady", "static_settings", "STATIC_TOLERANCE"]
@@ -82,12 +82,7 @@ def static_settings(tolerance: float = NEWTON_TOLERANCE, max_iterations: int = 1
     ss.newton.relativeTolerance = tolerance
     ss.newton.absoluteTolerance = absolute_tolerance_N
     ss.newton.maxIterations = int(max_iterations)
-    s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
-    s.solution.file.write = False
-    s.solution.sensors.active = False
-    s.show.computationTime = False
-    s.show.statistics = False
-    return s
+    return quiet_sparse(s)
 
 
 class PseudoTimeSpring:

@@ -32,7 +32,7 @@ from .checkpoints import hermite_unit
 from .kernel import ContactKernel
 from .reference import ReferenceKernel
 from .fast import (_JIT, _PAIRS, _J0, _PX, _PY, _PZ, _BEST, _RX, _RY, _RZ, _AX, _AY, _AZ, _BEYOND,
-                   _VX, _VY, _VZ, _FX, _accumulate_blocks, _exponent_mode, _friction, _nearest_segments,
+                   _VX, _VY, _VZ, _accumulate_blocks, _add_generalized_force, _exponent_mode, _friction, _nearest_segments,
                    _normal_force, _normals, _point_jacobians, _positions, _refine_smooth)
 from .smooth import NEWTON_ITERATIONS
 
@@ -160,22 +160,7 @@ def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, pair_t, pai
         _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
                       exponent_mode, inv_onset)
         _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
-        fxr = tab[_FX]
-        fyr = tab[_FX + 1]
-        fzr = tab[_FX + 2]
-        for a in range(4):
-            na = n1 if a == 0 else (n2 if a == 1 else (n3 if a == 2 else n4))
-            scale = le if (a == 1 or a == 3) else 1.0
-            sx = 0.0
-            sy = 0.0
-            sz = 0.0
-            for k in range(n_k):
-                sx += na[k] * fxr[k]
-                sy += na[k] * fyr[k]
-                sz += na[k] * fzr[k]
-            force[b + 3 * a] += scale * sx
-            force[b + 3 * a + 1] += scale * sy
-            force[b + 3 * a + 2] += scale * sz
+        _add_generalized_force(tab, n1, n2, n3, n4, le, b, force)
         if not jacobian:
             continue
         _point_jacobians(tab, n_k, stiffness, damping)
