@@ -53,6 +53,11 @@ NEWTON_TOLERANCE = 1e-8
 #: :class:`PseudoTimeSpring`).
 AXIAL_SHARE = 1.0
 
+#: Factor on the axial share after each converged pseudo-time step: the axial mode is linear (EA)
+#: and, on a long cable, so soft (1 km: ~1 s⁻² per unit mass) that a spring falling like the
+#: lateral one would hold it for hundreds of steps.
+AXIAL_RELEASE = 0.25
+
 #: Pseudo-time steps before the solve is declared failed.
 MAX_PSEUDO_STEPS = 80
 
@@ -111,6 +116,7 @@ class PseudoTimeSpring:
         self.block_mass[:, 0] = m_node
         self.block_mass[:, 1] = m_node * L_node**2
         self.rate = 0.0                       # c [1/s²]
+        self.axial_share = AXIAL_SHARE        # weight along the tangent [-]
         self.anchor = np.zeros(self.n)        # q̄ (displacement coordinates)
         self._proj = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
         base = 6 * np.arange(self.n_nodes)[:, None, None, None] + 3 * np.arange(2)[None, :, None, None]
@@ -133,7 +139,7 @@ class PseudoTimeSpring:
         self.anchor = np.asarray(q_disp, dtype=float).copy()
         slope = (self._q_ref + self.anchor).reshape(-1, 6)[:, 3:]
         t = slope / np.linalg.norm(slope, axis=1, keepdims=True)
-        self._proj = np.eye(3)[None] - (1.0 - AXIAL_SHARE) * t[:, :, None] * t[:, None, :]
+        self._proj = np.eye(3)[None] - (1.0 - self.axial_share) * t[:, :, None] * t[:, None, :]
 
     def force(self, q) -> np.ndarray:
         """Generalized force -c·m·P (q - q̄) [N, N·m]."""
@@ -252,6 +258,7 @@ def solve_steady(model, progress: Progress | None = None) -> SolveOutcome:
         residual is below the tolerance."""
         _set_scale(model, lam)
         c = c0
+        spring.axial_share = AXIAL_SHARE
         message = ""
         for _ in range(MAX_PSEUDO_STEPS):
             store.restore_as_initial()
@@ -279,6 +286,7 @@ def solve_steady(model, progress: Progress | None = None) -> SolveOutcome:
             if residual <= tolerance_N:
                 return True, ""
             c /= 4.0
+            spring.axial_share *= AXIAL_RELEASE
         return False, f"no equilibrium after {MAX_PSEUDO_STEPS} pseudo-time steps"
 
     status, message = "ok", ""
