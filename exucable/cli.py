@@ -22,6 +22,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "sweep": ("exucable.commands.sweep", "run a parameter sweep (local pool or Dask)"),
     "compare": ("exucable.commands.compare", "compare two result sets (yours and ours)"),
     "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
+    "plan": ("exucable.commands.plan", "plan a pull: both directions, section tables, limit checks, HTML report"),
 }
 
 

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import ModelError
 from .versions import versions
 from .export import conduit_s
 from .results import RunResult, write_results
@@ -65,6 +66,9 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
+    if sc.cable.count != 1:
+        raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
+                                        "plan several cables per duct with `exucable plan`")
     t_start = time.perf_counter()
     model = build_model(sc)
     build_s = time.perf_counter() - t_start

@@ -29,6 +29,7 @@ from dataclasses import InitVar, dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
+from exucable import engineering as _eng
 from exucable import geometry as _geo
 from exucable.errors import GeometryError, ScenarioError
 from exucable.scenario_fields import FIELDS, REQUIRED, Field, fields_of
@@ -41,6 +42,8 @@ __all__ = [
     "GravitySpec",
     "OutputSpec",
     "SolverSpec",
+    "LimitsSpec",
+    "DisplaySpec",
     "Scenario",
     "load_scenario",
     "parse_scenario",
@@ -213,6 +216,10 @@ class CableSpec(_Spec):
     integration : str
         Exudyn's quadrature of the element's internal forces: ``"lobatto"`` (default),
         ``"reduced"`` or ``"full"`` (useReducedOrderIntegration 2, 1, 0).
+    count : int
+        Identical cables of this kind in the duct (1…4; ``exucable plan`` only).
+    arrangement : str
+        ``"auto"`` or their arrangement in the duct (:data:`exucable.engineering.ARRANGEMENTS`).
     """
 
     _SECTION: ClassVar[str] = "cable"
@@ -225,8 +232,12 @@ class CableSpec(_Spec):
     length_m: float | None = _default("cable.length")
     damping_time_s: float = _default("cable.damping_time")
     integration: str = _default("cable.integration")
+    count: int = _default("cable.count")
+    arrangement: str = _default("cable.arrangement")
 
     def _check(self) -> None:
+        if self.arrangement != "auto":
+            _eng.check_arrangement(self.count, self.arrangement)
         if self.density_kg_per_m3 is None and self.mass_per_length_kg_per_m is None:
             raise ScenarioError("cable.density", "required: give density (kg/m^3) or mass_per_length (kg/m)")
         if self.density_kg_per_m3 is not None:
@@ -434,6 +445,8 @@ class PullSpec(_Spec):
         Prescribed pulling force at the pulled end [N] (force-controlled pull), or None.
     ramp_time_s : float
         Time over which speed and loads ramp up from the start state [s].
+    feed_from_reel : bool
+        ``exucable plan``: also compute the pull-in history.
     """
 
     _SECTION: ClassVar[str] = "pull"
@@ -443,6 +456,7 @@ class PullSpec(_Spec):
     back_tension_N: float = _default("pull.back_tension")
     force_N: float | None = _default("pull.force")
     ramp_time_s: float = _default("pull.ramp_time")
+    feed_from_reel: bool = _default("pull.feed_from_reel")
 
     def _check(self) -> None:
         if self.force_N is not None and self.back_tension_N != 0.0:
@@ -573,6 +587,73 @@ class SolverSpec(_Spec):
             object.__setattr__(self, "output_interval_s", max(self.step_s, self.end_time_s / 1000.0))
 
 
+@dataclass(frozen=True)
+class LimitsSpec(_Spec):
+    """The cable's installation limits, checked by ``exucable plan`` (all optional; SI).
+
+    Attributes
+    ----------
+    max_tension_N, grip_limit_N : float or None
+        Largest pulling tension given directly; rating of the pulling eye or grip [N].
+    conductor_material : str or None
+        ``"copper"`` or ``"aluminium"``; with ``conductor_area_m2`` and ``conductors`` gives the
+        conductors' tension limit (:func:`exucable.engineering.max_tension_from_conductors_N`).
+    conductor_area_m2 : float or None
+        Cross-section of one conductor [m²].
+    conductors : int or None
+        Conductors sharing the pull.
+    conductor_rule : str or None
+        ``"iec"`` or ``"us"``; None: ``"us"`` with imperial display units, else ``"iec"``.
+    max_sidewall_pressure_N_per_m : float or None
+        Largest sidewall bearing pressure [N/m].
+    min_bend_radius_multiple : float or None
+        Smallest bend radius as a multiple of the cable diameter [-].
+    min_clearance_m : float or None
+        Smallest clearance between the uppermost cable and the duct [m].
+    """
+
+    _SECTION: ClassVar[str] = "limits"
+
+    max_tension_N: float | None = _default("limits.max_tension")
+    grip_limit_N: float | None = _default("limits.grip_limit")
+    conductor_material: str | None = _default("limits.conductor_material")
+    conductor_area_m2: float | None = _default("limits.conductor_area")
+    conductors: int | None = _default("limits.conductors")
+    conductor_rule: str | None = _default("limits.conductor_rule")
+    max_sidewall_pressure_N_per_m: float | None = _default("limits.max_sidewall_pressure")
+    min_bend_radius_multiple: float | None = _default("limits.min_bend_radius_multiple")
+    min_clearance_m: float | None = _default("limits.min_clearance")
+
+    def _check(self) -> None:
+        group = ("conductor_material", "conductor_area_m2", "conductors")
+        given = [a for a in group if getattr(self, a) is not None]
+        if given and len(given) < 3:
+            missing = next(a for a in group if getattr(self, a) is None)
+            name = {"conductor_material": "conductor_material", "conductor_area_m2": "conductor_area",
+                    "conductors": "conductors"}[missing]
+            raise ScenarioError(f"limits.{name}", "the conductor limit needs conductor_material, conductor_area and "
+                                                  "conductors together")
+        if self.conductor_rule is not None and not given:
+            raise ScenarioError("limits.conductor_rule", "given without conductor_material, conductor_area and "
+                                                         "conductors")
+
+
+@dataclass(frozen=True)
+class DisplaySpec(_Spec):
+    """How numbers are read and shown.
+
+    Attributes
+    ----------
+    units : str
+        ``"si"`` or ``"imperial"``: unit system of bare numbers in the file (converted to SI when it
+        is read) and of printed tables. Results files stay SI.
+    """
+
+    _SECTION: ClassVar[str] = "display"
+
+    units: str = _default("display.units")
+
+
 def default_elements(cable_length_m: float, max_curvature_1_per_m: float) -> int:
     """The default number of cable elements: max(10, ⌈L·κ_max / 0.25⌉).
 
@@ -612,6 +693,10 @@ class Scenario:
     solver : SolverSpec
     output : OutputSpec
         Snapshot times (default: none).
+    limits : LimitsSpec
+        Installation limits checked by ``exucable plan`` (default: none).
+    display : DisplaySpec
+        Unit system of the file's bare numbers and of printed tables (default: SI).
     source_path : Path or None
         File the scenario was read from (provenance only; not compared).
     route : exucable.Route, optional
@@ -627,6 +712,8 @@ class Scenario:
     gravity: GravitySpec | None = None
     solver: SolverSpec | None = None
     output: OutputSpec = field(default_factory=OutputSpec)
+    limits: LimitsSpec = field(default_factory=LimitsSpec)
+    display: DisplaySpec = field(default_factory=DisplaySpec)
     source_path: Path | None = field(default=None, compare=False)
     route: InitVar[Any] = None
 
@@ -660,6 +747,9 @@ class Scenario:
             i = self.output.snapshots_s.index(late[0])
             raise ScenarioError(f"output.snapshots[{i}]", f"must be <= solver.end_time = "
                                 f"{self.solver.end_time_s!r} s, got {late[0]!r}")
+        for part, cls in (("limits", LimitsSpec), ("display", DisplaySpec)):
+            if not isinstance(getattr(self, part), cls):
+                raise ScenarioError(part, f"must be a {cls.__name__}, got {_describe(getattr(self, part))}")
         if self.gravity is not None and not isinstance(self.gravity, GravitySpec):
             raise ScenarioError("gravity", f"must be a GravitySpec (exucable.Gravity(...)) or None, got "
                                            f"{_describe(self.gravity)}")
@@ -668,6 +758,8 @@ class Scenario:
                 "conduit.inner_radius",
                 f"must be > the cable radius {self.cable.radius_m!r} m (cable.radius), got {self.conduit.inner_radius_m!r}",
             )
+        if self.cable.count > 1:
+            _eng.check_fit(self.cable.count, 2.0 * self.conduit.inner_radius_m, 2.0 * self.cable.radius_m)
         conduit = self.build_conduit()  # route errors surface here, keyed
         conduit_length_m = _conduit_length_m(conduit)
         # A relative tolerance absorbs float round-off when the length is written as the sum
@@ -728,6 +820,11 @@ class Scenario:
             d["gravity"] = self.gravity.to_dict()
         d["solver"] = self.solver.to_dict()
         d["output"] = self.output.to_dict()
+        d["limits"] = self.limits.to_dict()
+        if self.display.units != "si":
+            # Bare numbers would be read back in the display system: echo the quantities with their SI unit.
+            d = _quantities_as_si_strings(d)
+        d["display"] = self.display.to_dict()
         return d
 
     def replace(self, **changes) -> "Scenario":
@@ -840,7 +937,10 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
         The first problem found, naming its full dotted key.
     """
     top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver",
-                            "output"})
+                            "output", "limits", "display"})
+    display = _parse_table("display", top.table("display", default={}), DisplaySpec)
+    data = _quantities_to_si(data, display.units)
+    top = _Table(data, "", set(data))
     name = top.string("name", default=default_name)
     if not name.strip():
         raise ScenarioError("name", "must be a non-empty string")
@@ -854,6 +954,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     gravity = None if gravity_data is None else _parse_gravity(gravity_data)
     solver = _parse_solver(top.table("solver"))
     output = _parse_output(top.table("output", default={}))
+    limits = _parse_table("limits", top.table("limits", default={}), LimitsSpec)
     # Cross-section rules (inner radius > cable radius, cable length <= conduit length),
     # the route build and the default mesh are the Scenario's own checks.
     return Scenario(
@@ -866,7 +967,85 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
         gravity=gravity,
         solver=solver,
         output=output,
+        limits=limits,
+        display=display,
     )
+
+
+# Keys read as quantities: a bare number in the display unit system's unit (SI, or imperial: see
+# scenarios/README.md) or a "value unit" string, converted to SI before the rows check them.
+# (section, key) -> (dimension, cross-section length: inches rather than feet in imperial)
+_QUANTITY_KEYS = {
+    ("cable", "radius"): ("length", True),
+    ("cable", "mass_per_length"): ("mass_per_length", False),
+    ("cable", "length"): ("length", False),
+    ("conduit", "inner_radius"): ("length", True),
+    ("pull", "back_tension"): ("force", False),
+    ("pull", "force"): ("force", False),
+    ("pull", "speed"): ("speed", False),
+    ("limits", "max_tension"): ("force", False),
+    ("limits", "grip_limit"): ("force", False),
+    ("limits", "conductor_area"): ("area", False),
+    ("limits", "max_sidewall_pressure"): ("force_per_length", False),
+    ("limits", "min_clearance"): ("length", True),
+}
+_PATH_QUANTITY_KEYS = {"straight": "length", "radius": "length", "pitch": "length"}
+
+
+def _quantities_to_si(data: dict, system: str) -> dict:
+    """A copy of ``data`` with its quantity keys as SI numbers (:mod:`exucable.units`).
+
+    In SI, bare numbers pass unchanged (only strings are converted), so SI files read as before.
+    """
+    from exucable.units import to_si
+
+    def convert(key, value, dim, small):
+        if system == "si" and (isinstance(value, bool) or not isinstance(value, (str, numbers.Real))):
+            return value  # not a quantity: the row's own check words the error
+        if isinstance(value, (str, numbers.Real)) and not isinstance(value, bool):
+            return to_si(key, value, dim, system, small)
+        return value
+
+    out = dict(data)
+    for (section, name), (dim, small) in _QUANTITY_KEYS.items():
+        table = out.get(section)
+        if isinstance(table, dict) and name in table:
+            table = out[section] = dict(table)
+            table[name] = convert(f"{section}.{name}", table[name], dim, small)
+    conduit = out.get("conduit")
+    if isinstance(conduit, dict) and isinstance(conduit.get("path"), list):
+        path = []
+        for i, item in enumerate(conduit["path"]):
+            if isinstance(item, dict):
+                item = dict(item)
+                for name, dim in _PATH_QUANTITY_KEYS.items():
+                    if name in item:
+                        item[name] = convert(f"conduit.path[{i}].{name}", item[name], dim, False)
+            path.append(item)
+        out["conduit"] = dict(conduit, path=path)
+    return out
+
+
+_SI_UNIT = {"length": "m", "mass_per_length": "kg/m", "force": "N", "speed": "m/s", "area": "m2",
+            "force_per_length": "N/m"}
+
+
+def _quantities_as_si_strings(d: dict) -> dict:
+    """The inverse of :func:`_quantities_to_si` for an imperial scenario's echo: quantities as exact
+    ``"<repr> <SI unit>"`` strings, so that reading the echo gives the same numbers."""
+    def text(value, dim):
+        return f"{float(value)!r} {_SI_UNIT[dim]}" if isinstance(value, (int, float)) and not isinstance(value, bool) else value
+
+    out = dict(d)
+    for (section, name), (dim, _) in _QUANTITY_KEYS.items():
+        if isinstance(out.get(section), dict) and name in out[section]:
+            out[section] = dict(out[section], **{name: text(out[section][name], dim)})
+    conduit = out.get("conduit")
+    if isinstance(conduit, dict) and isinstance(conduit.get("path"), list):
+        out["conduit"] = dict(conduit, path=[
+            {k: (text(v, _PATH_QUANTITY_KEYS[k]) if k in _PATH_QUANTITY_KEYS else v) for k, v in item.items()}
+            for item in conduit["path"]])
+    return out
 
 
 # --------------------------------------------------------------------------------------
@@ -1151,6 +1330,8 @@ _PARSERS = {
     "gravity": _parse_gravity,
     "solver": _parse_solver,
     "output": _parse_output,
+    "limits": lambda data: _parse_table("limits", data, LimitsSpec),
+    "display": lambda data: _parse_table("display", data, DisplaySpec),
 }
 
 

@@ -17,10 +17,10 @@ not a scalar (the conduit route) are ``kind="custom"`` and parsed by hand.
 from __future__ import annotations
 
 import re
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
 
 __all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "markdown_table", "format_default",
            "readme_with_tables"]
@@ -36,7 +36,7 @@ class _Required:
 REQUIRED: Any = _Required()
 
 #: Sections in file order; "" is the top level.
-SECTIONS = ("", "cable", "conduit", "contact", "pull", "gravity", "solver", "output")
+SECTIONS = ("", "cable", "conduit", "contact", "pull", "gravity", "solver", "output", "limits", "display")
 
 #: Heading of each section's key table in scenarios/README.md.
 SECTION_HEADINGS = {
@@ -48,6 +48,8 @@ SECTION_HEADINGS = {
     "gravity": "## `[gravity]` (optional; absent = no gravity)",
     "solver": "## `[solver]`",
     "output": "## `[output]` (optional; snapshots, see docs/results-format.md)",
+    "limits": "## `[limits]` (optional; checked by `exucable plan`)",
+    "display": "## `[display]` (optional; units of bare numbers and printed tables)",
 }
 
 
@@ -158,6 +160,13 @@ FIELDS: tuple[Field, ...] = (
            "(useReducedOrderIntegration 2, 1, 0); full quadrature lets coarse elements on curves carry a "
            "saw-tooth of axial force"),
     # ---- conduit (paper Sect. 2.3)
+    F("cable.count", "count", "int", "", 1, ge=1, le=4, ours=True,
+      rule="integer 1…4: identical cables of this kind in the duct; they must fit the duct. `exucable plan` only "
+           "(`exucable run` simulates one cable)"),
+    F("cable.arrangement", "arrangement", "choice", "", "auto",
+      choices=("auto", "single", "triangular", "cradled", "diamond"), ours=True,
+      rule="`single` (1), `triangular` (2, 3), `cradled` (3, 4), `diamond` (4); `auto`: 3 cables triangular for "
+           "D/d < 2.5 else cradled, 4 diamond for D/d < 3.0 else cradled (Cableizer CR_pull)"),
     F("conduit.inner_radius", "inner_radius_m", "float", "m", gt=0.0, rule="> `cable.radius`"),
     F("conduit.start", "start_m", "vector3", "m", (0.0, 0.0, 0.0), rule="3 numbers; path routes only"),
     F("conduit.heading", "heading", "vector3", "", (1.0, 0.0, 0.0), nonzero=True,
@@ -212,6 +221,9 @@ FIELDS: tuple[Field, ...] = (
            "`back_tension`"),
     F("pull.ramp_time", "ramp_time_s", "float", "s", 0.0, ge=0.0, ours=True,
       rule="≥ 0: time over which speed/loads ramp up from the start state"),
+    F("pull.feed_from_reel", "feed_from_reel", "bool", "", False, ours=True,
+      rule="`exucable plan`: also the pull-in history (tension at the rig vs pulled length), with `back_tension` "
+           "as the reel's back tension"),
     # ---- gravity
     F("gravity.g", "g_m_per_s2", "float", "m/s^2", unit_doc="m/s²", ge=0.0,
       default_doc="required if the table is present", rule="≥ 0, acting along −z"),
@@ -253,6 +265,30 @@ FIELDS: tuple[Field, ...] = (
            "(interpolated between solver steps)"),
     F("output.snapshot_interval", "snapshot_interval_s", "float", "s", None, gt=0.0, ours=True,
       default_doc="none", rule="> 0: also a snapshot at every multiple of it up to `solver.end_time`"),
+    # ---- limits (exucable plan)
+    F("limits.max_tension", "max_tension_N", "float", "N", None, gt=0.0, ours=True, default_doc="none",
+      rule="> 0: largest allowed pulling tension"),
+    F("limits.grip_limit", "grip_limit_N", "float", "N", None, gt=0.0, ours=True, default_doc="none",
+      rule="> 0: rating of the pulling eye or grip"),
+    F("limits.conductor_material", "conductor_material", "choice", "", None, choices=("copper", "aluminium"),
+      ours=True, default_doc="none",
+      rule="with `conductor_area` and `conductors`: the conductors' tension limit"),
+    F("limits.conductor_area", "conductor_area_m2", "float", "m^2", None, unit_doc="m²", gt=0.0, ours=True,
+      default_doc="none", rule="> 0: cross-section of ONE conductor"),
+    F("limits.conductors", "conductors", "int", "", None, ge=1, ours=True, default_doc="none",
+      rule="integer ≥ 1: conductors sharing the pull (all cables)"),
+    F("limits.conductor_rule", "conductor_rule", "choice", "", None, choices=("iec", "us"), ours=True,
+      default_doc="iec; us with imperial units",
+      rule="`iec`: 50 N/mm² copper, 30 N/mm² aluminium; `us`: 0.008 / 0.006 lb/cmil, × 0.8 above 3 conductors"),
+    F("limits.max_sidewall_pressure", "max_sidewall_pressure_N_per_m", "float", "N/m", None, gt=0.0, ours=True,
+      default_doc="none", rule="> 0: largest SWBP on the most loaded cable"),
+    F("limits.min_bend_radius_multiple", "min_bend_radius_multiple", "float", "", None, gt=0.0, ours=True,
+      default_doc="none", rule="> 0: smallest bend centreline radius as a multiple of the cable diameter"),
+    F("limits.min_clearance", "min_clearance_m", "float", "m", None, gt=0.0, ours=True, default_doc="none",
+      rule="> 0: smallest clearance between the uppermost cable and the duct"),
+    # ---- display
+    F("display.units", "units", "choice", "", "si", choices=("si", "imperial"), ours=True,
+      rule="unit system of bare numbers in the file and of printed tables (see above); results files stay SI"),
 )
 del F
 
@@ -320,20 +356,3 @@ def readme_with_tables(text: str) -> str:
         text = text[: m.start()] + markdown_table(section) + end_newline + text[m.end():]
     return text
 
-
-def main(argv=None) -> int:
-    """Rewrite the key tables of scenarios/README.md from :data:`FIELDS` (a developer tool)."""
-    argv = sys.argv[1:] if argv is None else argv
-    path = Path(argv[0]) if argv else Path(__file__).resolve().parent.parent / "scenarios" / "README.md"
-    old = path.read_text(encoding="utf-8")
-    new = readme_with_tables(old)
-    if new != old:
-        path.write_text(new, encoding="utf-8")
-        print(f"updated the key tables of {path}")
-    else:
-        print(f"{path} is up to date")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 import time
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 import exudyn as exu
@@ -38,7 +39,7 @@ class SolveOutcome:
     """What the integration did."""
 
     history: History
-    status: str                  # "ok" | "steady" (stopped early) | "failed"
+    status: Literal["ok", "steady", "failed"]  # "steady": stopped early, once steady
     message: str
     end_time_s: float            # simulated time reached [s]
     steps: int

@@ -240,3 +240,53 @@ def test_readme_layout_table_matches_the_tree():
                 if (p.suffix == ".py" and p.name != "__init__.py" or (p / "__init__.py").is_file())
                 and f"exucable/{p.name}" not in named]
     assert unlisted == [], "modules and packages missing from README's layout table (add a row)"
+
+
+def test_one_atomic_writer():
+    """Files are written through exucable.io only (temporary file + os.replace). Not files of
+    results: the sweep's lock file (held open, flock'ed, see sweep/store.py); its case directories
+    are installed by a rename of a complete directory."""
+    lock_file = ("exucable/sweep/store.py", 'f = open(self.path, "a+")')
+    writes = re.compile(r"os\.replace\(|mkstemp\(|NamedTemporaryFile\(|\.write_text\(|\.write_bytes\(|"
+                        r"open\([^)]*['\"][wax]b?\+?['\"]")
+    offenders = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.name == "io.py" and path.parent == PACKAGE:
+            continue
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            if (writes.search(line) and not line.lstrip().startswith("#")
+                    and (str(path.relative_to(ROOT)), line.strip()) != lock_file):
+                offenders.append(f"{path.relative_to(ROOT)}:{n}: {line.strip()}")
+    assert offenders == []
+
+
+def test_plots_import_nothing_above_them():
+    """Figures are drawn from data: plots/ may use the writer and the reference values, nothing
+    that runs, reads results or builds models."""
+    modules = _modules()
+    allowed = {"exucable.io", "exucable.reference", "exucable.data"}
+    for name in modules:
+        if name.startswith("exucable.plots"):
+            above = {m for m in _imports(name, modules) if not m.startswith("exucable.plots")} - allowed
+            assert above == set(), f"{name} imports {sorted(above)}"
+
+
+def test_only_the_command_line_prints_and_exits():
+    """Library code returns values and raises; printing and exit statuses belong to commands/,
+    cli.py and __main__.py (progress bars write to a stream they are given, not print)."""
+    command_line = {"exucable.cli", "exucable.__main__"}
+    offenders = []
+    for name, path in _modules().items():
+        if name in command_line or name.startswith("exucable.commands"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call):
+                f = node.func
+                called = f.id if isinstance(f, ast.Name) else f"{getattr(f.value, 'id', '?')}.{f.attr}" \
+                    if isinstance(f, ast.Attribute) else ""
+                if called in ("print", "exit", "quit", "sys.exit", "os._exit"):
+                    offenders.append(f"{name}:{node.lineno} {called}()")
+            elif isinstance(node, ast.Raise) and isinstance(node.exc, ast.Call) \
+                    and getattr(node.exc.func, "id", "") == "SystemExit":
+                offenders.append(f"{name}:{node.lineno} raise SystemExit")
+    assert offenders == []

@@ -79,7 +79,9 @@ BAD = [
     ("gravity-without-g", with_(base(), ("gravity",), {}), "gravity.g", "required"),
     # wrong types
     ("radius-bool", with_(base(), ("cable", "radius"), True), "cable.radius", "must be a number"),
-    ("radius-string", with_(base(), ("cable", "radius"), "2.5mm"), "cable.radius", "must be a number"),
+    # a quantity may carry its unit ("2.5 mm"); a string that is no quantity is refused with the key
+    ("radius-string", with_(base(), ("cable", "radius"), "thick"), "cable.radius", "cannot read 'thick' as a quantity"),
+    ("radius-wrong-unit", with_(base(), ("cable", "radius"), "2.5 N"), "cable.radius", "is a force, but this key is a length"),
     ("elements-float", with_(base(), ("cable", "elements"), 10.0), "cable.elements", "integer"),
     ("gravity-not-table", with_(base(), ("gravity",), 9.8), "gravity", "table"),
     ("steady-stop-string", with_(base(), ("solver", "steady_stop"), "yes"), "solver.steady_stop", "true or false"),
@@ -515,3 +517,22 @@ def test_paper_example_parameters():
     assert ex4.gravity.g_m_per_s2 == 9.8 and ex4.pull.back_tension_N == 20.0 and ex4.contact.friction == 0.3
     # 90° + 45° + 90° of turning
     assert math.degrees(ex4.build_conduit().centreline.turning_angle_rad) == pytest.approx(225.0, rel=1e-12)
+
+
+def test_quantities_with_units_and_imperial_numbers_are_read_as_si():
+    data = base()
+    data["cable"]["radius"] = "2.5 mm"
+    data["conduit"]["path"][0]["straight"] = "100 cm"
+    sc = parse_scenario(data, Path("."))
+    assert sc.cable.radius_m == pytest.approx(2.5e-3) and sc.conduit.path[0].length_m == pytest.approx(1.0)
+    imperial = base()
+    imperial["display"] = {"units": "imperial"}
+    imperial["cable"]["radius"] = 0.1           # in
+    imperial["conduit"]["inner_radius"] = 0.15  # in
+    imperial["conduit"]["path"][0]["straight"] = 10.0  # ft
+    imperial["pull"]["speed"] = 1.0             # ft/s
+    sc = parse_scenario(imperial, Path("."))
+    assert sc.cable.radius_m == pytest.approx(0.00254) and sc.conduit.path[0].length_m == pytest.approx(3.048)
+    assert sc.pull.speed_m_per_s == pytest.approx(0.3048)
+    # the echo reads back to the same scenario (quantities as exact SI strings)
+    assert parse_scenario(sc.to_dict(), Path(".")) == sc

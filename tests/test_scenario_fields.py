@@ -62,7 +62,7 @@ def test_readme_key_tables_are_the_field_table():
     text = README.read_text(encoding="utf-8")
     assert readme_with_tables(text) == text, (
         "scenarios/README.md key tables differ from exucable/scenario_fields.py: "
-        "run `.venv/bin/python -m exucable.scenario_fields`"
+        "run `.venv/bin/python -m exucable.commands.key_tables`"
     )
     for section in SECTIONS:
         assert markdown_table(section) in text

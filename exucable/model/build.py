@@ -7,6 +7,7 @@ rig to its leading end, let the conduit's wall act on it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import exudyn as exu
@@ -17,6 +18,12 @@ from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, contact_offsets, lay_cable
 from .rig import Drive, Guide, add_drive, add_end_force, add_tangential_drive, smooth_ramp
 
+if TYPE_CHECKING:  # for the annotations only
+    from ..contact import ContactKernel
+    from ..geometry import Conduit
+    from ..scenario import Scenario
+    from .coupling import ContactCoupling
+
 __all__ = ["LoadScale", "Model", "build_model", "pull_oriented_conduit"]
 
 
@@ -24,10 +31,10 @@ __all__ = ["LoadScale", "Model", "build_model", "pull_oriented_conduit"]
 class Model:
     """An assembled Exudyn system of one scenario and the handles post-processing needs."""
 
-    scenario: object
-    system_container: object
-    mbs: object
-    conduit: object                      # pull-oriented: the leading end is at its end
+    scenario: Scenario
+    system_container: exu.SystemContainer
+    mbs: exu.MainSystem
+    conduit: Conduit                     # pull-oriented: the leading end is at its end
     cable: CableHandles
     layout: CableLayout
     properties: CableProperties
@@ -36,9 +43,9 @@ class Model:
     applied_pull_force_N: float | None   # force-controlled pull
     back_tension_N: float
     rope: RopeSolution | None
-    load_scale: "LoadScale" = None
-    coupling: object | None = None
-    kernel: object | None = None
+    load_scale: LoadScale | None = None
+    coupling: ContactCoupling | None = None
+    kernel: ContactKernel | None = None
     ode2_index: np.ndarray = field(default=None)
 
     @property
