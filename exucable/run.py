@@ -17,7 +17,7 @@ from .versions import versions
 from .export import conduit_s
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
-from .solve import Progress, simulate, steady_quantity
+from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity
 from .tension import SteadyState, detect_steady_state, tension_profile
 
 __all__ = ["run_scenario", "contact_profile"]
@@ -78,9 +78,12 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         from .solve_steady import solve_steady
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
         h = out.history.arrays()
-        # one static state: the result is the last (converged) pseudo-time step's
+        # one static state, the start's extent of cable in the conduit (nothing pulled out yet):
+        # the result is the last (converged) pseudo-time step's
+        drift = 0.0
         st = SteadyState(out.status != "failed", 0.0, 0.0, 0.0, 0.0)
         i0 = max(len(h["time_s"]) - 1, 0)
+        refs = extent_references(sc, model, 0.0)
     else:
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
         snapshot_times = sc.output.times_s(sp.end_time_s)
@@ -89,8 +92,11 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
             recorder = SnapshotRecorder(model, snapshot_times)
         out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
         h = out.history.arrays()
-        st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance)
+        drift = expected_drift_N_per_s(model)
+        st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
+                                 expected_drift_N_per_s=drift)
         i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
+        refs = window_references(sc, model, h["time_s"][i0:])
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
     cprof, peak_pressure = contact_profile(model)
@@ -101,7 +107,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "status": out.status,
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
-        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+        # scatter about the drift the cable's changing extent explains (none without gravity)
+        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
+        if len(h["time_s"]) else None,
+        "reference_drift_N_per_s": drift,
         "steady_quantity": steady_quantity(model),
         "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
@@ -116,9 +125,11 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "build_time_s": build_s,
         "kernel_time_s": model.coupling.kernel_time_s if model.coupling is not None else 0.0,
         "max_sidewall_pressure_N_per_m": peak_pressure,
-        "rope_pull_force_N": rope.pull_force_N if rope is not None else None,
+        "rope_pull_force_N": refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        "rope_clearance_pull_force_N": refs.get("rope_clearance_pull_force_N"),
+        "reference_pulled_out_m": refs.get("pulled_out_m"),
         "scenario": sc.to_dict(),
         "versions": versions(),
     }
@@ -144,3 +155,25 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         write_results(out_dir, result, plots=plots)
     return result
 
+
+def window_references(scenario, model, window_time_s) -> dict:
+    """Both flexible references (:mod:`exucable.references`) for the cable's extent at the mean
+    time of the averaging window ``window_time_s`` [s] of a velocity-controlled pull; ``{}`` for a
+    force-controlled one (its references are the model's centreline rope)."""
+    from .model.rig import ramped_displacement
+
+    sc = scenario
+    if sc.pull.force_N is not None or len(window_time_s) == 0:
+        return {}
+    t_mean = float(np.mean(window_time_s))
+    return extent_references(sc, model, ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s))
+
+
+def extent_references(scenario, model, pulled_out_m: float) -> dict:
+    """Both flexible references for the cable pulled ``pulled_out_m`` [m] out of its start;
+    ``{}`` for a force-controlled pull."""
+    from .references import pull_force_references_N
+
+    if scenario.pull.force_N is not None:
+        return {}
+    return pull_force_references_N(scenario, model.conduit, pulled_out_m)

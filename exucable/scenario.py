@@ -216,6 +216,8 @@ class CableSpec(_Spec):
     integration : str
         Exudyn's quadrature of the element's internal forces: ``"lobatto"`` (default),
         ``"reduced"`` or ``"full"`` (useReducedOrderIntegration 2, 1, 0).
+    bending_stiffness_given_N_m2 : float or None
+        EJ [N m²] if given (stranded cables: not E π r⁴/4), else None.
     count : int
         Identical cables of this kind in the duct (1…4; ``exucable plan`` only).
     arrangement : str
@@ -232,6 +234,7 @@ class CableSpec(_Spec):
     length_m: float | None = _default("cable.length")
     damping_time_s: float = _default("cable.damping_time")
     integration: str = _default("cable.integration")
+    bending_stiffness_given_N_m2: float | None = _default("cable.bending_stiffness")
     count: int = _default("cable.count")
     arrangement: str = _default("cable.arrangement")
 
@@ -264,7 +267,9 @@ class CableSpec(_Spec):
 
     @property
     def bending_stiffness_N_m2(self) -> float:
-        """Bending stiffness EJ = E π r⁴ / 4 [N m²] (solid circular section)."""
+        """Bending stiffness EJ [N m²]: as given, else E π r⁴ / 4 (solid circular section)."""
+        if self.bending_stiffness_given_N_m2 is not None:
+            return self.bending_stiffness_given_N_m2
         return self.youngs_modulus_Pa * math.pi * self.radius_m**4 / 4.0
 
     @property

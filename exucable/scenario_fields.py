@@ -146,6 +146,9 @@ FIELDS: tuple[Field, ...] = (
     F("cable.mass_per_length", "mass_per_length_kg_per_m", "float", "kg/m", None, gt=0.0, default_doc="—",
       rule="> 0"),
     F("cable.youngs_modulus", "youngs_modulus_Pa", "float", "Pa", gt=0.0, rule="> 0"),
+    F("cable.bending_stiffness", "bending_stiffness_given_N_m2", "float", "N m^2", None, unit_doc="N m²", gt=0.0,
+      ours=True, default_doc="E π r⁴/4",
+      rule="> 0: EJ of a stranded or layered cable, apart from `youngs_modulus` (which still gives EA)"),
     F("cable.elements", "elements", "int", "", None, ge=1, derived=True,
       default_doc="max(10, ⌈L·κ_max / 0.25⌉)",
       rule="integer ≥ 1; default: each element turns at most 0.25 rad on the tightest bend "

@@ -18,7 +18,8 @@ import exudyn as exu
 
 from .tension import detect_steady_state, tension_at, tension_profile
 
-__all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "Progress"]
+__all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "expected_drift_N_per_s",
+           "Progress"]
 
 
 @dataclass
@@ -127,6 +128,14 @@ def record_state(model, t: float, history: History) -> None:
     history.max_tension_N.append(float(np.max(N)))
 
 
+def expected_drift_N_per_s(model) -> float:
+    """The drift the steady detector takes off the steady quantity [N/s]: the flexible reference's,
+    as the cable leaves its conduit (pulling force of a velocity-controlled pull), else 0."""
+    if steady_quantity(model) != "pull_force_N":
+        return 0.0
+    return float(getattr(model, "reference_drift_N_per_s", 0.0))
+
+
 def simulate(model, progress: Progress | None = None, steady_stop: bool | None = None,
              snapshots=None) -> SolveOutcome:
     """Integrate ``model`` to the scenario's end time (or to a steady pulling force).
@@ -157,7 +166,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
                 progress.update(t, f"F = {history.pull_force_N[-1]:.4g} N")
             if steady_stop and t >= sp.steady_window_s:
                 st = detect_steady_state(history.time_s, getattr(history, steady_quantity(model)),
-                                         sp.steady_window_s, sp.steady_tolerance)
+                                         sp.steady_window_s, sp.steady_tolerance,
+                                         expected_drift_N_per_s=expected_drift_N_per_s(model))
                 if st.steady:
                     stopped_steady[0] = True
                     return False

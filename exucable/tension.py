@@ -108,22 +108,31 @@ def _window_stats(t, f):
 
 
 def detect_steady_state(time_s, force_N, min_window_s: float, rel_tolerance: float = 1e-3,
-                        abs_tolerance_N: float = 1e-6) -> SteadyState:
+                        abs_tolerance_N: float = 1e-6, expected_drift_N_per_s: float = 0.0) -> SteadyState:
     """Find the longest final window in which the force is steady.
 
     A window [t0, t_end] is steady when it is at least ``min_window_s`` long and both the drift
     of a least-squares line across it and the standard deviation are below
     ``rel_tolerance·|mean| + abs_tolerance_N``. The earliest such t0 (scanned on the saved times)
     is returned, so the mean uses as much of the steady sliding as there is.
+
+    ``expected_drift_N_per_s`` [N/s] is a drift the physics predicts (the cable leaving its conduit
+    under gravity, :mod:`exucable.references`): it is taken off the force before the tests, so a
+    force that follows its moving reference is steady; the mean reported is of the force itself,
+    and belongs to the window's mean time.
     """
     t = np.asarray(time_s, dtype=float)
     f = np.asarray(force_N, dtype=float)
+    if expected_drift_N_per_s and len(t):
+        f = f - expected_drift_N_per_s * (t - t[-1])   # the force referred to the last time...
     if len(t) == 0:
         return SteadyState(False, float("nan"), float("nan"), float("nan"), float("nan"))
     t_end = t[-1]
 
     def ok(i0):
         mean, std, drift = _window_stats(t[i0:], f[i0:])
+        if expected_drift_N_per_s:   # ...and the mean back to the window's own mean time
+            mean += expected_drift_N_per_s * (float(np.mean(t[i0:])) - t[-1])
         bound = rel_tolerance * abs(mean) + abs_tolerance_N
         return abs(drift) <= bound and std <= bound, (mean, std, drift)
 

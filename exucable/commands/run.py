@@ -47,6 +47,9 @@ def main(args) -> int:
         ref, got, what = rope, s["pull_force_N"], "pulling force"
     if ref is not None and got is not None and np.isfinite(got):
         print(f"  rope reference: {what} {ref:.6g} N ({100 * (got / ref - 1):+.3f} %)")
+    ref_c = s.get("rope_clearance_pull_force_N")
+    if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
+        print(f"  rope with clearance: pulling force {ref_c:.6g} N ({100 * (got / ref_c - 1):+.3f} %)")
     if s.get("mode") == "steady":
         print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
               f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")

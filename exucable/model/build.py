@@ -14,6 +14,8 @@ import exudyn as exu
 
 from ..errors import ModelError
 from ..rope import RopeSolution, solve_rope, solve_rope_for_pull_force
+from ..references import reference_drift_N_per_s
+from ..rope_clearance import solve_rope_with_clearance
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, contact_offsets, lay_cable
 from .rig import Drive, Guide, add_drive, add_end_force, add_tangential_drive, smooth_ramp
@@ -47,6 +49,8 @@ class Model:
     coupling: ContactCoupling | None = None
     kernel: ContactKernel | None = None
     ode2_index: np.ndarray = field(default=None)
+    # how fast the flexible reference's pulling force moves as the cable leaves its conduit [N/s]
+    reference_drift_N_per_s: float = 0.0
 
     @property
     def axial_stiffness_N(self) -> float:
@@ -118,6 +122,18 @@ def _rope_start(scenario, centreline, w_N_per_m: float) -> RopeSolution:
     return solve_rope(centreline, trailing_tension_N=scenario.pull.back_tension_N, **common)
 
 
+def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: float):
+    """The rope with clearance for the start of a velocity-controlled pull, or None (force-controlled,
+    no clearance, or a cable that runs slack somewhere)."""
+    if scenario.pull.force_N is not None or clearance_m <= 0.0:
+        return None
+    try:
+        return solve_rope_with_clearance(centreline, clearance_m, scenario.contact.friction, w_N_per_m,
+                                         scenario.pull.back_tension_N, cable_length_m=scenario.cable_length_m)
+    except ModelError:
+        return None
+
+
 def check_resolution(scenario, conduit) -> None:
     """Refuse meshes too coarse for the conduit: along the tightest bend (curvature κ) each
     element may turn at most 0.5 rad. A cubic element spanning an arc of angle φ departs from it
@@ -171,12 +187,22 @@ def build_model(scenario, with_contact: bool = True) -> Model:
         # half an element so the nodes can follow it
         T_ref = max(float(np.max(rope.tension_N)), 1e-6)
         blend = max(0.5 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
+        free = _clearance_rope_start(sc, centre, w, clearance) if with_contact else None
+        path = {}
+        if free is not None:
+            # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
+            # free spans across the clearance, and a start pressed onto the wall the centreline rope's
+            # load points to rang for a second as those spans formed (issue 10, item 3).
+            T_grid = np.interp(s_grid, free.s_conduit_m, free.tension_N)
+            path = {"path_offset_m": np.stack([np.interp(s_grid, free.s_conduit_m, free.offset_m[:, j])
+                                               for j in range(3)], axis=1),
+                    "path_pressure_N_per_m": np.interp(s_grid, free.s_conduit_m, free.sidewall_pressure_N_per_m)}
         off = contact_offsets(centre, s_grid, T_grid, w, clearance,
                               sc.contact.stiffness / sc.contact.reference_spacing_m,
-                              sc.contact.exponent, blend) if with_contact else np.zeros((len(s_grid), 3))
+                              sc.contact.exponent, blend, **path) if with_contact else np.zeros((len(s_grid), 3))
 
         def tension_fn(s):
-            return np.interp(s, rope.s_conduit_m, rope.tension_N, left=rope.tension_N[0], right=rope.tension_N[-1])
+            return np.interp(s, s_grid, T_grid)
 
         def offset_fn(s):
             return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
@@ -231,7 +257,8 @@ def build_model(scenario, with_contact: bool = True) -> Model:
     model = Model(scenario=sc, system_container=SC, mbs=mbs, conduit=conduit, cable=cable, layout=layout,
                   properties=props, lead_drive=lead_drive, trail_drive=trail_drive,
                   applied_pull_force_N=applied, back_tension_N=sc.pull.back_tension_N, rope=rope,
-                  load_scale=load_scale)
+                  load_scale=load_scale,
+                  reference_drift_N_per_s=reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s))
     if with_contact:
         from ..contact import ContactKernel, ContactLaw
         from .coupling import ContactCoupling, StartupDamper

@@ -98,6 +98,8 @@ def contact_offsets(
     line_stiffness_N_per_m_e_per_m: float,
     exponent: float,
     blend_length_m: float,
+    path_offset_m: np.ndarray | None = None,
+    path_pressure_N_per_m: np.ndarray | None = None,
 ) -> np.ndarray:
     """Offset of the cable axis from the conduit axis at rest on its bearing wall.
 
@@ -123,6 +125,10 @@ def contact_offsets(
         Hertz exponent e [-].
     blend_length_m : float
         Smoothing length [m].
+    path_offset_m, path_pressure_N_per_m : ndarray (m, 3) and (m,), optional
+        The path and wall pressure of the rope with clearance on the grid
+        (:mod:`exucable.rope_clearance`); when given, the cable starts on that path (free spans
+        included) instead of on the wall the centreline rope's load points to.
 
     Returns
     -------
@@ -136,12 +142,17 @@ def contact_offsets(
     w_perp = weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
     load = np.asarray(tension_N, dtype=float)[:, None] * kn - w_perp
     p = np.linalg.norm(load, axis=1)
+    off = np.zeros_like(load)
+    if path_offset_m is not None:
+        p = np.asarray(path_pressure_N_per_m, dtype=float)
+        load = np.asarray(path_offset_m, dtype=float)   # only its direction is used where loaded
+        off = load.copy()
     scale = max(p.max(), 1e-300)
     loaded = p > 1e-9 * scale
-    off = np.zeros_like(load)
     if loaded.any():
         delta = (p[loaded] / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent)
-        off[loaded] = load[loaded] / p[loaded, None] * (clearance_m + delta)[:, None]
+        size = np.maximum(np.linalg.norm(load[loaded], axis=1), 1e-300)
+        off[loaded] = load[loaded] / size[:, None] * (clearance_m + delta)[:, None]
     ds = s[1] - s[0] if len(s) > 1 else 1.0
     sigma = blend_length_m / ds
     if sigma > 0.5 and loaded.any():

@@ -1,0 +1,107 @@
+"""The rope with clearance against the closed forms that still hold when the cable may leave the wall.
+
+Tolerances: the chain's discretisation error is O(h²) (h the node spacing); at the spacings used here it is
+below 1e-5 relative on a bend, so 2e-5 catches any modelling error (a mis-signed friction or a weight
+counted twice moves the answer by percents) without resting on rounding. On straights the solution is exact
+to rounding (1e-9).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from exucable import closed_forms as cf
+from exucable.errors import ModelError
+from exucable.geometry import Bend, Straight, centreline_from_path
+from exucable.rope import solve_rope
+from exucable.rope_clearance import solve_rope_with_clearance
+
+W = 0.21 * 9.81  # the issue's 18 mm fibre cable, 0.21 kg/m [N/m]
+
+
+def route(*items, heading=(1.0, 0.0, 0.0)):
+    return centreline_from_path([0.0, 0.0, 0.0], heading, list(items))
+
+
+@pytest.mark.parametrize("clearance_m", [0.002, 0.0084, 0.02])
+def test_bend_without_gravity_is_the_capstan_at_any_clearance(clearance_m):
+    # Without weight the cable wraps the inner wall and turns through the bend's angle wherever it lies:
+    # T_out = T_in e^{μθ} (paper Eq. 26), whatever the clearance.
+    centre = route(Straight(2.0), Bend(90.0, 3.0), Straight(2.0))
+    sol = solve_rope_with_clearance(centre, clearance_m, 0.5, 0.0, 100.0, node_spacing_m=0.01)
+    assert sol.pull_force_N == pytest.approx(cf.capstan_out_N(100.0, 0.5, math.pi / 2), rel=2e-5)
+    # it lies on the inner wall through the bend, pressing T/(R − c) per length of cable, which is
+    # T/R per length of conduit (the cable's arc is (R − c)/R as long as the centreline's)
+    body = (sol.s_conduit_m > 2.3) & (sol.s_conduit_m < 2.0 + 3.0 * math.pi / 2 - 0.3)
+    assert np.all(sol.in_contact[body])
+    inner = np.array([-1.0, 1.0, 0.0]) / math.sqrt(2)  # toward the bend's centre at mid-bend
+    mid = np.argmin(abs(sol.s_conduit_m - (2.0 + 3.0 * math.pi / 4)))
+    assert sol.offset_m[mid] @ inner == pytest.approx(clearance_m, rel=1e-5)
+    np.testing.assert_allclose(sol.sidewall_pressure_N_per_m[body],
+                               sol.tension_N[body] / 3.0, rtol=1e-4)
+
+
+@pytest.mark.parametrize("theta_deg", [0.0, 20.0])
+def test_straight_with_gravity_lies_on_the_floor(theta_deg):
+    # On a straight the cable rests on the lower wall: T = T_b + w(μ cos θ + sin θ)L (paper Eq. 25; μwL flat).
+    theta = math.radians(theta_deg)
+    centre = route(Straight(30.0), heading=(math.cos(theta), 0.0, math.sin(theta)))
+    sol = solve_rope_with_clearance(centre, 0.01, 0.5, W, 10.0)
+    assert sol.pull_force_N == pytest.approx(10.0 + cf.incline_tension_N(30.0, W, 0.5, theta), rel=1e-9)
+    assert np.all(sol.in_contact)
+    np.testing.assert_allclose(sol.offset_m @ [-math.sin(theta), 0.0, math.cos(theta)], -0.01, rtol=1e-6)
+
+
+def test_frictionless_pull_lifts_the_weight_through_its_free_spans():
+    # μ = 0: the only work is lifting the cable, so T_lead − T_trail = w (z_lead − z_trail) exactly, with the
+    # ends where the clearance puts them (on the floor of the entry, the inner (upper) wall of the exit).
+    centre = route(Straight(5.0), Bend(60.0, 5.0, turn="up"), Straight(3.0))
+    sol = solve_rope_with_clearance(centre, 0.01, 0.0, 9.81, 200.0, node_spacing_m=0.01)
+    rise = sol.position_m[-1, 2] - sol.position_m[0, 2]
+    # 1e-6: the weight is lumped at the nodes (an O(h²) error on the curved spans)
+    assert sol.pull_force_N == pytest.approx(200.0 + 9.81 * rise, rel=1e-6)
+    assert sol.free_spans_m(), "the cable crosses the clearance from the floor to the bend's inner wall"
+
+
+def test_up_bend_free_span_lowers_the_pull_and_vanishes_with_the_clearance():
+    # The issue's vertical up-bend (60°, R 5 m, 1 kg/m, μ 0.3, 200 N): the cable leaves the floor before the
+    # bend and hangs in a free span to its upper wall, so the weight of the span is carried by the bend's
+    # wall, where it partly cancels the pressure T/R (the rope counts both): the pull is lower than the
+    # centreline rope's, and the difference shrinks as the clearance closes, as the square root of it: the
+    # free span that crosses the clearance c under tension T is a parabola of length √(2cT/w).
+    centre = route(Straight(5.0), Bend(60.0, 5.0, turn="up"), Straight(3.0))
+    rope = solve_rope(centre, 0.3, 9.81, 200.0).pull_force_N
+    diffs = [solve_rope_with_clearance(centre, c, 0.3, 9.81, 200.0).pull_force_N / rope - 1
+             for c in (0.01, 0.001, 0.0001)]
+    assert diffs[0] < diffs[1] < diffs[2] < 0.0
+    assert 7.0 < diffs[0] / diffs[2] < 13.0  # √100 = 10
+
+
+def test_converges_with_the_node_spacing():
+    centre = route(Straight(5.0), Bend(60.0, 5.0, turn="up"), Straight(3.0))
+    f = [solve_rope_with_clearance(centre, 0.01, 0.3, 9.81, 200.0, node_spacing_m=h).pull_force_N
+         for h in (0.04, 0.02, 0.01)]
+    assert abs(f[2] - f[1]) < 0.5 * abs(f[1] - f[0]) + 1e-9 * f[2]
+    assert abs(f[2] / f[1] - 1) < 2e-4
+
+
+def test_reverse_pull_is_the_reversed_route():
+    centre = route(Straight(3.0), Bend(45.0, 4.0, turn="up"), Straight(2.0))
+    rev = solve_rope_with_clearance(centre, 0.01, 0.3, 9.81, 50.0, direction="reverse")
+    fwd = solve_rope_with_clearance(centre.reversed(), 0.01, 0.3, 9.81, 50.0)
+    assert rev.pull_force_N == pytest.approx(fwd.pull_force_N, rel=1e-9)
+    np.testing.assert_allclose(rev.s_conduit_m, centre.length_m - fwd.s_conduit_m, atol=1e-12)
+
+
+@pytest.mark.parametrize("kwargs, key", [(dict(clearance_m=0.0), "clearance_m"), (dict(friction=-0.1), "friction"),
+                                         (dict(direction="up"), "direction"),
+                                         (dict(cable_length_m=99.0), "cable_length_m")])
+def test_bad_arguments_name_the_argument(kwargs, key):
+    args = dict(centreline=route(Straight(5.0)), clearance_m=0.01, friction=0.3)
+    args.update(kwargs)
+    with pytest.raises(ModelError) as err:
+        solve_rope_with_clearance(**args)
+    assert err.value.key == key
