@@ -1,8 +1,8 @@
 """Results of one run and their files (the documented results format, see README).
 
 Every file is written atomically (a temporary file in the same directory, then ``os.replace``),
-so a crash or a kill never leaves a half-written file, and ``summary.json`` is written last:
-its presence marks a complete result directory.
+so a crash or a kill never leaves a half-written file, and ``summary.json`` is written after the
+data files: its presence marks complete results. The figures (optional) follow it.
 
 Files
 -----
@@ -51,7 +51,8 @@ class RunResult:
 
 
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
-    """Write ``result`` into ``out_dir`` (created if needed); ``summary.json`` last. Returns the paths."""
+    """Write ``result`` into ``out_dir`` (created if needed): the CSV files, then ``summary.json``,
+    then (unless ``plots`` is false) the figures. Returns the paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -71,14 +72,16 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
         for name, data in result.snapshots.items():
             write_csv(out / name, SNAPSHOT_FILES[name], data)
             written.append(out / name)
+    write_json(out / "summary.json", result.summary)
+    written.append(out / "summary.json")
+    # the figures come after the numbers: they cost about half a second of matplotlib, and a
+    # failure to draw must not hold back (or lose) a result already computed
     if plots:
         plot_pull_force(out / "pull_force.png", result)
         written.append(out / "pull_force.png")
         if result.tension_profile is not None:
             plot_tension_profile(out / "tension_profile.png", result)
             written.append(out / "tension_profile.png")
-    write_json(out / "summary.json", result.summary)
-    written.append(out / "summary.json")
     return written
 
 

@@ -120,6 +120,8 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "simulated_time_s": out.end_time_s,
         "steps": out.steps,
         "newton_iterations": out.newton_iterations,
+        # all iterations, those of rejected step attempts included, per accepted step
+        "newton_iterations_per_step": out.newton_iterations / out.steps if out.steps else None,
         "jacobian_updates": out.jacobian_updates,
         "wall_time_s": out.wall_time_s,
         "build_time_s": build_s,

@@ -7,6 +7,7 @@ are built here from exact arcs and helices (the geometry package is developed se
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import textwrap
@@ -620,3 +621,30 @@ def test_numba_cache_and_first_call_in_fresh_process():
                          timeout=300)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["8", "True"]
+
+
+def test_kernel_imports_and_runs_when_no_cache_directory_is_writable():
+    """Numba finds no writable cache directory (simulated by offering it only a locator that
+    never applies: IPython's): exucable warns once per compiled module, with the fix, instead of
+    failing at import, and compiles in memory (checked on the broad phase, which compiles in a
+    second; the kernel's own compilation takes tens of seconds and is the same code path)."""
+    code = textwrap.dedent("""
+        import warnings
+        warnings.simplefilter("always")
+        with warnings.catch_warnings(record=True) as caught:
+            from exucable.contact import broadphase, fast
+        print(type(fast._contact_kernel._cache).__name__,
+              len([w for w in caught if "NUMBA_CACHE_DIR" in str(w.message)]))
+        import numpy as np
+        lo, hi = np.empty((1, 3)), np.empty((1, 3))
+        broadphase._element_boxes(np.array([0.0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0]), np.array([1.0]),
+                                  0.01, lo, hi)
+        print(type(broadphase._element_boxes._cache).__name__, np.allclose(lo[0], [-0.01] * 3))
+    """)
+    env = dict(os.environ, NUMBA_CACHE_LOCATOR_CLASSES="IPythonCacheLocator")
+    env.pop("NUMBA_CACHE_DIR", None)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300, env=env)
+    assert out.returncode == 0, out.stderr
+    # one warning from the broad phase's module, one from the kernel's
+    assert out.stdout.split() == ["NullCache", "2", "NullCache", "True"]

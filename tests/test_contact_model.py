@@ -91,3 +91,26 @@ def test_contact_force_converges_as_check_points_are_added():
     slope = np.polyfit(np.log(ns), np.log(err), 1)[0]
     assert err[-1] < 1e-3
     assert slope < -1.5, (err, slope)
+
+
+def test_one_kernel_pass_per_newton_iteration():
+    """The Jacobian call reuses the kernel pass of the force call at the same state: half the
+    passes, and a bit-identical run (issue 15: contact cost per Newton iteration)."""
+    def run(with_force):
+        sc = make_scenario(conduit={"inner_radius": 0.0035, "path": [{"straight": 1.0},
+                                                                     {"bend": 90.0, "radius": 0.5, "turn": "left"}]},
+                           cable=dict(radius=0.0025, density=1000.0, youngs_modulus=1.0e9, elements=8),
+                           contact={"friction": 0.2, "check_points_per_element": 10},
+                           pull={"speed": 0.1, "back_tension": 50.0},
+                           solver={"end_time": 0.03, "step": 0.01})
+        model = build_model(sc)
+        model.coupling.jacobian_with_force = with_force
+        out = simulate(model)
+        return out, model.coupling
+
+    (a, ca), (b, cb) = run(False), run(True)
+    assert a.status == b.status == "ok"
+    assert a.history.pull_force_N == b.history.pull_force_N       # bit for bit
+    assert cb.jacobian_calls > 0 and cb.reused_evaluations == cb.jacobian_calls
+    assert ca.kernel_evaluations == ca.force_calls + ca.jacobian_calls
+    assert cb.kernel_evaluations == cb.force_calls

@@ -21,7 +21,7 @@ def test_run_writes_the_documented_results(tmp_path):
     res = run_scenario(ROOT / "scenarios/fast/paper_ex1_incline.toml", tmp_path, quiet=True)
     s = json.loads((tmp_path / "summary.json").read_text())
     for key in ("pull_force_N", "pull_force_std_N", "trailing_tension_N", "max_tension_N", "steady_from_s",
-                "steps", "wall_time_s", "rope_pull_force_N", "max_sidewall_pressure_N_per_m", "scenario",
+                "steps", "newton_iterations_per_step", "wall_time_s", "rope_pull_force_N", "max_sidewall_pressure_N_per_m", "scenario",
                 "versions"):
         assert key in s, key
     assert s["versions"]["exudyn"].startswith("1.13")
@@ -39,6 +39,7 @@ def test_run_writes_the_documented_results(tmp_path):
         assert (tmp_path / png).stat().st_size > 5000
     assert not list(tmp_path.glob(".*.tmp"))                   # atomic writes leave no temp files
     assert res.summary["status"] in ("ok", "steady")
+    assert s["newton_iterations_per_step"] == pytest.approx(s["newton_iterations"] / s["steps"])
 
 
 def test_solver_failure_is_reported_with_its_time_and_keeps_results(tmp_path):
@@ -89,6 +90,21 @@ def test_cli_lists_every_subcommand():
     assert p.returncode == 0
     for cmd in ("route", "run", "validate", "sweep", "compare"):
         assert cmd in p.stdout
+
+
+def test_cli_imports_only_the_chosen_subcommand():
+    """`exucable run` does not pay for the other commands' imports (fixed cost, issue 15), and
+    their help still works."""
+    code = ("import sys\nfrom exucable.cli import build_parser, _command_in\n"
+            "build_parser(only=_command_in(['run', 'x.toml']))\n"
+            "print(sorted(m for m in ('exucable.commands.sweep', 'exucable.commands.validate', "
+            "'exucable.commands.compare', 'exucable.sweep', 'exucable.validate', "
+            "'matplotlib') if m in sys.modules))")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == "[]"
+    p = subprocess.run([sys.executable, "-m", "exucable", "sweep", "--help"], capture_output=True, text=True)
+    assert p.returncode == 0 and "--workers" in p.stdout
 
 
 @pytest.mark.parametrize("name", ["paper_ex1_incline", "paper_ex2_bend90", "paper_ex3_helix", "paper_ex4_spatial"])

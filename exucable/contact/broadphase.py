@@ -36,8 +36,15 @@ __all__ = [
 try:  # numba is a dependency, but the numpy reference must not need it
     from numba import njit as _njit
 
+    from .jitcache import jit_cache_available
+
+    def _cache_probe():
+        """Stands for this file's functions in the check for a writable numba cache."""
+
+    _CACHE = jit_cache_available(_cache_probe)
+
     def _jit(func):
-        return _njit(cache=True, nogil=True)(func)
+        return _njit(cache=_CACHE, nogil=True)(func)
 
 except ImportError:  # pragma: no cover - exercised only without numba
     def _jit(func):
