@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from .export import conduit_s
 from .results import RunResult, write_results
 from .scenario import Scenario, load_scenario
 from .pressure import bend_table, default_window_m, pressure_profile
-from .tension import detect_steady_state, tension_at, tension_profile
+from .tension import SteadyState, detect_steady_state, tension_at, tension_profile
 from .trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile"]
@@ -129,43 +130,58 @@ def _assess(model, out, st, h, pull_force_N):
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
                  steady_stop: bool | None = None, refine: float = 1.0,
-                 check_points_per_element: int | None = None) -> RunResult:
+                 check_points_per_element: int | None = None, mode: str | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
     message and the simulated time where it happened, and everything recorded until then is
     written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
     ``refine`` divides the mesh's element length and ``check_points_per_element`` overrides the
-    scenario's (``exucable converge``).
+    scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
+    ``solver.mode``.
     """
     from .model.build import build_model
     from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if mode is not None and mode != sc.solver.mode:
+        sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
     if sc.cable.count != 1:
         raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
                                         "plan several cables per duct with `exucable plan`")
     t_start = time.perf_counter()
     model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element)
     build_s = time.perf_counter() - t_start
-    progress = Progress(sc.solver.end_time_s, label=sc.name, enabled=not quiet)
-    snapshot_times = sc.output.times_s(sc.solver.end_time_s)
-    recorder = None
-    if snapshot_times:
-        from .snapshots import SnapshotRecorder
-        recorder = SnapshotRecorder(model, snapshot_times)
-    out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
-    h = out.history.arrays()
     sp = sc.solver
-    drift = expected_drift_N_per_s(model)
-    st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
-                             expected_drift_N_per_s=drift)
-    i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
-    refs = window_references(sc, model, h["time_s"][i0:])
-    # the uncertainty is of the mean about the drift the references explain (the cable's changing
-    # extent, evaluated at the window's mean time): remove that drift first
-    pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"],
-                                st.from_s if np.isfinite(st.from_s) else 0.0) if len(h["time_s"]) else None
+    recorder = None
+    if sp.mode == "steady":
+        from .solve_steady import solve_steady
+        out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
+        h = out.history.arrays()
+        # one static state, the start's extent of cable in the conduit (nothing pulled out yet):
+        # the result is the last (converged) pseudo-time step's; no time history, no scatter
+        drift = 0.0
+        st = SteadyState(out.status != "failed", 0.0, 0.0, 0.0, 0.0)
+        i0 = max(len(h["time_s"]) - 1, 0)
+        refs = extent_references(sc, model, 0.0)
+        pf = None
+    else:
+        progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
+        snapshot_times = sc.output.times_s(sp.end_time_s)
+        if snapshot_times:
+            from .snapshots import SnapshotRecorder
+            recorder = SnapshotRecorder(model, snapshot_times)
+        out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
+        h = out.history.arrays()
+        drift = expected_drift_N_per_s(model)
+        st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
+                                 expected_drift_N_per_s=drift)
+        i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
+        refs = window_references(sc, model, h["time_s"][i0:])
+        # the uncertainty is of the mean about the drift the references explain (the cable's changing
+        # extent, evaluated at the window's mean time): remove that drift first
+        pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"],
+                                    st.from_s if np.isfinite(st.from_s) else 0.0) if len(h["time_s"]) else None
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
     points = check_point_loads(model)
@@ -174,6 +190,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     pressure_info, bends, pressure_prof = _pressure(model, points, rope)
     summary = {
         "name": sc.name,
+        "mode": sp.mode,
         "status": out.status,
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
@@ -252,11 +269,19 @@ def window_references(scenario, model, window_time_s) -> dict:
     time of the averaging window ``window_time_s`` [s] of a velocity-controlled pull; ``{}`` for a
     force-controlled one (its references are the model's centreline rope)."""
     from .model.rig import ramped_displacement
-    from .references import pull_force_references_N
 
     sc = scenario
     if sc.pull.force_N is not None or len(window_time_s) == 0:
         return {}
     t_mean = float(np.mean(window_time_s))
-    out = ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s)
-    return pull_force_references_N(sc, model.conduit, out)
+    return extent_references(sc, model, ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s))
+
+
+def extent_references(scenario, model, pulled_out_m: float) -> dict:
+    """Both flexible references for the cable pulled ``pulled_out_m`` [m] out of its start;
+    ``{}`` for a force-controlled pull."""
+    from .references import pull_force_references_N
+
+    if scenario.pull.force_N is not None:
+        return {}
+    return pull_force_references_N(scenario, model.conduit, pulled_out_m)

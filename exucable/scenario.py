@@ -563,6 +563,9 @@ class SolverSpec(_Spec):
         Relative drift/scatter bound of the pulling force in that window [-].
     pretension : bool
         Start from the rope solution's tension profile near contact equilibrium.
+    mode : {"dynamic", "steady"}
+        ``"dynamic"``: integrate the paper's dynamics in time; ``"steady"``: solve the steady
+        sliding state in one static solve (:mod:`exucable.solve_steady`).
     """
 
     _SECTION: ClassVar[str] = "solver"
@@ -580,8 +583,12 @@ class SolverSpec(_Spec):
     steady_window_s: float = _default("solver.steady_window")
     steady_tolerance: float = _default("solver.steady_tolerance")
     pretension: bool = _default("solver.pretension")
+    mode: str = _default("solver.mode")
 
     def _check(self) -> None:
+        if self.mode == "steady" and not self.pretension:
+            raise ScenarioError("solver.pretension", 'solver.mode = "steady" starts from the rope solution '
+                                "near the steady state; set it to true (or use the dynamic mode)")
         if self.min_step_s is None:
             object.__setattr__(self, "min_step_s", min(_DEFAULT_MIN_STEP_S, self.step_s))
         elif self.min_step_s > self.step_s:

@@ -262,6 +262,10 @@ FIELDS: tuple[Field, ...] = (
       rule="> 0, relative drift/scatter bound"),
     F("solver.pretension", "pretension", "bool", "", True, ours=True,
       rule="start from the rope solution's tension profile near contact equilibrium"),
+    F("solver.mode", "mode", "choice", "", "dynamic", choices=("dynamic", "steady"), ours=True,
+      rule="`\"dynamic\"`: integrate the dynamics in time (paper Sect. 2.6); `\"steady\"`: one static solve "
+           "of the steady sliding state (friction along the cable's tangent, no start-up, no time history; "
+           "needs `solver.pretension = true`); the `solver` time keys are then unused"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
       rule="array of times in [0, `solver.end_time`]: the whole state is written at each "

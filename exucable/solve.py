@@ -89,6 +89,11 @@ def solver_settings(solver_spec) -> exu.SimulationSettings:
     ti.newton.relativeTolerance = solver_spec.newton_tolerance
     ti.generalizedAlpha.spectralRadius = solver_spec.spectral_radius
     ti.verboseMode = 0
+    return quiet_sparse(s)
+
+
+def quiet_sparse(s: exu.SimulationSettings) -> exu.SimulationSettings:
+    """Sparse linear solver, no solution file, sensors or statistics (both solve modes)."""
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     s.solution.file.write = False
     s.solution.sensors.active = False

@@ -25,7 +25,7 @@ from .io import atomic_write_text
 from .plots.validation import plot_validation_figures
 from .reference import load_reference
 
-__all__ = ["Check", "ValidationRun", "validate", "format_table", "write_report", "TOLERANCES", "CASES"]
+__all__ = ["Check", "ModeDifference", "MODES", "ValidationRun", "validate", "format_table", "write_report", "TOLERANCES", "CASES"]
 
 #: The validation cases, in the order they run.
 CASES = ("ex1", "ex2", "ex3", "fig12", "ex4")
@@ -43,6 +43,8 @@ class Check:
     paper_error: float | None = None
     scale: float | None = None  # error normalised by this instead of the reference (profiles)
     note: str = ""
+    mode: str = "dynamic"     # solver.mode of the run that gave ``value``
+    scatter: float | None = None  # relative steady scatter of the run (std/mean of its window)
 
     @property
     def rel_error(self) -> float:
@@ -52,6 +54,30 @@ class Check:
     @property
     def passed(self) -> bool:
         return bool(np.isfinite(self.value)) and self.rel_error <= self.tolerance
+
+
+@dataclass(frozen=True)
+class ModeDifference:
+    """The same check in both modes: steady against dynamic.
+
+    ``tolerance`` is the issue's bound (0.2 %) on |steady - dynamic| / |dynamic| when both describe
+    the same state; ``scatter`` is the dynamic run's own steady scatter (std/mean) for scale.
+    """
+
+    case: str
+    quantity: str
+    dynamic: float
+    steady: float
+    scatter: float | None
+    tolerance: float = 2e-3
+
+    @property
+    def rel_difference(self) -> float:
+        return (self.steady - self.dynamic) / abs(self.dynamic) if self.dynamic else float("inf")
+
+    @property
+    def agrees(self) -> bool:
+        return bool(np.isfinite(self.rel_difference)) and abs(self.rel_difference) <= self.tolerance
 
 
 # Tolerances: (paper fidelity, fast). Paper-fidelity targets are the issue's; fast ones are what
@@ -69,13 +95,30 @@ TOLERANCES = {
 }
 
 
+MODES = ("dynamic", "steady")
+
+
 @dataclass
 class ValidationRun:
     checks: list = field(default_factory=list)
-    runs: dict = field(default_factory=dict)       # case -> RunResult
+    runs: dict = field(default_factory=dict)       # case -> RunResult (dynamic mode if it ran)
     sweep_rows: list = field(default_factory=list)
     wall_time_s: float = 0.0
     failures: list = field(default_factory=list)   # (case, message)
+    steady_runs: dict = field(default_factory=dict)  # case -> RunResult of the steady mode
+    steady_sweep_rows: list = field(default_factory=list)
+    mode_wall_time_s: dict = field(default_factory=dict)  # mode -> wall time of its runs [s]
+
+    @property
+    def differences(self) -> list:
+        """:class:`ModeDifference` of every check that ran in both modes."""
+        dyn = {(c.case, c.quantity): c for c in self.checks if c.mode == "dynamic"}
+        out = []
+        for c in self.checks:
+            d = dyn.get((c.case, c.quantity))
+            if c.mode == "steady" and d is not None:
+                out.append(ModeDifference(c.case, c.quantity, d.value, c.value, d.scatter))
+        return out
 
 
 def _shipped(*parts: str, fast: bool) -> tuple[Path, str]:
@@ -85,15 +128,15 @@ def _shipped(*parts: str, fast: bool) -> tuple[Path, str]:
     return data_path("scenarios", *parts), "/".join(("scenarios",) + parts)
 
 
-def _run(case, name, fast, out_dir, quiet, vr: ValidationRun, progress):
+def _run(case, name, fast, out_dir, quiet, vr: ValidationRun, progress, mode: str = "dynamic"):
     from .run import run_scenario
     path, shown = _shipped(f"{name}.toml", fast=fast)
     if progress is not None:
-        progress(f"validate: running {case} ({shown})")
-    res = run_scenario(path, Path(out_dir) / name, quiet=quiet, plots=True)
-    vr.runs[case] = res
+        progress(f"validate: running {case} ({shown}, {mode})")
+    res = run_scenario(path, Path(out_dir) / name, quiet=quiet, plots=True, mode=mode)
+    (vr.runs if mode == "dynamic" else vr.steady_runs)[case] = res
     if res.summary["status"] == "failed":
-        vr.failures.append((case, res.summary["message"]))
+        vr.failures.append((f"{case} ({mode})", res.summary["message"]))
     return res
 
 
@@ -101,82 +144,116 @@ def _tol(key, fast):
     return TOLERANCES[key][1 if fast else 0]
 
 
+def _scatter(res, what="pull_force_N") -> float | None:
+    """Relative steady scatter std/mean of a dynamic run's pulling force (None for a steady solve)."""
+    s = res.summary
+    if s.get("mode") == "steady" or not s.get(what):
+        return None
+    std = s.get("pull_force_std_N") if what == "pull_force_N" else None
+    return None if std is None else abs(std / s[what])
+
+
 def validate(fast: bool = False, out_dir="validation", quiet: bool = True, cases=None,
-             progress: Callable[[str], None] | None = None) -> ValidationRun:
-    """Run the validation set, write its table and figures into ``out_dir``; returns the checks
-    (see :class:`Check`).
+             progress: Callable[[str], None] | None = None, modes=MODES) -> ValidationRun:
+    """Run the validation set in each solver mode, write its table and figures into ``out_dir``;
+    returns the checks (see :class:`Check`) and, where both modes ran, their differences
+    (:attr:`ValidationRun.differences`).
 
     Parameters
     ----------
     fast : bool
         The coarse variants (``scenarios/fast``) with their looser tolerances.
     out_dir : str or os.PathLike
-        Where ``validation.csv``, ``validation.md``, the figures and each run's results go.
+        Where ``validation.csv``, ``validation.md``, the figures and each run's results go
+        (dynamic runs in ``out_dir/<scenario>``, steady ones in ``out_dir/steady/<scenario>``).
     quiet : bool
         No progress bar in the runs.
     cases : iterable of str, optional
         A subset of :data:`CASES` (default: all).
     progress : callable, optional
         Called with one line of text as each case starts.
+    modes : iterable of {"dynamic", "steady"}
+        The solver modes to run (default both).
     """
     ref = load_reference()
     vr = ValidationRun()
     t0 = time.perf_counter()
     wanted = set(cases or CASES)
     out = Path(out_dir)
-
-    if "ex1" in wanted:
-        r = _run("Ex. 1", "paper_ex1_incline", fast, out, quiet, vr, progress)
-        T50 = ref["example1"]["pull_force_N"]
-        slope = ref["example1"]["tension_slope_N_per_m"]
-        vr.checks.append(Check("Ex. 1", "pulling force at the top end [N]", r.summary["pull_force_N"], T50,
-                               _tol("ex1_top", fast), note="Eq. 25"))
-        x = np.asarray(r.tension_profile["x_m"])
-        N = np.asarray(r.tension_profile["tension_N"])
-        worst = float(np.max(np.abs(N - slope * x)))
-        vr.checks.append(Check("Ex. 1", "max |T(x) - Eq. 25| along the cable / T(50 m)", T50 + worst, T50,
-                               _tol("ex1_profile", fast), scale=T50, note="Fig. 7"))
-    if "ex2" in wanted:
-        r = _run("Ex. 2", "paper_ex2_bend90", fast, out, quiet, vr, progress)
-        T1 = ref["example2"]["pull_force_N"]
-        paper = abs(ref["example2"].get("pull_force_reported_N", float("nan")) / T1 - 1)
-        vr.checks.append(Check("Ex. 2", "pulling force T1 [N]", r.summary["pull_force_N"], T1,
-                               _tol("ex2", fast), paper_error=paper, note="Eq. 26, capstan"))
-    if "ex3" in wanted:
-        r = _run("Ex. 3", "paper_ex3_helix", fast, out, quiet, vr, progress)
-        T2 = ref["example3"]["back_tension_N"]
-        vr.checks.append(Check("Ex. 3", "trailing tension T2 [N]", r.summary["trailing_tension_N"], T2,
-                               _tol("ex3", fast), paper_error=ref["example3"].get("relative_error_reported"),
-                               note="Eq. 26 with the exact helix angle"))
-    if "fig12" in wanted:
-        _fig12(ref, fast, out, quiet, vr, progress)
-    if "ex4" in wanted:
-        r = _run("Ex. 4", "paper_ex4_spatial", fast, out, quiet, vr, progress)
-        vr.checks.append(Check("Ex. 4", "pulling force vs rope solver [N]", r.summary["pull_force_N"],
-                               r.summary["rope_pull_force_N"], _tol("ex4", fast),
-                               note="independent rope solution (paper: RecurDyn)"))
+    for mode in modes:
+        tm = time.perf_counter()
+        _mode_checks(ref, vr, wanted, fast, out if mode == "dynamic" else out / "steady", quiet, progress, mode)
+        vr.mode_wall_time_s[mode] = time.perf_counter() - tm
     vr.wall_time_s = time.perf_counter() - t0
     write_report(vr, out, fast)
     return vr
 
 
-def _fig12(ref, fast, out, quiet, vr, progress):
-    from .sweep import load_sweep, run_sweep
+def _mode_checks(ref, vr, wanted, fast, out, quiet, progress, mode):
+    def check(case, quantity, value, reference, tol, res, **kw):
+        vr.checks.append(Check(case, quantity, value, reference, tol, mode=mode,
+                               scatter=_scatter(res), **kw))
+
+    if "ex1" in wanted:
+        r = _run("Ex. 1", "paper_ex1_incline", fast, out, quiet, vr, progress, mode)
+        T50 = ref["example1"]["pull_force_N"]
+        slope = ref["example1"]["tension_slope_N_per_m"]
+        check("Ex. 1", "pulling force at the top end [N]", r.summary["pull_force_N"], T50,
+              _tol("ex1_top", fast), r, note="Eq. 25")
+        x = np.asarray(r.tension_profile["x_m"])
+        N = np.asarray(r.tension_profile["tension_N"])
+        worst = float(np.max(np.abs(N - slope * x)))
+        check("Ex. 1", "max |T(x) - Eq. 25| along the cable / T(50 m)", T50 + worst, T50,
+              _tol("ex1_profile", fast), r, scale=T50, note="Fig. 7")
+    if "ex2" in wanted:
+        r = _run("Ex. 2", "paper_ex2_bend90", fast, out, quiet, vr, progress, mode)
+        T1 = ref["example2"]["pull_force_N"]
+        paper = abs(ref["example2"].get("pull_force_reported_N", float("nan")) / T1 - 1)
+        check("Ex. 2", "pulling force T1 [N]", r.summary["pull_force_N"], T1,
+              _tol("ex2", fast), r, paper_error=paper, note="Eq. 26, capstan")
+    if "ex3" in wanted:
+        r = _run("Ex. 3", "paper_ex3_helix", fast, out, quiet, vr, progress, mode)
+        T2 = ref["example3"]["back_tension_N"]
+        check("Ex. 3", "trailing tension T2 [N]", r.summary["trailing_tension_N"], T2,
+              _tol("ex3", fast), r, paper_error=ref["example3"].get("relative_error_reported"),
+              note="Eq. 26 with the exact helix angle")
+    if "fig12" in wanted:
+        _fig12(ref, fast, out, quiet, vr, progress, mode)
+    if "ex4" in wanted:
+        r = _run("Ex. 4", "paper_ex4_spatial", fast, out, quiet, vr, progress, mode)
+        check("Ex. 4", "pulling force vs rope solver [N]", r.summary["pull_force_N"],
+              r.summary["rope_pull_force_N"], _tol("ex4", fast), r,
+              note="independent rope solution (paper: RecurDyn)")
+
+
+def _fig12(ref, fast, out, quiet, vr, progress, mode="dynamic"):
+    from .scenario import read_toml
+    from .sweep import run_sweep
+    from .sweep.spec import parse_sweep
     path, shown = _shipped("sweeps", "paper_fig12_coils.toml", fast=fast)
     if progress is not None:
-        progress(f"validate: running Fig. 12 ({shown})")
-    sweep = load_sweep(path)
+        progress(f"validate: running Fig. 12 ({shown}, {mode})")
+    data = read_toml(path, "sweep")
+    data.setdefault("set", {})["solver.mode"] = mode
+    sweep = parse_sweep(data, Path(path).parent, default_name=Path(path).stem)
+    object.__setattr__(sweep, "source_path", Path(path).resolve())
     rows = run_sweep(sweep, out / "fig12", quiet=quiet)
-    vr.sweep_rows = rows
+    if mode == "dynamic":
+        vr.sweep_rows = rows
+    else:
+        vr.steady_sweep_rows = rows
     expected = dict(zip(ref["fig12"]["coils"], ref["fig12"]["pull_force_N"]))
     key = next(k for k in rows[0] if k.endswith("helix_turns"))
     for row in rows:
         n = float(row[key])
         value = float(row["pull_force_N"]) if row.get("status") in ("ok", "steady") else float("nan")
         if row.get("status") not in ("ok", "steady"):
-            vr.failures.append((f"Fig. 12 n = {n:g}", row.get("message", "")))
+            vr.failures.append((f"Fig. 12 n = {n:g} ({mode})", row.get("message", "")))
+        std = row.get("pull_force_std_N")
+        scatter = (abs(float(std) / value) if mode == "dynamic" and std not in (None, "") and np.isfinite(value)
+                   and value else None)
         vr.checks.append(Check("Fig. 12", f"pulling force, {n:g} coils [N]", value, expected[int(round(n))],
-                               _tol("fig12", fast), note="10 e^(0.1 beta(n))"))
+                               _tol("fig12", fast), note="10 e^(0.1 beta(n))", mode=mode, scatter=scatter))
 
 
 def _fmt(v, digits=6):
@@ -186,18 +263,27 @@ def _fmt(v, digits=6):
 
 
 def table_rows(vr: ValidationRun):
-    header = ["case", "quantity", "exucable", "reference", "rel. error", "tolerance", "paper's error", "pass"]
+    header = ["case", "quantity", "mode", "exucable", "reference", "rel. error", "tolerance", "paper's error", "pass"]
     rows = []
     for c in vr.checks:
-        rows.append([c.case, c.quantity, _fmt(c.value), _fmt(c.reference), f"{100 * c.rel_error:.3f} %",
+        rows.append([c.case, c.quantity, c.mode, _fmt(c.value), _fmt(c.reference), f"{100 * c.rel_error:.3f} %",
                      f"{100 * c.tolerance:.2f} %",
                      "-" if c.paper_error is None or not math.isfinite(c.paper_error) else f"{100 * c.paper_error:.2f} %",
                      "PASS" if c.passed else "FAIL"])
     return header, rows
 
 
-def format_table(vr: ValidationRun) -> str:
-    header, rows = table_rows(vr)
+def difference_rows(vr: ValidationRun):
+    header = ["case", "quantity", "dynamic", "steady", "steady - dynamic", "dynamic scatter", "bound", "agree"]
+    rows = []
+    for d in vr.differences:
+        rows.append([d.case, d.quantity, _fmt(d.dynamic), _fmt(d.steady), f"{100 * d.rel_difference:+.3f} %",
+                     "-" if d.scatter is None else f"{100 * d.scatter:.3f} %", f"{100 * d.tolerance:.2f} %",
+                     "yes" if d.agrees else "NO"])
+    return header, rows
+
+
+def _text_table(header, rows) -> str:
     widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
     line = "  ".join(h.ljust(w) for h, w in zip(header, widths))
     out = [line, "-" * len(line)]
@@ -205,22 +291,36 @@ def format_table(vr: ValidationRun) -> str:
     return "\n".join(out)
 
 
+def format_table(vr: ValidationRun) -> str:
+    text = _text_table(*table_rows(vr))
+    if vr.differences:
+        text += "\n\nSteady against dynamic (see reference/README.md where they differ):\n"
+        text += _text_table(*difference_rows(vr))
+    return text
+
+
 def write_report(vr: ValidationRun, out: Path, fast: bool) -> None:
     header, rows = table_rows(vr)
     out.mkdir(parents=True, exist_ok=True)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["case", "quantity", "exucable", "reference", "rel_error", "tolerance", "paper_error", "passed"])
+    w.writerow(["case", "quantity", "mode", "exucable", "reference", "rel_error", "tolerance", "paper_error",
+                "passed", "scatter"])
     for c in vr.checks:
-        w.writerow([c.case, c.quantity, repr(float(c.value)), repr(float(c.reference)), repr(c.rel_error),
-                    c.tolerance, "" if c.paper_error is None else c.paper_error, c.passed])
+        w.writerow([c.case, c.quantity, c.mode, repr(float(c.value)), repr(float(c.reference)), repr(c.rel_error),
+                    c.tolerance, "" if c.paper_error is None else c.paper_error, c.passed,
+                    "" if c.scatter is None else c.scatter])
     atomic_write_text(out / "validation.csv", buf.getvalue())
     md = [f"# exucable validation ({'fast variants' if fast else 'paper fidelity'})", "",
           "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     md += ["| " + " | ".join(str(x) for x in r) + " |" for r in rows]
-    md += ["", f"Wall time {vr.wall_time_s:.1f} s."]
+    if vr.differences:
+        dh, dr = difference_rows(vr)
+        md += ["", "## Steady against dynamic", "", "| " + " | ".join(dh) + " |", "|" + "---|" * len(dh)]
+        md += ["| " + " | ".join(str(x) for x in r) + " |" for r in dr]
+    times = ", ".join(f"{m} {t:.1f} s" for m, t in vr.mode_wall_time_s.items())
+    md += ["", f"Wall time {vr.wall_time_s:.1f} s ({times})."]
     for case, msg in vr.failures:
         md.append(f"- {case}: run failed: {msg}")
     atomic_write_text(out / "validation.md", "\n".join(md) + "\n")
     plot_validation_figures(vr, out, load_reference())
-

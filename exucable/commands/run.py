@@ -19,6 +19,9 @@ def add_arguments(p) -> None:
     p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    p.add_argument("--mode", choices=("dynamic", "steady"), default=None,
+                   help="dynamic time integration or one static solve of steady sliding "
+                        "(overrides solver.mode)")
     p.add_argument("--steady-stop", dest="steady_stop", action="store_true", default=None,
                    help="stop once the pulling force is steady (overrides solver.steady_stop)")
     p.add_argument("--no-steady-stop", dest="steady_stop", action="store_false",
@@ -32,7 +35,8 @@ def _f(value, fmt=".6g") -> str:
 def main(args) -> int:
     sc = load_scenario(args.scenario)
     out_dir = Path(args.out) if args.out else Path("out") / sc.name
-    res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop)
+    res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
+                       mode=args.mode)
     s = res.summary
     rope = s.get("rope_pull_force_N")
     print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
@@ -48,8 +52,12 @@ def main(args) -> int:
     ref_c = s.get("rope_clearance_pull_force_N")
     if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
         print(f"  rope with clearance: pulling force {ref_c:.6g} N ({100 * (got / ref_c - 1):+.3f} %)")
-    print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
-          f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    if s.get("mode") == "steady":
+        print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    else:
+        print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
     m = s.get("mesh") or {}
     if m:

@@ -283,6 +283,29 @@ def _closest_points(tab, seg, cand, c0, c1, sel, open_first, open_last, smooth, 
                        tab[_RZ], tab[_AX], tab[_AY], tab[_AZ], seg_piece, pieces, seg_phi, n_newton)
 
 
+@njit(inline="always", **_JIT)
+def _add_generalized_force(tab, n1, n2, n3, n4, le, b, force):
+    """Q_e += Σ_k S(ξ_k)ᵀ F_k for the element whose coordinates start at force[b] (slope rows
+    carry the factor L)."""
+    n_k = n1.shape[0]
+    fxr = tab[_FX]
+    fyr = tab[_FX + 1]
+    fzr = tab[_FX + 2]
+    for a in range(4):
+        na = n1 if a == 0 else (n2 if a == 1 else (n3 if a == 2 else n4))
+        scale = le if (a == 1 or a == 3) else 1.0
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
+        for k in range(n_k):
+            sx += na[k] * fxr[k]
+            sy += na[k] * fyr[k]
+            sz += na[k] * fzr[k]
+        force[b + 3 * a] += scale * sx
+        force[b + 3 * a + 1] += scale * sy
+        force[b + 3 * a + 2] += scale * sz
+
+
 @njit(**_JIT)
 def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open_first, open_last):
     """Contact search only (no force law): nearest segment of every check point, -1 if none."""
@@ -371,23 +394,7 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
                       exponent_mode, inv_onset)
         _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
-        # Q_e = Σ S(ξ)ᵀ F (slope rows carry the factor L)
-        fxr = tab[_FX]
-        fyr = tab[_FX + 1]
-        fzr = tab[_FX + 2]
-        for a in range(4):
-            na = n1 if a == 0 else (n2 if a == 1 else (n3 if a == 2 else n4))
-            scale = le if (a == 1 or a == 3) else 1.0
-            sx = 0.0
-            sy = 0.0
-            sz = 0.0
-            for k in range(n_k):
-                sx += na[k] * fxr[k]
-                sy += na[k] * fyr[k]
-                sz += na[k] * fzr[k]
-            force[b + 3 * a] += scale * sx
-            force[b + 3 * a + 1] += scale * sy
-            force[b + 3 * a + 2] += scale * sz
+        _add_generalized_force(tab, n1, n2, n3, n4, le, b, force)
         if not jacobian:
             continue
         _point_jacobians(tab, n_k, stiffness, damping)

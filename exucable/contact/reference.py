@@ -166,6 +166,14 @@ class ReferenceKernel:
                 "residual_m": st["residual"], "normal_force_N": law["f"],
                 "sliding_velocity_m_per_s": law["slip"], "friction_force_N": law["friction"]}
 
+    #: True when the check points' velocities are a function of q (see :meth:`_velocity_map`)
+    velocity_from_coordinates = False
+
+    def _velocity_map(self, shape, q, q_t):
+        """(shape table, coordinates) whose product gives the check points' velocities:
+        v = S(ξ) q̇ (Eq. 8). A subclass may derive v from q instead (steady sliding)."""
+        return shape, q_t
+
     def _state(self, q, q_t, jacobian):
         k = self.k
         n_el, n_k = k.n_elements, k.n_check_points
@@ -173,7 +181,8 @@ class ReferenceKernel:
         shape[:, :, 1] *= k.element_length_m[:, None]
         shape[:, :, 3] *= k.element_length_m[:, None]
         p = np.einsum("ekA,eAi->eki", shape, _element_values(q))  # Eq. 2
-        v = np.einsum("ekA,eAi->eki", shape, _element_values(q_t))  # Eq. 8
+        rate_shape, rate_source = self._velocity_map(shape, q, q_t)
+        v = np.einsum("ekA,eAi->eki", rate_shape, _element_values(rate_source))  # Eq. 8
         offsets, indices = self.candidates(q)
         segment = np.full((n_el, n_k), -1, dtype=np.int64)
         t = np.full((n_el, n_k), np.nan)
@@ -203,7 +212,7 @@ class ReferenceKernel:
         law = _point_law(residual.reshape(-1, 3), v.reshape(-1, 3), axis_inside.reshape(-1, 3),
                          w.reshape(-1), k.law, k.gap_m, jacobian)
         return {"p": p.reshape(-1, 3), "v": v.reshape(-1, 3), "segment": segment.reshape(-1),
-                "t": t.reshape(-1), "shape": shape, "law": law, "phi": phi,
+                "t": t.reshape(-1), "shape": shape, "rate_shape": rate_shape, "law": law, "phi": phi,
                 "residual": residual.reshape(-1, 3)}
 
     def evaluate(self, q, q_t, jacobian):
@@ -229,5 +238,10 @@ class ReferenceKernel:
             jv = law["jv"].reshape(n_el, n_k, 3, 3)
             # (N Nᵀ) ⊗ J per point, summed over the element's points
             jq = np.einsum("ekA,ekB,ekij->eAiBj", shape, shape, jp).reshape(n_el, 12, 12)
-            jqt = np.einsum("ekA,ekB,ekij->eAiBj", shape, shape, jv).reshape(n_el, 12, 12)
+            jv_blocks = np.einsum("ekA,ekB,ekij->eAiBj", shape, st["rate_shape"], jv).reshape(n_el, 12, 12)
+            if self.velocity_from_coordinates:   # v depends on q, not on q̇
+                jq += jv_blocks
+                jqt = np.zeros_like(jq)
+            else:
+                jqt = jv_blocks
         return force, jq, jqt, n_contact, max_pen

@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # names for the annotations only
     from .rig import TangentialDrive
     from .startup import StartupDamper
 
-__all__ = ["CableInConduit", "Model", "JoinToMarker", "ReelOnto", "add_cable_in_conduit", "build_model",
+__all__ = ["CableInConduit", "Model", "JoinToMarker", "ReelOnto", "LoadScale", "add_cable_in_conduit", "build_model",
            "pull_oriented_conduit"]
 
 
@@ -112,6 +112,7 @@ class CableInConduit:
     back_tension_N: float = 0.0
     rope: RopeSolution | None = None
     mesh: MeshPlan | None = None
+    load_scale: LoadScale | None = None
     coupling: ContactCoupling | None = None
     kernel: ContactKernel | None = None
     startup_damper: StartupDamper | None = None
@@ -180,6 +181,33 @@ class CableInConduit:
         if self.trail_drive is None:
             return None
         return -self.trail_drive.force_N(self.mbs)
+
+
+class LoadScale:
+    """Scale factors [-] of the loads of a steady (static) solve, the continuation parameters of
+    :func:`exucable.solve_steady.solve_steady`: gravity and the end forces (back tension or the
+    applied pull). All 1 = the scenario's loads. The loads carry no user function (Exudyn would
+    call it once per element and residual); :meth:`apply` rewrites their load vectors instead."""
+
+    def __init__(self):
+        self.gravity = 1.0
+        self.end_force = 1.0
+        self._gravity_loads: list[tuple[int, list]] = []
+        self._end_loads: list[tuple[int, list]] = []
+
+    def track(self, gravity_loads=(), end_loads=(), vectors=None) -> None:
+        """Remember loads (indices) and their full-scale vectors [N or m/s²]."""
+        for i in gravity_loads:
+            self._gravity_loads.append((i, vectors[i]))
+        for i in end_loads:
+            self._end_loads.append((i, vectors[i]))
+
+    def apply(self, mbs, gravity: float, end_force: float) -> None:
+        """Set the factors and rewrite the loads' vectors."""
+        self.gravity, self.end_force = float(gravity), float(end_force)
+        for loads, f in ((self._gravity_loads, self.gravity), (self._end_loads, self.end_force)):
+            for i, vec in loads:
+                mbs.SetLoadParameter(i, "loadVector", [f * x for x in vec])
 
 
 @dataclass(eq=False, repr=False)
@@ -282,21 +310,36 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         scenario=sc, mbs=mbs, conduit=conduit, cable=cable, layout=layout, start=start, properties=props,
         leading_marker=mbs.AddMarker(MarkerNodePosition(nodeNumber=lead_node)),
         trailing_marker=mbs.AddMarker(MarkerNodePosition(nodeNumber=trail_node)),
-        back_tension_N=sc.pull.back_tension_N, rope=start.rope, mesh=start.mesh)
+        back_tension_N=sc.pull.back_tension_N, rope=start.rope, mesh=start.mesh, load_scale=LoadScale())
 
+    # steady mode: a static solve of the steady sliding state; the rig holds the leading end
+    # (or, for a force-controlled pull, the trailing end) where the start put it, and the loads'
+    # scale is the continuation parameter of exucable.solve_steady, not time
+    steady = sc.solver.mode == "steady"
+    if steady and not sc.solver.pretension:
+        raise ModelError("solver.pretension", 'solver.mode = "steady" starts from the rope solution near the '
+                         "steady state; set it to true (or use the dynamic mode)")
     ramp_time = sc.pull.ramp_time_s
-    factor = None if ramp_time <= 0 else (lambda t: smooth_ramp(t, ramp_time))
+    factor = None if (steady or ramp_time <= 0) else (lambda t: smooth_ramp(t, ramp_time))
     g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
     if g > 0:
-        add_gravity(mbs, cable, [0.0, 0.0, -g], factor)
+        gravity_vector = [0.0, 0.0, -g]
+        loads = add_gravity(mbs, cable, gravity_vector, factor)
+        h.load_scale.track(gravity_loads=loads, vectors={i: gravity_vector for i in loads})
     speed = sc.pull.speed_m_per_s
+    rig_speed = 0.0 if steady else speed
     t_exit, t_entry = start.exit_tangent, start.entry_tangent
 
+    def end_force(node, vec):
+        vec = list(vec)
+        i = add_end_force(mbs, node, vec, factor)
+        h.load_scale.track(end_loads=[i], vectors={i: vec})
+
     if leading == "rig":
-        h.lead_drive = add_drive(mbs, lead_node, t_exit, speed, ramp_time)
+        h.lead_drive = add_drive(mbs, lead_node, t_exit, rig_speed, ramp_time)
     elif leading == "force":
         h.applied_pull_force_N = sc.pull.force_N
-        add_end_force(mbs, lead_node, sc.pull.force_N * t_exit, factor)
+        end_force(lead_node, sc.pull.force_N * t_exit)
     elif isinstance(leading, JoinToMarker):
         mbs.AddObject(ObjectJointSpherical(markerNumbers=[leading.marker, h.leading_marker],
                                            visualization={"show": False, "jointRadius": 0.0, "color": [-1.0, -1.0, -1.0, -1.0]}))
@@ -305,9 +348,11 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
 
     if trailing == "back_tension":
         if sc.pull.back_tension_N > 0:
-            add_end_force(mbs, trail_node, -sc.pull.back_tension_N * t_entry, factor)
+            end_force(trail_node, -sc.pull.back_tension_N * t_entry)
     elif trailing == "brake":
-        if ramp_time > 0.0:
+        if steady:
+            h.trail_drive = add_drive(mbs, trail_node, t_entry, 0.0)
+        elif ramp_time > 0.0:
             h.trail_drive = add_drive(mbs, trail_node, t_entry, speed, ramp_time)
         else:
             h.trail_drive = add_tangential_drive(mbs, trail_node, t_entry, speed)
@@ -324,13 +369,17 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
                          static_friction=ct.static_friction, stribeck_velocity_m_per_s=ct.stribeck_velocity_m_per_s,
                          regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s,
                          damping_onset_m=ct.damping_onset_m)
-        h.kernel = ContactKernel(conduit.segments, layout.element_length_m, c.radius_m, law,
-                                 start.mesh.check_points_per_element, rule=ct.check_point_rule,
-                                 reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
-                                 surface=ct.surface, centreline=centre)
+        kernel_type, extra = ContactKernel, {}
+        if steady:
+            from ..contact.steady import SteadySlidingKernel
+            kernel_type, extra = SteadySlidingKernel, {"speed_m_per_s": speed}
+        h.kernel = kernel_type(conduit.segments, layout.element_length_m, c.radius_m, law,
+                               start.mesh.check_points_per_element, rule=ct.check_point_rule,
+                               reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
+                               surface=ct.surface, centreline=centre, **extra)
         h.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, h.kernel)
         sp = sc.solver
-        if sp.pretension and sp.startup_time_s > 0.0:
+        if sp.pretension and sp.startup_time_s > 0.0 and not steady:
             Le = layout.element_length_m
             lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
             h.startup_damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)

@@ -1,0 +1,216 @@
+"""Contact kernel of steady sliding: the friction direction from the cable's own tangent.
+
+In a steady pull the cable's shape is fixed in space and its material flows along it toward the
+leading end. A material point at element coordinate ξ then moves with
+
+    v(ξ) = V ∂r/∂x = V S'(ξ) q_e,
+
+V the pull speed [m/s] and x the material (unstretched) arc length, so v is a function of the
+coordinates q, not of the nodal rates q̇ (which are zero in a static solve). Everything else is the
+dynamic kernel's (paper Eqs. 14-23): the normal law with its damping on δ̇ = n·v, friction
+-μ f_n v_τ/√(|v_τ|² + ε²) against the sliding direction. Its derivative with respect to q gains
+the term of the velocity's dependence on the slopes,
+
+    ∂Q_e/∂q_e = Σ_k S_kᵀ (∂F/∂P) S_k + Σ_k S_kᵀ (∂F/∂v) V S'_k,
+
+which the compiled path accumulates from the sixteen products N_a N'_b (not symmetric in a, b).
+
+|∂r/∂x| = 1 + ε: the material speed is taken as V (the pull speed) everywhere rather than
+V (1 + ε)/(1 + ε_lead); the difference (strain, < 1e-3 on the paper's examples) changes only the
+regularisation factor V/√(V² + ε²) (by < 1e-6 at V = 0.1 m/s, ε = 1e-3 m/s) and the contact
+damping's share, whose entry and exit contributions cancel along a contact zone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numba import njit
+
+from .checkpoints import hermite_unit
+from .kernel import ContactKernel
+from .reference import ReferenceKernel
+from .fast import (_JIT, _PAIRS, _J0, _PX, _PY, _PZ, _BEST, _RX, _RY, _RZ, _AX, _AY, _AZ, _BEYOND,
+                   _VX, _VY, _VZ, _accumulate_blocks, _add_generalized_force, _exponent_mode, _friction, _nearest_segments,
+                   _normal_force, _normals, _point_jacobians, _positions, _refine_smooth)
+from .smooth import NEWTON_ITERATIONS
+
+__all__ = ["SteadySlidingKernel", "hermite_unit_derivative"]
+
+
+def hermite_unit_derivative(xi) -> np.ndarray:
+    """dN/dξ of the unit-length Hermite functions of :func:`hermite_unit`, shape (..., 4) [-]."""
+    x = np.asarray(xi, dtype=float)
+    x2 = x * x
+    return np.stack([-6.0 * x + 6.0 * x2, 1.0 - 4.0 * x + 3.0 * x2, 6.0 * x - 6.0 * x2, 3.0 * x2 - 2.0 * x],
+                    axis=-1)
+
+
+class SteadySlidingKernel(ContactKernel):
+    """:class:`~exucable.contact.ContactKernel` whose check points move as in steady sliding.
+
+    Parameters are those of :class:`~exucable.contact.ContactKernel`, plus
+
+    speed_m_per_s : float
+        Pull speed V [m/s]; material flows toward the last node (the leading end).
+
+    ``evaluate(q, q_t)`` and ``points(q, q_t)`` ignore ``q_t``; the ``jac_q_blocks`` are the full
+    derivative (including the velocity's dependence on q) and the ``jac_qt_blocks`` are zero.
+    """
+
+    def __init__(self, *args, speed_m_per_s: float, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.speed_m_per_s = float(speed_m_per_s)
+        self._dnh = hermite_unit_derivative(self.xi)
+        self._base_law = self.law
+        reference = _SteadyReference(self)
+        if self.backend == "numba":
+            self._impl = _SteadyFast(self._impl, self._dnh, self.speed_m_per_s, reference)
+        else:
+            self._impl = reference
+
+    def set_friction_scale(self, scale: float) -> None:
+        """Scale μ_k and μ_s by ``scale`` [-] (a continuation parameter; 1 = the scenario's law)."""
+        base = self._base_law
+        law = replace(base, friction=scale * base.friction,
+                      static_friction=None if base.static_friction is None else scale * base.static_friction)
+        self.law = law
+        if isinstance(self._impl, _SteadyFast):
+            self._impl.fast.law = law
+
+
+class _SteadyReference(ReferenceKernel):
+    """numpy backend: v = V ∂r/∂x, its derivative folded into ∂Q/∂q."""
+
+    velocity_from_coordinates = True
+
+    def _velocity_map(self, shape, q, q_t):
+        # V ∂r/∂x: positions' columns dN/dξ / L, slopes' columns dN/dξ (L N_unit differentiated)
+        k = self.k
+        L = k.element_length_m[:, None]
+        d = np.broadcast_to(k._dnh, shape.shape).copy()
+        d[:, :, 0] /= L
+        d[:, :, 2] /= L
+        return k.speed_m_per_s * d, q
+
+
+@njit(inline="always", **_JIT)
+def _accumulate_rate_blocks(tab, cross_t, le, speed, acc, bq):
+    """Add Σ_k S_kᵀ (∂F/∂v)_k V S'_k to the element block ``bq`` (16 products N_a N'_b)."""
+    n_k = cross_t.shape[1]
+    for p in range(16):
+        cp = cross_t[p]
+        for col in range(9):
+            jc = tab[_J0 + 9 + col]
+            s = 0.0
+            for k in range(n_k):
+                s += cp[k] * jc[k]
+            acc[p, col] = s
+    for a in range(4):
+        row_scale = le if (a == 1 or a == 3) else 1.0     # S: slope functions carry L
+        for b in range(4):
+            col_scale = 1.0 if (b == 1 or b == 3) else 1.0 / le   # S' = dS/dx
+            scale = speed * row_scale * col_scale
+            p = 4 * a + b
+            for i in range(3):
+                for j in range(3):
+                    bq[3 * a + i, 3 * b + j] += scale * acc[p, 3 * i + j]
+
+
+@njit(**_JIT)
+def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, pair_t, pair_ab, cross_t,
+                   omega, seg, off, cand, gap, stiffness, damping, exponent, exponent_mode, mu_k,
+                   dmu, inv_vs2, eps2, inv_href, jacobian, force, jq, scratch, tab, sel, acc,
+                   acc16, open_first, open_last, smooth, seg_piece, pieces, seg_phi, n_newton,
+                   inv_onset):
+    """As :func:`exucable.contact.fast._contact_kernel`, with v = V S'(ξ) q_e."""
+    n_k = n1.shape[0]
+    n_contact = 0
+    max_d2 = -1.0
+    for e in range(length.shape[0]):
+        c0 = off[e]
+        c1 = off[e + 1]
+        if c0 == c1:
+            continue
+        le = length[e]
+        b = 6 * e
+        _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])
+        _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
+                          tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ],
+                          open_first, open_last, tab[_BEYOND])
+        if smooth:
+            _refine_smooth(tab[_PX], tab[_PY], tab[_PZ], seg, sel, tab[_BEST], tab[_RX], tab[_RY],
+                           tab[_RZ], tab[_AX], tab[_AY], tab[_AZ], seg_piece, pieces, seg_phi,
+                           n_newton)
+        n_touch, max_d2 = _normals(tab, n_k, gap, max_d2)
+        if n_touch == 0:
+            continue
+        n_contact += n_touch
+        # v = V ∂r/∂x: _positions with the derivative table gives L ∂r/∂x
+        _positions(q, b, le, d1, d2, d3, d4, tab[_VX], tab[_VY], tab[_VZ])
+        vs = speed / le
+        vx = tab[_VX]
+        vy = tab[_VY]
+        vz = tab[_VZ]
+        for k in range(n_k):
+            vx[k] *= vs
+            vy[k] *= vs
+            vz[k] *= vs
+        _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
+                      exponent_mode, inv_onset)
+        _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
+        _add_generalized_force(tab, n1, n2, n3, n4, le, b, force)
+        if not jacobian:
+            continue
+        _point_jacobians(tab, n_k, stiffness, damping)
+        _accumulate_blocks(tab, pair_t, pair_ab, le, acc, jq[e], scratch)
+        _accumulate_rate_blocks(tab, cross_t, le, speed, acc16, jq[e])
+    max_pen = np.sqrt(max_d2) - gap if max_d2 >= 0.0 else -np.inf
+    return n_contact, max_pen
+
+
+class _SteadyFast:
+    """Compiled steady-sliding evaluation sharing a :class:`~exucable.contact.fast.FastKernel`'s
+    tables, broad phase and work buffers."""
+
+    def __init__(self, fast, dnh_unit, speed_m_per_s, reference):
+        self.fast = fast
+        self.reference = reference
+        self.speed = float(speed_m_per_s)
+        self._d = [np.ascontiguousarray(dnh_unit[:, i]) for i in range(4)]
+        nh = fast.nh
+        self.cross_t = np.ascontiguousarray(
+            np.stack([nh[:, a] * dnh_unit[:, b] for a in range(4) for b in range(4)]))
+        self._acc16 = np.empty((16, 9))
+        self._scratch = np.empty((12, 12))
+
+    def candidates(self, q):
+        return self.fast.candidates(q)
+
+    def point_state(self, q, q_t):
+        """Per check point state (post-processing only: the numpy reference's)."""
+        return self.reference.point_state(q, q_t)
+
+    def evaluate(self, q, q_t, jacobian):
+        """As :meth:`FastKernel.evaluate`; ``q_t`` is ignored and the q̇-blocks are zero."""
+        f = self.fast
+        q = np.ascontiguousarray(q, dtype=float)
+        off, cand = f.candidates(q)
+        force = np.zeros(f.n_coordinates)
+        jq = np.zeros((f.n_el, 12, 12)) if jacobian else f._empty_blocks
+        law = f.law
+        n1, n2, n3, n4 = f._n
+        d1, d2, d3, d4 = self._d
+        n_contact, max_pen = _steady_kernel(
+            q, f.length, n1, n2, n3, n4, d1, d2, d3, d4, self.speed, f.pair_t, _PAIRS, self.cross_t,
+            f.omega, f.seg, off, cand, f.gap, float(law.stiffness), float(law.damping),
+            float(law.exponent), _exponent_mode(law.exponent), float(law.friction),
+            float(law.static_excess), 1.0 / law.stribeck_velocity_m_per_s**2,
+            law.regularisation_velocity_m_per_s**2, f.inv_href, bool(jacobian), force, jq,
+            self._scratch, f._tab, f._sel, f._acc, self._acc16, f.open_first, f.open_last,
+            f.smooth, f.seg_piece, f.pieces, f.seg_phi, NEWTON_ITERATIONS,
+            1.0 / law.damping_onset_m if law.damping_onset_m > 0.0 else 0.0)
+        if not jacobian:
+            return force, None, None, int(n_contact), float(max_pen)
+        return force, jq, np.zeros_like(jq), int(n_contact), float(max_pen)

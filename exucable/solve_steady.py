@@ -1,0 +1,340 @@
+"""Steady sliding in one static solve (``[solver] mode = "steady"``).
+
+At a constant low pull speed the cable reaches a state whose shape and tension no longer change
+in space: its material flows along a fixed curve at the pull speed V. Inertia is then negligible
+(ρA·V² is millinewtons), every check point slides along the cable's own tangent, and the pulling
+force is the reaction of a static equilibrium. The model is the dynamic run's (same ANCF cable,
+contact law, smooth wall, broad phase, gravity, back tension), built by
+:func:`exucable.model.build.build_model` with
+
+- the contact kernel :class:`exucable.contact.steady.SteadySlidingKernel` (friction against the
+  tangent, v = V ∂r/∂x, exact Jacobian);
+- the rig holding the leading end where the start put it (its reaction is the pulling force), or
+  for a force-controlled pull the trailing end (its reaction is the trailing tension);
+
+and solved from the pre-tensioned start (the rope solution) with Exudyn's static solver.
+
+Why pseudo-time steps: the start is near equilibrium, but a full Newton step from it overshoots
+into the wall (Hertz contact is stiff, 1e5-1e6 N/m per node, the free spans are soft), and the
+iterates then bounce between contact states. Where the cable continues a bend's inner wall along
+a straight it grazes that wall with δ → 0 over a long stretch, the Hertz stiffness ∝ δ^(1/2)
+vanishes there, and plain Newton 2-cycles (a check point in contact is pushed out, out of contact
+it falls back in): the "stall near 1e-5" of the first probe. So the solve is pseudo-transient
+continuation (Kelley & Keyes 1998): each static solve adds a spring c·m_k·(q_k - q̄_k) to every
+coordinate, anchored at the previous solve's state q̄ (m_k the lumped nodal mass, times L_e² for
+slopes), which makes every Newton problem well posed; c starts at an element's axial stiffness
+per mass and falls by 4 after each converged solve (rises by 4 after a failed one). The spring's force at convergence is exactly the
+residual of the unregularised equilibrium, so the solve stops once its norm is below
+``STATIC_TOLERANCE`` times the rope solution's largest tension.
+Where that does not converge, the loads themselves are ramped (friction, gravity and end forces
+scaled by λ) with the increment halved on failure.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import exudyn as exu
+
+from .solve import History, Progress, SolveOutcome, quiet_sparse
+from .tension import tension_at, tension_profile
+
+__all__ = ["solve_steady", "static_settings", "STATIC_TOLERANCE"]
+
+#: Residual of the steady equilibrium at which the solve stops, relative to the largest tension of
+#: the rope solution [-]: the spring force c·m·(q - q̄) left at the last pseudo-time step.
+STATIC_TOLERANCE = 1e-6
+
+#: Newton's relative tolerance inside one pseudo-time step (its problem is well posed).
+NEWTON_TOLERANCE = 1e-8
+
+#: Weight of the pseudo-time spring along the cable's axis relative to across it (see
+#: :class:`PseudoTimeSpring`).
+AXIAL_SHARE = 1.0
+
+#: Factor on the axial share after each converged pseudo-time step: the axial mode is linear (EA)
+#: and, on a long cable, so soft (1 km: ~1 s⁻² per unit mass) that a spring falling like the
+#: lateral one would hold it for hundreds of steps.
+AXIAL_RELEASE = 0.25
+
+#: Pseudo-time steps before the solve is declared failed.
+MAX_PSEUDO_STEPS = 80
+
+#: Smallest continuation increment of the load scale before the solve is declared failed.
+MIN_CONTINUATION_STEP = 1.0 / 16.0
+
+
+def initial_spring_rate(model) -> float:
+    """c0 [1/s²]: an element's axial stiffness EA/L_e per its mass ρA·L_e, E/(ρ L_e²) — of the
+    order of the contact stiffness per node, so the first steps are short."""
+    L_e = float(np.min(model.layout.element_length_m))
+    return model.axial_stiffness_N / (model.properties.mass_per_length_kg_per_m * L_e * L_e)
+
+
+def static_settings(tolerance: float = NEWTON_TOLERANCE, max_iterations: int = 12,
+                    absolute_tolerance_N: float = 1e-10) -> exu.SimulationSettings:
+    """Exudyn's static solver settings of one pseudo-time step: one load step, plain Newton."""
+    s = exu.SimulationSettings()
+    ss = s.staticSolver
+    ss.numberOfLoadSteps = 1
+    ss.loadStepDuration = 1.0
+    ss.useLoadFactor = False
+    ss.stabilizerODE2term = 0.0
+    ss.adaptiveStep = False
+    ss.verboseMode = 0
+    ss.newton.useModifiedNewton = False
+    ss.newton.relativeTolerance = tolerance
+    ss.newton.absoluteTolerance = absolute_tolerance_N
+    ss.newton.maxIterations = int(max_iterations)
+    return quiet_sparse(s)
+
+
+class PseudoTimeSpring:
+    """The pseudo-transient term c·m_k·P_k (q_k - q̄_k) on the cable coordinates, as an
+    ``ObjectGenericODE2`` with a force and a sparse Jacobian user function.
+
+    m_k: lumped nodal mass [kg] for positions, times L_e² [kg·m²] for slopes.
+    P_k = I - (1 - AXIAL_SHARE) t tᵀ weights the spring along the cable's tangent t at node k
+    (at the anchor). Measured: releasing the axial direction entirely (share 0) lets a long
+    cable's first Newton step slide it by the start's strain misfit (decimetres on 300 m) and
+    the step fails; the isotropic spring (share 1) solves 300 m in 21 pseudo-time steps.
+    """
+
+    def __init__(self, model):
+        from exudyn.itemInterface import ObjectGenericODE2
+
+        Le = np.asarray(model.layout.element_length_m, dtype=float)
+        rho_a = model.properties.mass_per_length_kg_per_m
+        m_node = rho_a * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
+        L_node = np.maximum(np.concatenate([Le, [0.0]]), np.concatenate([[0.0], Le]))
+        self._q_ref = np.asarray(model.layout.coordinates, dtype=float).reshape(-1)
+        self.n_nodes = len(m_node)
+        self.n = 6 * self.n_nodes
+        # per 3-block (positions, slopes of each node): its mass
+        self.block_mass = np.empty((self.n_nodes, 2))
+        self.block_mass[:, 0] = m_node
+        self.block_mass[:, 1] = m_node * L_node**2
+        self.rate = 0.0                       # c [1/s²]
+        self.axial_share = AXIAL_SHARE        # weight along the tangent [-]
+        self.anchor = np.zeros(self.n)        # q̄ (displacement coordinates)
+        self._proj = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
+        base = 6 * np.arange(self.n_nodes)[:, None, None, None] + 3 * np.arange(2)[None, :, None, None]
+        i3 = np.arange(3)
+        self._rows = (base + i3[None, None, :, None] + 0 * i3[None, None, None, :]).reshape(-1).astype(float)
+        self._cols = (base + i3[None, None, None, :] + 0 * i3[None, None, :, None]).reshape(-1).astype(float)
+        empty = [exu.MatrixContainer() for _ in range(3)]
+        for m in empty:
+            m.Initialize(self.n, self.n, False)
+        mbs = model.mbs
+        self.object = mbs.AddObject(ObjectGenericODE2(
+            nodeNumbers=list(model.cable.nodes), massMatrix=empty[0], stiffnessMatrix=empty[1],
+            dampingMatrix=empty[2], forceUserFunction=self._force, jacobianUserFunction=self._jacobian,
+            visualization={"show": False, "color": [-1.0, -1.0, -1.0, -1.0], "triangleMesh": [],
+                           "showNodes": False, "graphicsDataUserFunction": 0}))
+        mbs.Assemble()
+
+    def anchor_at(self, q_disp) -> None:
+        """Anchor the spring at displacement coordinates ``q_disp`` (tangents taken there)."""
+        self.anchor = np.asarray(q_disp, dtype=float).copy()
+        slope = (self._q_ref + self.anchor).reshape(-1, 6)[:, 3:]
+        t = slope / np.linalg.norm(slope, axis=1, keepdims=True)
+        self._proj = np.eye(3)[None] - (1.0 - self.axial_share) * t[:, :, None] * t[:, None, :]
+
+    def force(self, q) -> np.ndarray:
+        """Generalized force -c·m·P (q - q̄) [N, N·m]."""
+        d = (np.asarray(q, dtype=float) - self.anchor).reshape(self.n_nodes, 2, 3)
+        f = np.einsum("kij,kbj->kbi", self._proj, d) * self.block_mass[:, :, None]
+        return -self.rate * f.reshape(-1)
+
+    def _force(self, mbs, t, item, q, q_t):
+        return self.force(q)
+
+    def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
+        m = exu.MatrixContainer()
+        vals = (f_q * self.rate * self.block_mass[:, :, None, None] * self._proj[:, None, :, :]).reshape(-1)
+        nz = vals != 0.0  # Exudyn's sparse triplets must not contain zeros
+        if not nz.any():
+            m.Initialize(self.n, self.n, False)
+            return m
+        m.SetWithSparseMatrix(np.column_stack([self._rows[nz], self._cols[nz], vals[nz]]), self.n, self.n, False)
+        return m
+
+
+class _StateStore:
+    """Copies of the system's coordinates (displacements and multipliers) to restart from."""
+
+    def __init__(self, mbs):
+        self.mbs = mbs
+        self.saved = self.read()
+
+    def read(self):
+        sd = self.mbs.systemData
+        return (np.array(sd.GetODE2Coordinates()), np.array(sd.GetAECoordinates()))
+
+    def save(self):
+        self.saved = self.read()
+
+    def restore_as_initial(self):
+        """Make the saved state the next solve's start."""
+        sd = self.mbs.systemData
+        q, lam = self.saved
+        for cfg in (exu.ConfigurationType.Initial, exu.ConfigurationType.Current):
+            sd.SetODE2Coordinates(list(q), configuration=cfg)
+            sd.SetAECoordinates(list(lam), configuration=cfg)
+
+
+def steady_forces(model) -> tuple[float, float, float]:
+    """Pulling force, trailing tension and maximum tension [N] of the current static state.
+
+    The static solver's Lagrange multipliers carry the opposite sign of the dynamic solver's
+    (checked: the leading end's reaction then equals its tension EA·ε, tests/test_steady.py).
+    """
+    q, _ = model.coordinates()
+    EA = model.axial_stiffness_N
+    _, N = tension_profile(q, model.layout.element_length_m, EA, points_per_element=2)
+    if model.lead_drive is not None:
+        pull = -model.lead_drive.force_N(model.mbs)
+    else:
+        pull = model.applied_pull_force_N * model.load_scale.end_force
+    if model.trail_drive is not None:
+        trail = model.trail_drive.force_N(model.mbs)
+    else:
+        trail = float(tension_at(q, model.layout.element_length_m, EA, [0.0])[0])
+    return float(pull), float(trail), float(np.max(N))
+
+
+def _outside_points(model) -> int:
+    """Check points with no conduit segment within R of them (outside the conduit, or beyond
+    its open ends where the rig holds the cable)."""
+    q, _ = model.coordinates()
+    q = q.reshape(-1)
+    return int(np.count_nonzero(model.kernel.points(q, np.zeros_like(q)).segment < 0))
+
+
+def _set_scale(model, lam: float) -> None:
+    model.load_scale.apply(model.mbs, gravity=lam, end_force=lam)
+    model.kernel.set_friction_scale(lam)
+
+
+def solve_steady(model, progress: Progress | None = None) -> SolveOutcome:
+    """Solve ``model`` (built with ``solver.mode = "steady"``) for its steady sliding state.
+
+    Pseudo-transient continuation from the pre-tensioned start at the full loads; if that fails,
+    continuation in the load scale λ (friction, gravity, end forces) from the start, each stage
+    solved the same way, the increment doubled after a success and halved after a failure. The
+    history has one row per converged pseudo-time step; its ``time_s`` column holds the step's
+    number [-] (not a time: a static solve has none).
+
+    Never raises for a diverging solve: the outcome has ``status == "failed"`` and the message.
+    """
+    mbs = model.mbs
+    history = History()
+    spring = PseudoTimeSpring(model)
+    store = _StateStore(mbs)
+    start = store.saved
+    counters = {"newton": 0, "jacobian": 0, "steps": 0}
+    scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
+                  model.back_tension_N, 1.0)
+    tolerance_N = STATIC_TOLERANCE * scale_N
+    settings = static_settings(absolute_tolerance_N=1e-3 * tolerance_N)
+    c0 = initial_spring_rate(model)
+    t_wall = time.perf_counter()
+    total = [0]
+
+    def one_solve() -> tuple[bool, str]:
+        solver = exu.MainSolverStatic()
+        try:
+            ok = solver.SolveSystem(mbs, settings)
+            message = "" if ok else (solver.GetErrorString() or "Newton did not converge")
+        except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
+            ok, message = False, f"{type(exc).__name__}: {exc}".strip()
+        counters["newton"] += int(solver.it.newtonStepsCount)
+        counters["jacobian"] += int(solver.it.newtonJacobiCount)
+        return ok, message
+
+    def relax(lam: float) -> tuple[bool, str]:
+        """Pseudo-time steps at load scale ``lam`` from the stored state until the equilibrium
+        residual is below the tolerance."""
+        _set_scale(model, lam)
+        c = c0
+        spring.axial_share = AXIAL_SHARE
+        message = ""
+        for _ in range(MAX_PSEUDO_STEPS):
+            store.restore_as_initial()
+            spring.anchor_at(_cable_part(model, store.saved[0]))
+            spring.rate = c
+            ok, message = one_solve()
+            counters["steps"] += 1
+            if not ok:
+                c *= 4.0
+                if c > 1e6 * c0:
+                    return False, message
+                continue
+            q_now = _cable_part(model, np.array(mbs.systemData.GetODE2Coordinates()))
+            residual = float(np.linalg.norm(spring.force(q_now)))
+            store.save()
+            total[0] += 1
+            pull, trail, tmax = steady_forces(model)
+            history.time_s.append(float(total[0]))
+            history.pull_force_N.append(pull)
+            history.trailing_tension_N.append(trail)
+            history.max_tension_N.append(tmax)
+            if progress is not None:
+                progress.update(min(1.0, tolerance_N / max(residual, 1e-300)),
+                                f"λ = {lam:.3g}, residual {residual:.2e} N, F = {pull:.5g} N")
+            if residual <= tolerance_N:
+                return True, ""
+            c /= 4.0
+            spring.axial_share *= AXIAL_RELEASE
+        return False, f"no equilibrium after {MAX_PSEUDO_STEPS} pseudo-time steps"
+
+    status, message = "ok", ""
+    outside_at_start = _outside_points(model)
+    ok, first_message = relax(1.0)
+    if ok:
+        message = f"{total[0]} pseudo-time steps"
+    else:
+        store.saved = start
+        lam, step, stages = 0.0, 0.5, 0
+        while lam < 1.0:
+            target = min(1.0, lam + step)
+            before = store.saved
+            ok, msg = relax(target)
+            stages += 1
+            if ok:
+                lam = target
+                step = min(2.0 * step, 1.0)
+            else:
+                store.saved = before
+                step *= 0.5
+                if step < MIN_CONTINUATION_STEP:
+                    status = "failed"
+                    message = (f"no steady state found: continuation stalled at load scale {lam:.4g} "
+                               f"(at full load: {first_message}; last: {msg})")
+                    break
+        if status == "ok":
+            message = (f"continuation in the load scale, {stages} stages, {total[0]} pseudo-time steps "
+                       f"(at full load from the start: {first_message})")
+    store.restore_as_initial()
+    spring.rate = 0.0
+    if status == "ok":
+        # an equilibrium with the cable pulled out of the conduit (straight across its walls) is
+        # a solution of the same equations, but not the steady pull
+        outside = _outside_points(model) - outside_at_start
+        if outside > model.kernel.n_check_points:
+            status = "failed"
+            message = (f"the static solve found an equilibrium with {outside} more check points outside "
+                       f"the conduit than at the start: the cable left the conduit (start too far from "
+                       f"the steady state?)")
+    wall = time.perf_counter() - t_wall
+    if progress is not None:
+        progress.close()
+    return SolveOutcome(history=history, status=status, message=message, end_time_s=0.0,
+                        steps=counters["steps"], newton_iterations=counters["newton"],
+                        jacobian_updates=counters["jacobian"], wall_time_s=wall)
+
+
+def _cable_part(model, q_all) -> np.ndarray:
+    """The cable's displacement coordinates out of the system's ODE2 vector."""
+    return np.asarray(q_all, dtype=float)[model.ode2_index]
