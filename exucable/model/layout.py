@@ -252,9 +252,12 @@ def lay_cable(
     t_c = extended_tangent(centreline, ss)
     want = np.linalg.norm(target - C - np.sum((target - C) * t_c, axis=1)[:, None] * t_c, axis=1)
     inside = (ss > 0.0) & (ss < L)
-    normal = basis.T @ basis
+    from scipy.sparse.linalg import factorized
+
+    solve_normal = factorized((basis.T @ basis).tocsc())   # banded normal matrix, factored once
     for _ in range(correction_iterations + 1):
-        coef = np.linalg.solve(normal, basis.T @ target)           # (2(n+1), 3): r_k, r'_k rows
+        rhs = basis.T @ target
+        coef = np.stack([solve_normal(rhs[:, j]) for j in range(3)], axis=1)  # (2(n+1), 3): r_k, r'_k rows
         fitted = basis @ coef
         rel = fitted - C
         lat = rel - np.sum(rel * t_c, axis=1)[:, None] * t_c
@@ -286,15 +289,17 @@ def lay_cable(
 def _hermite_matrix(e, xi, Le, n_elements):
     """Rows of the Hermite basis (paper Eqs. 4-6) on the unknowns [r_0, r'_0, r_1, r'_1, ...]
     (one coordinate direction), at element ``e`` and coordinate ``xi``."""
+    from scipy.sparse import csr_matrix
+
+    # sparse: four entries a row, so the fit's normal matrix is banded and a 1 km cable's start
+    # (thousands of elements) costs milliseconds, not the seconds-to-minutes of a dense O(n³) solve
     m = len(xi)
-    B = np.zeros((m, 2 * (n_elements + 1)))
     L = Le[e]
-    rows = np.arange(m)
-    B[rows, 2 * e] = 1 - 3 * xi**2 + 2 * xi**3
-    B[rows, 2 * e + 1] = L * (xi - 2 * xi**2 + xi**3)
-    B[rows, 2 * e + 2] = 3 * xi**2 - 2 * xi**3
-    B[rows, 2 * e + 3] = L * (-xi**2 + xi**3)
-    return B
+    rows = np.repeat(np.arange(m), 4)
+    cols = (2 * e[:, None] + np.arange(4)[None, :]).ravel()
+    vals = np.stack([1 - 3 * xi**2 + 2 * xi**3, L * (xi - 2 * xi**2 + xi**3),
+                     3 * xi**2 - 2 * xi**3, L * (-xi**2 + xi**3)], axis=1).ravel()
+    return csr_matrix((vals, (rows, cols)), shape=(m, 2 * (n_elements + 1)))
 
 
 def _second_derivative_at_nodes(coef, Le):
