@@ -158,12 +158,13 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         from .solve_steady import solve_steady
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
         h = out.history.arrays()
-        # one static state, the start's extent of cable in the conduit (nothing pulled out yet):
-        # the result is the last (converged) pseudo-time step's; no time history, no scatter
+        # one static state, the start's extent of cable in the conduit (laid out past the exit by
+        # the steady lead-out, model.layout.steady_lead_out_m): the result is the last (converged)
+        # pseudo-time step's; no time history, no scatter
         drift = 0.0
         st = SteadyState(out.status != "failed", 0.0, 0.0, 0.0, 0.0)
         i0 = max(len(h["time_s"]) - 1, 0)
-        refs = extent_references(sc, model, 0.0)
+        refs = extent_references(sc, model, model.start.lead_out_m)
         pf = None
     else:
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
