@@ -368,8 +368,10 @@ class InitialLayout:
 
 
 #: Length of straight cable between the last bend's end and the rig in a steady solve, in bending
-#: lengths √(EJ/T) of the cable at the exit [-] (see :func:`steady_lead_out_m`).
-LEAD_OUT_BENDING_LENGTHS = 5.0
+#: lengths √(EJ/T) of the cable at the exit [-] (see :func:`steady_lead_out_m`). Measured on
+#: Fig. 12's one coil (80 elements, 1.5 m lead-in; 2026-11-29), steady minus capstan at 1 / 2.5 /
+#: 5 / 10 / 20 bending lengths: +0.09 / +0.00 / -0.034 / -0.050 / -0.052 %: settled from 10 on.
+LEAD_OUT_BENDING_LENGTHS = 10.0
 
 
 def steady_lead_out_m(centreline, bending_stiffness_N_m2: float, exit_tension_N: float) -> float:
