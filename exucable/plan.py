@@ -20,6 +20,7 @@ imperial with ``display.units = "imperial"``, converted to SI when the file is r
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -229,7 +230,83 @@ def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: floa
     return out
 
 
-def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
+def _finite_or_none(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry: dict, progress: bool) -> dict:
+    """One direction's plan entry from the multibody model, the rope's values kept beside.
+
+    The scenario is run in ``engine``'s solver mode with ``pull.direction = name`` (the reverse pull is
+    the reversed route). Section tensions are the cable's tension (EA·ε at its nodes) interpolated at
+    the section boundaries along the conduit (``s_conduit_m``); a bend's SWBP is the peak of the
+    windowed sidewall pressure over the bend (:mod:`exucable.pressure`: the contact forces of the check
+    points within ±w/2, over w), with the bend body's mean windowed pressure and the point loads at
+    its ends beside it. A dynamic run's tensions are those of its last state; its pulling force is the
+    mean over its steady window.
+    """
+    from exucable.run import cable_tension_along_conduit, run_scenario  # builds an Exudyn model
+
+    sc = dataclasses.replace(scenario, pull=dataclasses.replace(scenario.pull, direction=name))
+    result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine)
+    summary = result.summary
+    s_c, T_c = cable_tension_along_conduit(result.model)
+    order = np.argsort(s_c)
+    s_c, T_c = np.asarray(s_c, dtype=float)[order], np.asarray(T_c, dtype=float)[order]
+    L = scenario.build_conduit().centreline.length_m
+    to_conduit = (lambda s: s) if name == "forward" else (lambda s: L - s)
+
+    def tension(s_pull):
+        return float(np.interp(to_conduit(s_pull), s_c, T_c))
+
+    bends = iter(summary["bends"] if name == "forward" else summary["bends"][::-1])
+    rows = []
+    running = tension(0.0)
+    for r in rope_entry["sections"]:
+        a, b = r["s_start_m"], r["s_start_m"] + r["length_m"]
+        lo, hi = sorted((to_conduit(a), to_conduit(b)))
+        inside = T_c[(s_c >= lo) & (s_c <= hi)]
+        t_in, t_out = tension(a), tension(b)
+        running = max(running, t_in, t_out, float(np.max(inside)) if inside.size else t_out)
+        row = dict(r, tension_in_N=t_in, tension_out_N=t_out, max_tension_so_far_N=running,
+                   rope_tension_in_N=r["tension_in_N"], rope_tension_out_N=r["tension_out_N"],
+                   rope_sidewall_pressure_N_per_m=r["sidewall_pressure_N_per_m"])
+        if r["sidewall_pressure_N_per_m"] is not None:
+            bend = next(bends)
+            row.update(sidewall_pressure_N_per_m=float(bend["peak_pressure_N_per_m"]),
+                       mean_sidewall_pressure_N_per_m=_finite_or_none(bend["mean_pressure_N_per_m"]),
+                       rope_windowed_sidewall_pressure_N_per_m=float(bend["rope_peak_pressure_N_per_m"]),
+                       entry_point_load_N=float(bend["entry_point_load_N"]),
+                       entry_s_conduit_m=float(bend["entry_s_conduit_m"]),
+                       exit_point_load_N=float(bend["exit_point_load_N"]),
+                       exit_s_conduit_m=float(bend["exit_s_conduit_m"]))
+        rows.append(row)
+    s_pull = np.clip(np.array([to_conduit(s) for s in s_c]), 0.0, L)
+    back = np.argsort(s_pull)
+    pressures = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+    return {
+        "pull_force_N": summary["pull_force_N"],
+        "max_tension_N": max(r["max_tension_so_far_N"] for r in rows),
+        "max_sidewall_pressure_N_per_m": max(pressures) if pressures else None,
+        "slack": rope_entry["slack"],
+        "sections": rows,
+        "profile": {"s_m": s_pull[back].tolist(), "tension_N": T_c[back].tolist()},
+        "rope_pull_force_N": rope_entry["pull_force_N"],
+        "rope_max_tension_N": rope_entry["max_tension_N"],
+        "rope_max_sidewall_pressure_N_per_m": rope_entry["max_sidewall_pressure_N_per_m"],
+        "rope_profile": rope_entry["profile"],
+        "status": summary["status"],
+        "message": summary["message"],
+        "flags": summary.get("flags", []),
+        "pull_force_std_N": summary.get("pull_force_std_N"),
+        "pressure_window_m": summary.get("pressure_window_m"),
+        "elements": int(result.model.layout.element_length_m.size),
+        "wall_time_s": summary["wall_time_s"],
+    }
+
+
+def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress: bool = False) -> dict:
     """Plan a pull in both directions.
 
     Parameters
@@ -238,7 +315,12 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
         Route, cable (one of the ``spec.count`` identical cables), friction, back tension, gravity.
     spec : PlanSpec
     engine : {"rope", "steady", "dynamic"}
-        Only ``"rope"`` is available in this version (see Raises).
+        ``"rope"``: the quasi-static rope (instant). ``"steady"`` / ``"dynamic"``: the multibody model of
+        one cable (:func:`exucable.run.run_scenario` in that solver mode, one run per direction, the
+        reverse run on the reversed route); the rope's values stay beside each section's
+        (``rope_*`` keys), see :func:`_multibody_direction`.
+    progress : bool
+        Show the multibody runs' progress bars on a terminal (stderr).
 
     Returns
     -------
@@ -252,14 +334,14 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
     Raises
     ------
     ExucableError
-        ``engine`` other than ``"rope"``: the multibody engines are not wired into planning yet.
+        An unknown ``engine``; ``cable.count`` > 1 with a multibody engine (it simulates one cable).
     """
     if engine not in ENGINES:
         raise ExucableError(f"--engine: must be one of {', '.join(ENGINES)}, got {engine!r}")
-    if engine != "rope":
-        raise ExucableError(
-            f"--engine {engine}: planning with the multibody model is not available in this version "
-            "(the steady solver is being built; the dynamic one is not wired into `plan` yet); use --engine rope")
+    if engine != "rope" and spec.count != 1:
+        raise ScenarioError("cable.count", f"--engine {engine} simulates one cable, got {spec.count}; plan "
+                                           "several cables per duct with --engine rope (weight correction "
+                                           "factor), or set cable.count = 1")
     if scenario.pull.force_N is not None:
         raise ScenarioError("pull.force", "exucable plan computes the pulling force from the back tension; give "
                                           "pull.back_tension (the reel's) instead of a prescribed pull.force")
@@ -290,6 +372,8 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
             "sections": rows,
             "profile": {"s_m": (rope.s_cable_m).tolist(), "tension_N": rope.tension_N.tolist()},
         }
+        if engine != "rope":
+            entry = _multibody_direction(scenario, name, engine, entry, progress)
         entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
         entry["passed"] = all(c["passed"] for c in entry["checks"])
         if spec.feed_from_reel:

@@ -133,10 +133,18 @@ def test_bad_inputs_are_refused_with_the_key(over, key):
     assert exc.value.key == key
 
 
-def test_multibody_engines_say_they_are_not_available():
+@pytest.mark.parametrize("engine", ["steady", "dynamic"])
+def test_multibody_engines_refuse_several_cables_naming_the_key(engine):
+    scenario, spec = parse_plan_scenario(_data(cable__count=3), ROOT)
+    with pytest.raises(ScenarioError, match="--engine rope") as exc:
+        plan_pull(scenario, spec, engine=engine)
+    assert exc.value.key == "cable.count"
+
+
+def test_an_unknown_engine_is_refused():
     scenario, spec = parse_plan_scenario(_data(), ROOT)
-    with pytest.raises(ExucableError, match="use --engine rope"):
-        plan_pull(scenario, spec, engine="steady")
+    with pytest.raises(ExucableError, match="--engine"):
+        plan_pull(scenario, spec, engine="fem")
 
 
 class _Page(HTMLParser):
