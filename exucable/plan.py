@@ -4,7 +4,10 @@ What the installation calculators (Polywater Pull-Planner, Southwire SIMpull, Ca
 and Southwire manuals' hand calculations) give for a route and a cable set, from exucable's rope
 reference (:mod:`exucable.rope`): for each direction the tension entering and leaving every section,
 the sidewall bearing pressure (SWBP) in every bend, the limit checks with margins, and the recommended
-direction (the lower maximum tension among the directions that violate no limit).
+direction (the lower maximum tension among the directions that violate no limit). With ``engine =
+"steady"`` or ``"dynamic"`` each direction is also run on the multibody model of one cable
+(:func:`exucable.run.run_scenario`), whose section tensions and windowed SWBP replace the rope's, the rope's
+kept beside them.
 
 Several cables per duct enter as the calculators have them (:mod:`exucable.engineering`): the weight of
 all cables W = n·w, and friction multiplied by the weight correction factor w_c, so that the rope
