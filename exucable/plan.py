@@ -12,7 +12,8 @@ kept beside them.
 Several cables per duct enter as the calculators have them (:mod:`exucable.engineering`): the weight of
 all cables W = n·w, and friction multiplied by the weight correction factor w_c, so that the rope
 equation gives T_out = T_in + w_c μ W L on a level straight and T_out = T_in e^{w_c μ θ} in a bend
-without weight (Polywater, "Weight Correction Factor in Pulling Tension Calculations"). The rope keeps
+without weight (Polywater, "Weight Correction Factor in Pulling Tension Calculations"; with
+``cable.weight_correction_in_bends = false``, T_in e^{μ θ} as in SEC TES-P-104.05). The rope keeps
 gravity exactly on slopes and vertical bends, where the calculators use approximations.
 
 The scenario keys used here beyond the simulation's: ``cable.count``, ``cable.arrangement``,
@@ -73,6 +74,8 @@ class PlanSpec:
     limits : PlanLimits
     feed_from_reel : bool
         Also compute the pull-in history (``pull.feed_from_reel``).
+    weight_correction_in_bends : bool
+        The weight correction factor multiplies the friction in bends too (``cable.weight_correction_in_bends``).
     """
 
     count: int = 1
@@ -80,6 +83,7 @@ class PlanSpec:
     units: str = "si"
     limits: PlanLimits = field(default_factory=PlanLimits)
     feed_from_reel: bool = False
+    weight_correction_in_bends: bool = True
 
 
 def plan_spec(scenario: Scenario, units: str | None = None) -> PlanSpec:
@@ -98,7 +102,8 @@ def plan_spec(scenario: Scenario, units: str | None = None) -> PlanSpec:
         raise ExucableError(f"--units: must be one of {', '.join(SYSTEMS)}, got {units!r}")
     return PlanSpec(count=scenario.cable.count, arrangement=scenario.cable.arrangement,
                     units=units or scenario.display.units, limits=limits,
-                    feed_from_reel=scenario.pull.feed_from_reel)
+                    feed_from_reel=scenario.pull.feed_from_reel,
+                    weight_correction_in_bends=scenario.cable.weight_correction_in_bends)
 
 
 def parse_plan_scenario(data: dict, base_dir: Path, default_name: str = "scenario",
@@ -358,13 +363,15 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
     w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
     mu_eff = wc * scenario.contact.friction
+    # in bends: w_c μ (IEEE 1185, AEIC CG5, Polywater) or μ (SEC TES-P-104.05's worked example)
+    mu_bend = None if spec.weight_correction_in_bends else scenario.contact.friction
     back = scenario.pull.back_tension_N
     centreline = scenario.build_conduit().centreline
 
     directions = {}
     for name in ("forward", "reverse"):
         curve = centreline if name == "forward" else centreline.reversed()
-        rope = solve_rope(centreline, mu_eff, w_total, back, name)
+        rope = solve_rope(centreline, mu_eff, w_total, back, name, bend_friction=mu_bend)
         rows = _sections(curve, rope, w_total, swbp_factor)
         bends = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
         entry = {
@@ -391,6 +398,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
         "directions": directions,
         "recommended_direction": recommended,
         "weight_correction_factor": wc,
+        "weight_correction_in_bends": spec.weight_correction_in_bends,
         "sidewall_pressure_factor": swbp_factor,
         "jam_ratio": jam.jam_ratio,
         "jam_risk": jam.risk,

@@ -72,6 +72,19 @@ def test_three_cables_use_weight_correction_and_bundle_weight():
     assert _plan(cable__count=3)["arrangement"] == "cradled"  # auto: D/d = 5 >= 2.5
 
 
+@pytest.mark.parametrize("in_bends", [True, False])
+def test_weight_correction_in_bends_or_on_straights_only(in_bends):
+    """Without gravity the rope is the capstan law: the bend's factor is e^(w_c mu theta) by default (IEEE 1185)
+    and e^(mu theta) with cable.weight_correction_in_bends = false (SEC TES-P-104.05's worked example)."""
+    plan = _plan(cable__count=3, cable__arrangement="cradled", cable__weight_correction_in_bends=in_bends,
+                 gravity={"g": 0.0})
+    wc, mu = plan["weight_correction_factor"], 0.3
+    assert wc > 1.05 and plan["weight_correction_in_bends"] is in_bends
+    bend = plan["directions"]["forward"]["sections"][1]
+    factor = math.exp((wc if in_bends else 1.0) * mu * math.pi / 2)
+    assert bend["tension_out_N"] == pytest.approx(bend["tension_in_N"] * factor, rel=1e-9)
+
+
 def test_vertical_bends_are_named():
     plan = _plan(conduit__path=[{"straight": 10.0}, {"bend": 30.0, "radius": 5.0, "turn": "up"}, {"straight": 10.0},
                                 {"bend": 30.0, "radius": 5.0, "turn": "down"}, {"straight": 10.0}])
