@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -286,3 +287,19 @@ def test_a_prescribed_pull_force_is_refused_and_slack_is_reported():
                  conduit__path=[{"straight": 20.0}], pull__back_tension=0.0)
     assert plan["directions"]["reverse"]["slack"] and plan["directions"]["reverse"]["pull_force_N"] == 0.0
     assert not plan["directions"]["forward"]["slack"]
+
+
+def test_readme_links_an_industry_report_and_shows_its_picture():
+    """Issue #16 "Done when": the HTML report of one industry route is linked from the README, with a picture."""
+    readme = (ROOT / "README.md").read_text()
+    assert "(docs/plan_example/report.html)" in readme and "![plan report](docs/plan_example/preview.png)" in readme
+    example = ROOT / "docs" / "plan_example"
+    assert (example / "preview.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    page = _Page()
+    page.feed((example / "report.html").read_text())
+    assert page.external == [] and page.imgs and all(src.startswith("data:image/png;base64,") for src in page.imgs)
+    assert {"sections-forward", "sections-reverse", "checks-forward", "recommended"} <= page.ids
+    plan = json.loads((example / "plan.json").read_text())
+    scenario = ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml"
+    assert plan["inputs"]["scenario"] == parse_plan_scenario(tomllib.loads(scenario.read_text()), ROOT)[0].name
+
