@@ -36,6 +36,7 @@ from exucable.errors import ExucableError, ScenarioError
 from exucable.geometry.centreline import Centreline
 from exucable.rope import sidewall_pressure_N_per_m, solve_rope
 from exucable.scenario import Scenario, load_scenario, parse_scenario
+from exucable.trust import TRUSTED_STATUSES
 from exucable.units import SYSTEMS
 
 __all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES"]
@@ -385,6 +386,11 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
         if engine != "rope":
             entry = _multibody_direction(scenario, name, engine, entry, progress)
         entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
+        if engine != "rope":
+            # a run that failed or is flagged (exucable.trust) gives numbers no check should pass on
+            entry["checks"].append({"name": "multibody_run", "passed": entry["status"] in TRUSTED_STATUSES,
+                                    "value": None, "limit": None, "margin": None, "quantity": None,
+                                    "where": f"status {entry['status']}" + (f": {entry['message']}" if entry["message"] else "")})
         entry["passed"] = all(c["passed"] for c in entry["checks"])
         if spec.feed_from_reel:
             entry["pull_in"] = _pull_in_history(curve, rope)

@@ -88,6 +88,8 @@ def _check_against_rope(plan: dict, engine: str) -> None:
             for key in ("entry_point_load_N", "exit_point_load_N", "rope_windowed_sidewall_pressure_N_per_m"):
                 assert math.isfinite(b[key]), key
         assert d["max_sidewall_pressure_N_per_m"] == max(b["sidewall_pressure_N_per_m"] for b in bends)
+        run_check = [c for c in d["checks"] if c["name"] == "multibody_run"]
+        assert len(run_check) == 1 and run_check[0]["passed"]
 
 
 def test_steady_engine_plan_against_the_capstan_rope_in_both_directions(tmp_path, capsys):
@@ -122,3 +124,35 @@ def test_dynamic_engine_plan_shows_progress_and_matches_the_rope(monkeypatch):
     plan = plan_pull(scenario, spec, engine="dynamic", progress=True)
     _check_against_rope(plan, "dynamic")
     assert "small_level_route [" in terminal.getvalue()  # the progress bar of the runs
+
+
+def test_a_failed_multibody_run_fails_the_plan(monkeypatch):
+    """A run whose status is not trusted (here: failed) fails its direction's `multibody_run` check, so no
+    direction is recommended as passing on its numbers. The run itself is replaced by a stub that answers
+    with the rope's tension (the wiring is what is tested, not the solver)."""
+    import types
+
+    import numpy as np
+    import tomllib
+
+    import importlib
+
+    run = importlib.import_module("exucable.run")  # the module (the package also exports a function `run`)
+
+    def fake_run(sc, out_dir, quiet, plots, mode):
+        bends = [{"peak_pressure_N_per_m": 1.0, "mean_pressure_N_per_m": float("nan"), "rope_peak_pressure_N_per_m": 1.0,
+                  "entry_point_load_N": 0.0, "entry_s_conduit_m": 0.0, "exit_point_load_N": 0.0, "exit_s_conduit_m": 0.0}] * 2
+        summary = {"pull_force_N": 1.0, "bends": bends, "status": "failed", "message": "Newton did not converge",
+                   "wall_time_s": 0.0}
+        model = types.SimpleNamespace(layout=types.SimpleNamespace(element_length_m=np.ones(4)))
+        return types.SimpleNamespace(summary=summary, model=model)
+
+    monkeypatch.setattr(run, "run_scenario", fake_run)
+    monkeypatch.setattr(run, "cable_tension_along_conduit", lambda model: (np.linspace(0.0, 2.0, 5), np.full(5, 20.0)))
+    scenario, spec = parse_plan_scenario(tomllib.loads(TOML), ROOT)
+    plan = plan_pull(scenario, spec, engine="steady")
+    for d in plan["directions"].values():
+        check = next(c for c in d["checks"] if c["name"] == "multibody_run")
+        assert not check["passed"] and "Newton did not converge" in check["where"] and not d["passed"]
+    assert not plan["passed"]
+

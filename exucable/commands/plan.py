@@ -122,8 +122,9 @@ def main(args) -> int:
             value, limit, unit = check_in_units(c, units)
             margin = "" if c["margin"] is None else f", margin {100 * c['margin']:.1f} %"
             limit = "" if limit is None else f", limit {limit:.4g} {unit}"
-            print(f"  check {c['name']}: {'pass' if c['passed'] else 'FAIL'} (value {value:.4g} {unit}"
-                  f"{limit}{margin}; {c['where']})")
+            value = "" if value is None else f"value {value:.4g} {unit}"
+            print(f"  check {c['name']}: {'pass' if c['passed'] else 'FAIL'} ({value}"
+                  f"{limit}{margin}{'; ' if value else ''}{c['where']})")
     out = Path(args.out) if args.out else Path(f"plan_{scenario.name}")
     write_plan(out, plan, scenario, units)
     print(f"\nrecommended direction: {plan['recommended_direction']}"
