@@ -295,7 +295,8 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     back = np.argsort(s_pull)
     pressures = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
     return {
-        "pull_force_N": summary["pull_force_N"],
+        # a run that failed before its first converged state has no pulling force
+        "pull_force_N": float("nan") if summary["pull_force_N"] is None else summary["pull_force_N"],
         "max_tension_N": max(r["max_tension_so_far_N"] for r in rows),
         "max_sidewall_pressure_N_per_m": max(pressures) if pressures else None,
         "slack": rope_entry["slack"],

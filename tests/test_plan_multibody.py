@@ -142,7 +142,7 @@ def test_a_failed_multibody_run_fails_the_plan(monkeypatch):
     def fake_run(sc, out_dir, quiet, plots, mode):
         bends = [{"peak_pressure_N_per_m": 1.0, "mean_pressure_N_per_m": float("nan"), "rope_peak_pressure_N_per_m": 1.0,
                   "entry_point_load_N": 0.0, "entry_s_conduit_m": 0.0, "exit_point_load_N": 0.0, "exit_s_conduit_m": 0.0}] * 2
-        summary = {"pull_force_N": 1.0, "bends": bends, "status": "failed", "message": "Newton did not converge",
+        summary = {"pull_force_N": None, "bends": bends, "status": "failed", "message": "Newton did not converge",
                    "wall_time_s": 0.0}
         model = types.SimpleNamespace(layout=types.SimpleNamespace(element_length_m=np.ones(4)))
         return types.SimpleNamespace(summary=summary, model=model)
@@ -155,4 +155,5 @@ def test_a_failed_multibody_run_fails_the_plan(monkeypatch):
         check = next(c for c in d["checks"] if c["name"] == "multibody_run")
         assert not check["passed"] and "Newton did not converge" in check["where"] and not d["passed"]
     assert not plan["passed"]
+    assert math.isnan(plan["directions"]["forward"]["pull_force_N"])  # no converged state: no pulling force
 
