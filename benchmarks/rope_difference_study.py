@@ -54,6 +54,10 @@ CASES = {
                    mass_kg_per_m=1.0, friction=0.3, back_tension_N=200.0, radius_m=5.0),
     "downbend": dict(path=[{"straight": 5.0}, {"bend": 60.0, "radius": 5.0, "turn": "down"}, {"straight": 3.0}],
                      mass_kg_per_m=1.0, friction=0.3, back_tension_N=200.0, radius_m=5.0),
+    # a tight horizontal bend (R 0.5 m, about 28 cable diameters) where a bending length of up to
+    # 0.3 R still lifts off less than the clearance: the bending-stiffness study's case
+    "tight": dict(path=[{"straight": 2.0}, {"bend": 90.0, "radius": 0.5, "turn": "left"}, {"straight": 2.0}],
+                  mass_kg_per_m=0.21, friction=0.5, back_tension_N=100.0, radius_m=0.5),
 }
 
 
