@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rope_difference_study import CASES, G, scenario_dict  # noqa: E402
+from rope_difference_study import CASES, G, add_case_arguments, scenario_dict  # noqa: E402
 
 # (case, gravity, clearance [m], EJ [N m²]); tight: EJ = 25 (λ_in/R)² at T_in = 100 N
 SWEEP = [
@@ -96,7 +96,9 @@ def run_one(case: str, gravity: bool, clearance_m: float, ej: float, refine: flo
     # (the vertical cases' entry straight is level)
     t_in = c["back_tension_N"] + c["friction"] * w * g["before_m"]
     lam = math.sqrt(ej / t_in)
-    element_length = min(0.1, lam / 3.0) / refine
+    # λ/3 resolves the lift-off; no finer than 25 mm (the smallest EJ are baselines: their point
+    # loads are then not resolved, their pulling force is)
+    element_length = max(min(0.1, lam / 3.0), 0.025) / refine
     check_spacing = min(0.005, lam / 8.0) / refine
     d = scenario_dict(case, clearance_m, ej, gravity, element_length, check_spacing, 1.0)
     d["solver"]["mode"] = "steady"
@@ -141,12 +143,36 @@ def print_row(r: dict) -> None:
           f"{1e3 * r['entry_edge_m']:.0f} ({1e3 * r['model_entry_edge_m']:.0f}) | {r['wall_s']:.0f} |", flush=True)
 
 
+def readme_table(rows) -> str:
+    """One line per case: both meshes' values side by side (reference/README.md)."""
+    out = ["| case | gravity | c [mm] | EJ [N m²] | λ_in/R | lift-off/2c | meshes | exucable − rope with clearance | "
+           "estimate | entry P [N] (model) | exit P [N] (model) | entry place [mm into the bend] (model) |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    keys = []
+    for r in rows:
+        k = (r["case"], r["gravity"], r["clearance_m"], r["EJ_N_m2"])
+        if k not in keys:
+            keys.append(k)
+    for k in keys:
+        rs = sorted((r for r in rows if (r["case"], r["gravity"], r["clearance_m"], r["EJ_N_m2"]) == k),
+                    key=lambda r: r["refine"])
+        r0 = rs[0]
+        both = lambda f: " / ".join(f(r) for r in rs)  # noqa: E731
+        est = f"{r0['model_pct']:+.3f} %" + ("" if r0["model_fits"] else " (invalid: lift-off > 2c)")
+        out.append(f"| {k[0]} | {'yes' if k[1] else 'no'} | {k[2] * 1e3:g} | {k[3]:g} | {r0['lambda_in_over_R']:.3g} | "
+                   f"{r0['offset_over_2c']:.2f} | {both(lambda r: str(r['elements']))} | "
+                   f"{both(lambda r: format(r['vs_rope_clearance_pct'], '+.3f'))} % | {est} | "
+                   f"{both(lambda r: format(r['entry_point_load_N'], '.2f'))} ({r0['model_entry_point_load_N']:.2f}) | "
+                   f"{both(lambda r: format(r['exit_point_load_N'], '.2f'))} ({r0['model_exit_point_load_N']:.2f}) | "
+                   f"{both(lambda r: format(1e3 * r['entry_edge_m'], '.0f'))} ({1e3 * r0['model_entry_edge_m']:.0f}) |")
+    return "\n".join(out)
+
+
 def plot(rows, path) -> None:
     """Measured exucable − rope with clearance against the model, and the point loads against T sin ψ_e."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
     styles = {("tight", False): ("o", "C0"), ("hbend", False): ("D", "C4"), ("tight", True): ("s", "C1"),
               ("hbend", True): ("P", "C5"), ("upbend", True): ("^", "C2"), ("downbend", True): ("v", "C3")}
@@ -159,7 +185,9 @@ def plot(rows, path) -> None:
         label = f"{case}{' + gravity' if grav else ''}"
         axes[0].plot(x, [r["vs_rope_clearance_pct"] for r in sel], marker=marker, color=colour, ls="none",
                      ms=7, label=f"exucable, {label}")
-        axes[0].plot(x, [r["model_pct"] for r in sel], color=colour, ls=":", label=f"model, {label}")
+        valid = [r for r in sel if r["model_fits"]]       # the model's assumptions hold (lift-off ≤ 2c)
+        axes[0].plot([r["lambda_in_over_R"] for r in valid], [r["model_pct"] for r in valid], color=colour, ls=":",
+                     label=f"estimate, {label}")
         for key, fill in (("entry", True), ("exit", False)):
             axes[1].plot([r[f"model_{key}_point_load_N"] for r in sel], [r[f"{key}_point_load_N"] for r in sel],
                          marker=marker, color=colour, ls="none", mfc=colour if fill else "none",
@@ -170,7 +198,7 @@ def plot(rows, path) -> None:
     axes[1].plot([0, top], [0, 0.9 * top], "k:", lw=0.5, label="±10 %")
     axes[0].set_xlabel("bending length √(EJ/T_in) / R")
     axes[0].set_ylabel("exucable − rope with clearance [%]")
-    axes[0].set_title("pulling force: steady solves (points) and the stiff-bend model (lines)")
+    axes[0].set_title("pulling force: steady solves (points), estimate where valid (lines)")
     axes[1].set_xlabel("model T sin ψ_e [N]")
     axes[1].set_ylabel("exucable's bend-end point load [N]")
     axes[1].set_title("point loads (filled: entry, open: exit)")
@@ -182,31 +210,27 @@ def plot(rows, path) -> None:
     tmp = Path(str(path) + ".tmp.png")
     fig.savefig(tmp, dpi=110)
     tmp.replace(path)
-    del np
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--case", choices=sorted(CASES))
-    p.add_argument("--clearance", type=float, help="clearance c [m] (default: the sweep's for the case)")
-    p.add_argument("--ej", type=float, help="bending stiffness EJ [N m²]")
+    add_case_arguments(p)           # --clearance defaults to the sweep's for the case
     p.add_argument("--gravity", action="store_true")
     p.add_argument("--refine", action="store_true", help="also run each row at half the element length")
+    p.add_argument("--cases", help="only these cases of the sweep (comma-separated)")
     p.add_argument("--json", help="write the rows to this JSON file (rewritten after each row)")
     p.add_argument("--from-json", help="print (and plot) the rows of this JSON file instead of running")
     p.add_argument("--figure", help="plot the rows to this PNG")
     a = p.parse_args(argv)
     if a.from_json:
         rows = json.loads(Path(a.from_json).read_text())
-        print(HEADER)
-        for r in rows:
-            print_row(r)
+        print(readme_table(rows))
     else:
         if a.case:
             c = a.clearance if a.clearance is not None else next(x[2] for x in SWEEP if x[0] == a.case)
             plan = [(a.case, a.gravity, c, a.ej)]
         else:
-            plan = SWEEP
+            plan = [x for x in SWEEP if not a.cases or x[0] in a.cases.split(",")]
         print(HEADER)
         rows = []
         for case, grav, c, ej in plan:

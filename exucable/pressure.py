@@ -44,7 +44,8 @@ __all__ = ["BEND_COLUMNS", "PRESSURE_COLUMNS", "default_window_m", "windowed_loa
 BEND_COLUMNS = ("bend", "s_conduit_start_m", "s_conduit_end_m", "radius_m", "angle_deg", "tension_in_N", "tension_out_N",
                 "rope_tension_in_N", "rope_tension_out_N", "mean_pressure_N_per_m", "peak_pressure_N_per_m",
                 "rope_mean_pressure_N_per_m", "rope_peak_pressure_N_per_m", "mean_pressure_vs_rope",
-                "entry_point_load_N", "entry_s_conduit_m", "exit_point_load_N", "exit_s_conduit_m")
+                "entry_point_load_N", "entry_s_conduit_m", "exit_point_load_N", "exit_s_conduit_m",
+                "point_loads_resolved")
 PRESSURE_COLUMNS = ("s_conduit_m", "windowed_pressure_N_per_m", "rope_windowed_pressure_N_per_m")
 
 
@@ -236,11 +237,12 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
         body = (grid >= b.s0 + margin) & (grid <= b.s1 - margin)
         mean = float(np.mean(p_w[body])) if body.any() else float("nan")
         rope_mean = float(np.mean(r_w[body])) if body.any() else float("nan")
-        ends = {}
+        ends, lams = {}, []
         for name, s_end, inward in (("start", b.s0, 1), ("end", b.s1, -1)):
             T_here = float(np.interp(s_end, *cab_T))
             lam = bending_length_m if bending_stiffness_N_m2 is None else float(
                 np.sqrt(bending_stiffness_N_m2 / max(T_here, 1e-12)))
+            lams.append(lam)
             ends[name] = bend_end_point_load(s_pts, np.diff(cum), s_end, inward, body_pressure, lam,
                                              element_length_m, window_m, max_capture_m=0.5 * (b.s1 - b.s0))
         t_start = (float(np.interp(b.s0, *cab_T)), float(np.interp(b.s1, *cab_T)))
@@ -256,5 +258,8 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
             "mean_pressure_vs_rope": mean / rope_mean - 1.0 if rope_mean > 0 else float("nan"),
             "entry_point_load_N": ends[entry][0], "entry_s_conduit_m": ends[entry][1],
             "exit_point_load_N": ends[exit_][0], "exit_s_conduit_m": ends[exit_][1],
+            # elements longer than 2λ cannot bend over the lift-off: the point loads are then the
+            # mesh's, not converged (measured on route100_4bends, reference/README.md)
+            "point_loads_resolved": bool(element_length_m <= 2.0 * min(lams)),
         })
     return rows
