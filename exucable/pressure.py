@@ -136,7 +136,7 @@ def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_pe
     near = near[np.argsort(-u[near])]
     loaded = F[near] > 1e-12 * max(float(F[near].max()) if near.size else 0.0, 1e-300)
     on, zeros = None, 0
-    for j, k in enumerate(near):
+    for j in range(near.size):
         if loaded[j]:
             zeros = 0
             continue
