@@ -216,12 +216,15 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_case_arguments(p)           # --clearance defaults to the sweep's for the case
     p.add_argument("--gravity", action="store_true")
+    p.add_argument("--mass", type=float, help="the case's cable mass per length [kg/m] (default: the case's)")
     p.add_argument("--refine", action="store_true", help="also run each row at half the element length")
     p.add_argument("--cases", help="only these cases of the sweep (comma-separated)")
     p.add_argument("--json", help="write the rows to this JSON file (rewritten after each row)")
     p.add_argument("--from-json", help="print (and plot) the rows of this JSON file instead of running")
     p.add_argument("--figure", help="plot the rows to this PNG")
     a = p.parse_args(argv)
+    if a.mass is not None and a.case:
+        CASES[a.case]["mass_kg_per_m"] = a.mass
     if a.from_json:
         rows = json.loads(Path(a.from_json).read_text())
         print(readme_table(rows))
