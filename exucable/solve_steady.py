@@ -217,8 +217,12 @@ def _set_scale(model, lam: float) -> None:
     model.kernel.set_friction_scale(lam)
 
 
-def solve_steady(model, progress: Progress | None = None) -> SolveOutcome:
+def solve_steady(model, progress: Progress | None = None, tolerance: float = STATIC_TOLERANCE) -> SolveOutcome:
     """Solve ``model`` (built with ``solver.mode = "steady"``) for its steady sliding state.
+
+    ``tolerance`` [-] is the equilibrium residual at which it stops, relative to the rope
+    solution's largest tension (default :data:`STATIC_TOLERANCE`; a tighter one shows how
+    converged the pulling force is, ``benchmarks/steady_scale.py --tolerance-check``).
 
     Pseudo-transient continuation from the pre-tensioned start at the full loads; if that fails,
     continuation in the load scale λ (friction, gravity, end forces) from the start, each stage
@@ -236,7 +240,7 @@ def solve_steady(model, progress: Progress | None = None) -> SolveOutcome:
     counters = {"newton": 0, "jacobian": 0, "steps": 0}
     scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
                   model.back_tension_N, 1.0)
-    tolerance_N = STATIC_TOLERANCE * scale_N
+    tolerance_N = float(tolerance) * scale_N
     settings = static_settings(absolute_tolerance_N=1e-3 * tolerance_N)
     c0 = initial_spring_rate(model)
     t_wall = time.perf_counter()
