@@ -56,6 +56,9 @@ _MAX_PASSES = 200
 _MAX_NEWTON = 300
 # A node placed on the wall sits this fraction of the clearance inside it (so it counts as touching).
 _ON_WALL = 1e-7
+# Chains of more segments than this start from the solution on a chain _COARSEN times coarser.
+_COARSEN_ABOVE = 4000
+_COARSEN = 4
 
 
 @dataclass(frozen=True, eq=False)
@@ -433,6 +436,23 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     G = np.zeros((n_seg + 1, 3))
     G[:, 2] = -w * hs
     newton = 0
+    ramp = True
+    if n_seg > _COARSEN_ABOVE:
+        # Nested iteration: the same problem on a chain _COARSEN times coarser places the free spans and
+        # the tensions to within a few of these nodes, from where few Newton steps finish (a free span's
+        # end moves about one node per step; on 1 km, 50 000 nodes, the fine chain needed ~110 steps).
+        coarse = solve_rope_with_clearance(centreline, clearance_m, friction, weight_per_length_N_per_m,
+                                           trailing_tension_N, direction, cable_length_m, _COARSEN * hs, rtol)
+        s_c = coarse.s_conduit_m if direction == "forward" else L - coarse.s_conduit_m
+        order = np.argsort(s_c)
+        off = np.stack([np.interp(s, s_c[order], coarse.offset_m[order, j]) for j in range(3)], axis=1)
+        d = np.einsum("ijk,ij->ik", frames, off)
+        on_wall = np.interp(s, s_c[order], coarse.in_contact[order].astype(float)) >= 0.5
+        size = np.linalg.norm(d, axis=1)
+        d[on_wall] *= (c * (1.0 + _ON_WALL) / np.maximum(size[on_wall], 1e-300))[:, None]
+        T_node = np.interp(s, s_c[order], coarse.tension_N[order])
+        T = 0.5 * (T_node[1:] + T_node[:-1])
+        newton, ramp = coarse.newton_iterations, False
     for passes in range(1, _MAX_PASSES + 1):
         if np.min(T) <= 0.0:
             raise ModelError("rope_clearance", "the cable runs slack (tension <= 0); the rope with clearance "
@@ -440,7 +460,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
         # The first pass stiffens the wall from soft to full in decades: a soft wall lets Newton move the
         # ends of the free spans by many nodes per step (at full stiffness they move ~1 node per step).
         d_new = d
-        for k in (k_wall * np.logspace(-4, 0, 5) if passes == 1 else [k_wall]):
+        for k in (k_wall * np.logspace(-4, 0, 5) if passes == 1 and ramp else [k_wall]):
             chain.k = k
             d_new, it = chain.solve_shape(d_new, T, G, max(1e-3 * rtol, 1e-10) * c)
             newton += it
