@@ -16,12 +16,13 @@ with clearance; then the exponent p of a least-squares fit wall ∝ L^p over the
 in steady mode, measured in this one run.
 
 ``--tolerance-check`` solves the longest route again in steady mode with the stop tolerance
-divided by 100 and prints how far the pulling force moves (how converged it is).
+divided by 100 and prints how far the pulling force moves (how converged it is); ``--mesh-check``
+solves it with twice the elements.
 Then, if ``--example4`` is given, steady Example 4 against dynamic Example 4, whole process
 (scenario → build → solve → result files), and their ratio, in this one run.
 
 Run: ``nice .venv/bin/python benchmarks/steady_scale.py [--lengths 10 100 1000] [--dynamic-max 100]
-[--tolerance-check] [--example4]``.
+[--tolerance-check] [--mesh-check] [--example4]``.
 """
 
 from __future__ import annotations
@@ -95,10 +96,10 @@ def timed(scenario) -> dict:
     return {"wall_s": wall, "summary": s, "peak_rss_MB": rss1 / 1024.0, "rss_increase_MB": (rss1 - rss0) / 1024.0}
 
 
-def one_case(length_m: float, mode: str) -> dict:
+def one_case(length_m: float, mode: str, elements_per_m: float = 1.0) -> dict:
     """One route in this process, after a 10 m warm-up of the same mode (the JSON a child prints)."""
     run_scenario(route_scenario(10.0, mode), None, plots=False)
-    r = timed(route_scenario(length_m, mode))
+    r = timed(route_scenario(length_m, mode, elements_per_m))
     s = r.pop("summary")
     keep = ("status", "message", "pull_force_N", "rope_pull_force_N", "rope_clearance_pull_force_N",
             "newton_iterations", "steps", "wall_time_s", "build_time_s", "kernel_time_s")
@@ -106,9 +107,9 @@ def one_case(length_m: float, mode: str) -> dict:
                 **{k: s[k] for k in keep})
 
 
-def in_child(length_m: float, mode: str) -> dict:
+def in_child(length_m: float, mode: str, elements_per_m: float = 1.0) -> dict:
     """:func:`one_case` in a fresh process, so that its peak memory is its own."""
-    cmd = [sys.executable, __file__, "--case", f"{length_m:g}", mode]
+    cmd = [sys.executable, __file__, "--case", f"{length_m:g}", mode, f"{elements_per_m:g}"]
     done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
@@ -130,6 +131,15 @@ def report(r) -> str:
             f"vs rope with clearance {_percent(F, r['rope_clearance_pull_force_N'])}\n"
             f"{'':17s}per Newton iteration and element: solve {1e6 * r['wall_time_s'] / per:6.1f} µs, "
             f"of which contact kernel {1e6 * r['kernel_time_s'] / per:6.1f} µs")
+
+
+def mesh_check(length_m: float, base: dict) -> str:
+    """Pulling force of the steady solve on the route with twice the elements, against ``base``'s."""
+    r = in_child(length_m, "steady", elements_per_m=2.0)
+    F0, F1 = base["pull_force_N"], r["pull_force_N"]
+    return (f"mesh check, {length_m:g} m steady: F = {F0:.4f} N with {base['elements']} elements, "
+            f"{F1:.4f} N with {r['elements']} ({r['status']}, wall {r['wall_s']:.1f} s): change "
+            f"{100 * (F1 / F0 - 1):+.4f} %")
 
 
 def tolerance_check(length_m: float) -> str:
@@ -157,12 +167,14 @@ def main() -> None:
     ap.add_argument("--tolerance-check", action="store_true",
                     help="solve the longest route again at 1/100 of the stop tolerance")
     ap.add_argument("--example4", action="store_true", help="also steady vs dynamic Example 4")
-    ap.add_argument("--case", nargs=2, metavar=("LENGTH_M", "MODE"), help=argparse.SUPPRESS)
+    ap.add_argument("--mesh-check", action="store_true",
+                    help="solve the longest route again in steady mode with twice the elements")
+    ap.add_argument("--case", nargs=3, metavar=("LENGTH_M", "MODE", "ELEMENTS_PER_M"), help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.case:
-        print(json.dumps(one_case(float(args.case[0]), args.case[1])))
+        print(json.dumps(one_case(float(args.case[0]), args.case[1], float(args.case[2]))))
         return
-    walls, per_element = [], []
+    walls, steady_runs = [], {}
     for L in sorted(args.lengths):
         for mode in ("steady", "dynamic"):
             if mode == "dynamic" and L > args.dynamic_max:
@@ -171,6 +183,7 @@ def main() -> None:
             print(report(r), flush=True)
             if mode == "steady" and r["status"] != "failed":
                 walls.append((L, r["wall_s"]))
+                steady_runs[L] = r
     if len(walls) >= 2:
         L, w = np.array(walls).T
         p = np.polyfit(np.log(L), np.log(w), 1)[0]
@@ -180,6 +193,8 @@ def main() -> None:
             print(f"        between the two longest routes: exponent {p_hi:.2f}")
     if args.tolerance_check:
         print(tolerance_check(max(args.lengths)), flush=True)
+    if args.mesh_check and max(args.lengths) in steady_runs:
+        print(mesh_check(max(args.lengths), steady_runs[max(args.lengths)]), flush=True)
     if args.example4:
         sc = load_scenario(ROOT / "scenarios" / "paper_ex4_spatial.toml")
         rd = timed(sc)
