@@ -11,7 +11,8 @@ mode (loading the compiled kernels) and then the measured one, whole process (sc
 → solve → result files). It prints wall time (and the build's and the solve's share), Newton
 iterations, the process's peak memory (ru_maxrss) and its increase over the measured run, the
 time and memory per element, the solve's and the contact kernel's time per Newton iteration and
-element (flat if nothing is quadratic in the elements), and the pulling force against the centreline rope and the rope
+element (flat if nothing is quadratic in the elements), the check points per element (the mesh
+rule gives a tenser cable more) and the memory per check point, and the pulling force against the centreline rope and the rope
 with clearance; then the exponent p of a least-squares fit wall ∝ L^p over the lengths solved
 in steady mode, measured in this one run.
 
@@ -104,7 +105,7 @@ def one_case(length_m: float, mode: str, elements_per_m: float = 1.0) -> dict:
     keep = ("status", "message", "pull_force_N", "rope_pull_force_N", "rope_clearance_pull_force_N",
             "newton_iterations", "steps", "wall_time_s", "build_time_s", "kernel_time_s")
     return dict(r, length_m=length_m, mode=mode, elements=s["scenario"]["cable"]["elements"],
-                **{k: s[k] for k in keep})
+                check_points_per_element=s["mesh"]["check_points_per_element"], **{k: s[k] for k in keep})
 
 
 def in_child(length_m: float, mode: str, elements_per_m: float = 1.0) -> dict:
@@ -123,6 +124,7 @@ def _percent(value, ref) -> str:
 def report(r) -> str:
     F, n = r["pull_force_N"], r["elements"]
     per = max(r["newton_iterations"], 1) * n
+    cp = r["check_points_per_element"]
     return (f"{r['length_m']:6.0f} m  {r['mode']:7s} {r['status']:6s} wall {r['wall_s']:7.2f} s "
             f"(build {r['build_time_s']:6.2f}, solve {r['wall_time_s']:6.2f})  Newton {r['newton_iterations']:5d}  "
             f"elements {n:5d}  {1e3 * r['wall_s'] / n:6.2f} ms/element  peak RSS {r['peak_rss_MB']:5.0f} MB "
@@ -130,7 +132,8 @@ def report(r) -> str:
             f"F {'-' if F is None else f'{F:.2f}'} N  vs rope {_percent(F, r['rope_pull_force_N'])}, "
             f"vs rope with clearance {_percent(F, r['rope_clearance_pull_force_N'])}\n"
             f"{'':17s}per Newton iteration and element: solve {1e6 * r['wall_time_s'] / per:6.1f} µs, "
-            f"of which contact kernel {1e6 * r['kernel_time_s'] / per:6.1f} µs")
+            f"of which contact kernel {1e6 * r['kernel_time_s'] / per:6.1f} µs; {cp} check points per element "
+            f"(the mesh rule's, grows with the tension), {1024 * r['rss_increase_MB'] / (n * cp):5.2f} kB per check point")
 
 
 def mesh_check(length_m: float, base: dict) -> str:
