@@ -345,6 +345,10 @@ class InitialLayout:
     lead_out_m : float
         Cable laid beyond the exit along the exit tangent at the start [m] (steady mode,
         :func:`steady_lead_out_m`; 0 otherwise): the start is the cable pulled out that far.
+    rope_clearance : exucable.rope_clearance.ClearanceRopeSolution or None
+        The rope with clearance whose path the start follows, for the cable inside the conduit at
+        the start (None where it is not used: a force-controlled pull, no clearance, no
+        pretension, or a cable that runs slack).
     """
 
     conduit: object
@@ -355,6 +359,7 @@ class InitialLayout:
     entry_tangent: np.ndarray
     mesh: object = None
     lead_out_m: float = 0.0
+    rope_clearance: object = None
 
     @property
     def leading_position_m(self) -> np.ndarray:
@@ -520,7 +525,9 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
                           offset_fn, clearance_m=clearance if with_contact else None, lead_out_m=lead_out)
     else:
         cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, 0.0)
+        free = None
     t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
     t_entry = np.asarray(centre.tangent(centre.length_m - L_cable + lead_out), dtype=float)
     return InitialLayout(conduit=conduit, rope=rope, cable=cable, weight_per_length_N_per_m=w,
-                         exit_tangent=t_exit, entry_tangent=t_entry, mesh=mesh, lead_out_m=lead_out)
+                         exit_tangent=t_exit, entry_tangent=t_entry, mesh=mesh, lead_out_m=lead_out,
+                         rope_clearance=free)
