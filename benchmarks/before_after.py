@@ -1,14 +1,14 @@
 """Issue 15's solver changes, switched off and on, side by side in one run.
 
-"before" is the solve as released: Exudyn doubles the step after any 2 steps
-(``adaptiveStepRecoverySteps = 2``, ``adaptiveStepRecoveryIterations = 7``) and each Newton
-iteration makes two kernel passes (force, then force + Jacobian). "after" is the current default:
-doubling after 4 steps of at most 4 iterations, one kernel pass per iteration. Each run is a whole
-``exucable run --no-plots`` process of a paper example at its fidelity (to a steady pulling force),
-alternating before/after ``--repeat`` times; medians and their ratio are printed, with the results
-and their difference.
+"before" is the solve as this session found it (main 04e3b65): Newton tolerance 1e-7, contact
+damping onset 10 µm, and the first step at the scenario's full step (Exudyn then halves it after
+each failed attempt). "after" is the current default: tolerance 1e-5, onset 100 µm, first step
+capped at step/128. Each run is a whole ``exucable run --no-plots`` process of a paper example at
+its fidelity (to a steady pulling force), alternating before/after ``--repeat`` times; medians and
+their ratio are printed, with the results and their difference. The "before" settings are given
+as scenario keys in a copy of the scenario, and the start by patching ``START_STEP_DIVISOR``.
 
-    nice .venv/bin/python benchmarks/before_after.py                 # Examples 3 and 4, ~3 min
+    nice .venv/bin/python benchmarks/before_after.py                 # Examples 3 and 4, ~2 min
     nice .venv/bin/python benchmarks/before_after.py --repeat 3 --examples 2 3 4
 """
 
@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -28,38 +29,47 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = {1: "paper_ex1_incline.toml", 2: "paper_ex2_bend90.toml", 3: "paper_ex3_helix.toml",
             4: "paper_ex4_spatial.toml"}
 
-# `exucable run` with the released solver settings patched back in
+# `exucable run` with the start as it was: the first step at the full solver.step
 _BEFORE = r"""
 import sys
 import exucable.solve as solve
-import exucable.model.coupling as coupling
-base = solve.solver_settings
-def released(sp):
-    s = base(sp)
-    s.timeIntegration.adaptiveStepRecoverySteps = 2
-    s.timeIntegration.adaptiveStepRecoveryIterations = 7
-    return s
-solve.solver_settings = released
-init = coupling.ContactCoupling.__init__
-def two_passes(self, *a, **k):
-    init(self, *a, **k)
-    self.jacobian_with_force = False
-coupling.ContactCoupling.__init__ = two_passes
+solve.START_STEP_DIVISOR = 1
 from exucable.cli import main
 sys.exit(main(sys.argv[1:]))
 """
 
+#: scenario keys of "before" (main 04e3b65 defaults), written into a copy of the scenario
+BEFORE_KEYS = {"contact": {"damping_onset": "1.0e-5"}, "solver": {"newton_tolerance": "1.0e-7"}}
+
+
+def before_scenario(scenario: Path, directory: Path) -> Path:
+    """A copy of ``scenario`` with the keys of :data:`BEFORE_KEYS` set at the top of their tables."""
+    text = scenario.read_text()
+    for table, keys in BEFORE_KEYS.items():
+        lines = "".join(f"{k} = {v}\n" for k, v in keys.items())
+        text, n = re.subn(rf"(?m)^\[{table}\]\s*\n", lambda m: m.group(0) + lines, text, count=1)
+        if n == 0:
+            text += f"\n[{table}]\n{lines}"
+    path = directory / f"before-{scenario.name}"
+    path.write_text(text)
+    return path
+
 
 def run(variant: str, scenario: Path, out: Path) -> dict:
+    if variant == "before":
+        scenario = before_scenario(scenario, out.parent)
     args = ["run", str(scenario), "--out", str(out), "--quiet", "--no-plots"]
     cmd = ([sys.executable, "-c", _BEFORE, *args] if variant == "before"
            else [str(Path(sys.executable).with_name("exucable")), *args])
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True)
     whole = time.perf_counter() - t0
-    if p.returncode != 0:
+    s_path = out / "summary.json"
+    if not s_path.exists():
         raise RuntimeError(f"{variant} {scenario.name} failed:\n{p.stderr[-2000:]}")
-    s = json.loads((out / "summary.json").read_text())
+    s = json.loads(s_path.read_text())
+    if s["status"] not in ("ok", "steady"):
+        raise RuntimeError(f"{variant} {scenario.name}: status {s['status']}\n{p.stderr[-2000:]}")
     key = s["steady_quantity"]
     return {"whole_s": whole, "solve_s": s["wall_time_s"], "steps": s["steps"], "newton": s["newton_iterations"],
             "kernel_s": s["kernel_time_s"], "result_N": s[key], "quantity": key}

@@ -210,11 +210,11 @@ FIELDS: tuple[Field, ...] = (
       rule="> 0; each check point's force is scaled by its share of the element length / this"),
     F("contact.broad_phase", "broad_phase", "choice", "", "aabb", choices=("aabb", "none"),
       rule="`\"aabb\"` or `\"none\"`"),
-    F("contact.damping_onset", "damping_onset_m", "float", "m", 1.0e-4, ge=0.0, ours=True,
+    F("contact.damping_onset", "damping_onset_m", "float", "m", 5.0e-5, ge=0.0, ours=True,
       rule="≥ 0: penetration over which the damping term grows from 0, f_n = Kδ^e + C·min(δ/δ_d, 1)·δ̇; 0 is "
            "the paper's Eq. 18, whose damping force jumps to C·δ̇ at first touch (each touch then cuts the "
-           "step: Example 4 took 7745 steps per 0.03 s with 0, 90 with 1e-5); 1e-4 halves Newton's "
-           "iterations against 1e-5 at the same results (docs/performance.md)"),
+           "step: Example 4 took 7745 steps per 0.03 s with 0, 90 with 1e-5); 5e-5 halves Newton's "
+           "iterations against 1e-5, results within their uncertainty (docs/performance.md)"),
     F("contact.surface", "surface", "choice", "", "smooth", choices=("smooth", "segments"), ours=True,
       rule="`\"smooth\"`: closest points on the exact bends/helices (the segments still do the search); "
            "`\"segments\"`: on the straight segments, as the paper (Sect. 2.3)"),
