@@ -16,12 +16,13 @@ from typing import Literal
 import numpy as np
 import exudyn as exu
 
-from .model.recorder import History, Recorder, expected_drift_N_per_s, steady_quantity
+from .model.recorder import History, Recorder, earliest_steady_s, expected_drift_N_per_s, steady_quantity
 
 # the first step is solver.step / START_STEP_DIVISOR (see simulate)
 START_STEP_DIVISOR = 128
 
 __all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "expected_drift_N_per_s",
+           "earliest_steady_s",
            "Progress"]
 
 
@@ -120,7 +121,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     sp = model.scenario.solver
     steady_stop = sp.steady_stop if steady_stop is None else steady_stop
     recorder = Recorder(model, sp.output_interval_s, steady_stop, sp.steady_window_s, sp.steady_tolerance,
-                        progress=progress.update if progress is not None else None)
+                        progress=progress.update if progress is not None else None,
+                        earliest_steady_s=earliest_steady_s(model))
     history = recorder.history
     mbs = model.mbs
     # Exudyn 1.13 returns {"function": f, "type": "Python"} for a set function, 0 for none
