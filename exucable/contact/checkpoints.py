@@ -12,8 +12,6 @@ N4 = L(-ξ² + ξ³) (the paper's Eqs. 4-6 in Exudyn's ordering).
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
 __all__ = ["check_points", "hermite_unit", "hermite", "RULES"]
@@ -44,24 +42,15 @@ def check_points(n: int, rule: str = "gauss") -> tuple[np.ndarray, np.ndarray]:
     if n < 1:
         raise ValueError(f"check points per element must be >= 1, got {n}")
     if rule == "gauss":
-        x, w = _gauss_legendre(n)
+        # scipy's Golub-Welsch on the banded Jacobi matrix, O(n²): numpy's leggauss takes a dense
+        # eigensolve, O(n³), 0.2-0.7 s at the paper's 800 points per element (Example 4)
+        from scipy.special import roots_legendre
+
+        x, w = roots_legendre(n)
         return 0.5 * (x + 1.0), 0.5 * w
     if rule == "uniform":
         return (np.arange(n) + 0.5) / n, np.full(n, 1.0 / n)
     raise ValueError(f"check point rule must be one of {RULES}, got {rule!r}")
-
-
-@lru_cache(maxsize=8)
-def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1], computed once per n in a process (a run asks
-    twice). scipy's Golub-Welsch on the banded matrix: numpy's ``leggauss`` took 0.2-0.7 s for the
-    paper's 800 points (measured), scipy 0.05 s, weights equal to 1e-11 relative."""
-    from scipy.special import roots_legendre
-
-    x, w = roots_legendre(n)
-    x.flags.writeable = False
-    w.flags.writeable = False
-    return x, w
 
 
 def hermite_unit(xi) -> np.ndarray:
