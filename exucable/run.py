@@ -86,7 +86,9 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
     s_c, T_c = cable_tension_along_conduit(model)
     lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
     bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
-                       rope.tension_N, rope_p, w, lam, model.scenario.pull.direction)
+                       rope.tension_N, rope_p, w, lam, model.scenario.pull.direction,
+                       bending_stiffness_N_m2=model.scenario.cable.bending_stiffness_N_m2,
+                       element_length_m=float(np.max(model.layout.element_length_m)))
     i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
     info = {"pressure_window_m": w,
             "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
