@@ -143,7 +143,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     ``solver.mode``.
     """
     from .model.build import build_model
-    from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
+    from .solve import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
@@ -177,7 +177,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         h = out.history.arrays()
         drift = expected_drift_N_per_s(model)
         st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
-                                 expected_drift_N_per_s=drift)
+                                 expected_drift_N_per_s=drift, earliest_s=earliest_steady_s(model))
         i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
         refs = window_references(sc, model, h["time_s"][i0:])
         # the uncertainty is of the mean about the drift the references explain (the cable's changing
