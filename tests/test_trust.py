@@ -100,3 +100,17 @@ def test_the_issue_s_50_m_per_s_pull_is_dynamic():
                            pull_force_N=205.0, steady_window_s=0.2, steady_tolerance=1e-3, end_time_s=1.0,
                            base_status="steady")
     assert status == "dynamic" and flags[0]["value"] == pytest.approx(rhoA * 2500 / 205.0)
+
+
+def test_a_pull_that_would_empty_the_conduit_is_refused_before_it_runs(tmp_path):
+    """5 m/s for 0.6 s pulls 3 m of a 1.785 m cable: refused naming solver.end_time and the time the
+    cable has left (1.785 m / 5 m/s plus half the ramp), before anything runs or is written."""
+    from exucable.errors import ModelError
+    from exucable.model.rig import ramped_displacement
+
+    sc = _tiny(pull={"speed": 5.0}, solver={"end_time": 0.6})
+    with pytest.raises(ModelError, match=r"solver\.end_time") as err:
+        run_scenario(sc, tmp_path / "out")
+    t_out = float(str(err.value).split("left its conduit at ")[1].split(" s")[0])
+    assert ramped_displacement(t_out, 5.0, sc.pull.ramp_time_s) == pytest.approx(sc.cable_length_m, rel=2e-3)
+    assert not (tmp_path / "out").exists()
