@@ -143,7 +143,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     ``solver.mode``.
     """
     from .model.build import build_model
-    from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
+    from .solve import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
@@ -151,6 +151,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     if sc.cable.count != 1:
         raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
                                         "plan several cables per duct with `exucable plan`")
+    _refuse_pulling_the_cable_out(sc)
     t_start = time.perf_counter()
     model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element)
     build_s = time.perf_counter() - t_start
@@ -178,7 +179,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         h = out.history.arrays()
         drift = expected_drift_N_per_s(model)
         st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
-                                 expected_drift_N_per_s=drift)
+                                 expected_drift_N_per_s=drift, earliest_s=earliest_steady_s(model))
         i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
         refs = window_references(sc, model, h["time_s"][i0:])
         # the uncertainty is of the mean about the drift the references explain (the cable's changing
@@ -265,6 +266,28 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result
+
+
+def _refuse_pulling_the_cable_out(sc) -> None:
+    """Refuse a velocity-controlled dynamic pull whose drive would pull the whole cable out of its
+    conduit before ``solver.end_time``: nothing inside is left to pull, and the references at the
+    cable's extent do not exist. Refused before the run, so no result is lost afterwards."""
+    from .model.rig import ramped_displacement
+
+    sp = sc.solver
+    if sp.mode != "dynamic" or sc.pull.force_N is not None:
+        return
+    v, ramp, length = sc.pull.speed_m_per_s, sc.pull.ramp_time_s, sc.cable_length_m
+    pulled_m = ramped_displacement(sp.end_time_s, v, ramp)
+    if pulled_m < length:
+        return
+    # the time the drive has pulled the whole cable out (the ramp is monotone: invert it on a bracket)
+    from scipy.optimize import brentq
+    t_out = brentq(lambda t: ramped_displacement(t, v, ramp) - length, 0.0, sp.end_time_s)
+    raise ModelError("solver.end_time",
+                     f"at {v:g} m/s the drive pulls {pulled_m:.4g} m by {sp.end_time_s:g} s, but the cable is "
+                     f"{length:.4g} m long: it has left its conduit at {t_out:.3g} s. Set solver.end_time "
+                     f"well below {t_out:.3g} s, lower pull.speed, or lengthen the cable")
 
 
 def window_references(scenario, model, window_time_s) -> dict:
