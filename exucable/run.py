@@ -161,12 +161,13 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         from .solve_steady import solve_steady
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
         h = out.history.arrays()
-        # one static state, the start's extent of cable in the conduit (nothing pulled out yet):
-        # the result is the last (converged) pseudo-time step's; no time history, no scatter
+        # one static state, the start's extent of cable in the conduit (laid out past the exit by
+        # the steady lead-out, model.layout.steady_lead_out_m): the result is the last (converged)
+        # pseudo-time step's; no time history, no scatter
         drift = 0.0
         st = SteadyState(out.status != "failed", 0.0, 0.0, 0.0, 0.0)
         i0 = max(len(h["time_s"]) - 1, 0)
-        refs = extent_references(sc, model, 0.0)
+        refs = extent_references(sc, model, model.start.lead_out_m)
         pf = None
     else:
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
@@ -309,7 +310,9 @@ def extent_references(scenario, model, pulled_out_m: float) -> dict:
 
     if scenario.pull.force_N is not None:
         return {}
-    # at the start's extent the start's own rope with clearance is that reference (same conduit, cable
-    # length, loads): not solved twice
-    start_clearance = getattr(model.start, "rope_clearance", None) if pulled_out_m == 0.0 else None
+    # at the start's extent (nothing pulled out, or a steady start's lead-out) the start's own rope
+    # with clearance is that reference (same conduit, cable inside, loads): not solved twice
+    start = model.start
+    start_clearance = (getattr(start, "rope_clearance", None)
+                       if pulled_out_m == getattr(start, "lead_out_m", 0.0) else None)
     return pull_force_references_N(scenario, model.conduit, pulled_out_m, clearance_solution=start_clearance)

@@ -273,7 +273,9 @@ FIELDS: tuple[Field, ...] = (
     F("solver.mode", "mode", "choice", "", "dynamic", choices=("dynamic", "steady"), ours=True,
       rule="`\"dynamic\"`: integrate the dynamics in time (paper Sect. 2.6); `\"steady\"`: one static solve "
            "of the steady sliding state (friction along the cable's tangent, no start-up, no time history; "
-           "needs `solver.pretension = true`); the `solver` time keys are then unused"),
+           "needs `solver.pretension = true`; on a route ending in a bend the start is laid out past the exit so that "
+           "the rig sits 10 bending lengths √(EJ/T) beyond the bend, and `reference_pulled_out_m` says how far); "
+           "the `solver` time keys are then unused"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
       rule="array of times in [0, `solver.end_time`]: the whole state is written at each "
