@@ -215,8 +215,7 @@ def _outside_points(model) -> int:
     """Check points with no conduit segment within R of them (outside the conduit, or beyond
     its open ends where the rig holds the cable)."""
     q, _ = model.coordinates()
-    q = q.reshape(-1)
-    return int(np.count_nonzero(model.kernel.points(q, np.zeros_like(q)).segment < 0))
+    return int(np.count_nonzero(model.kernel.point_segments(q.reshape(-1)) < 0))
 
 
 def _set_scale(model, lam: float) -> None:
