@@ -310,9 +310,11 @@ def extent_references(scenario, model, pulled_out_m: float) -> dict:
 
     if scenario.pull.force_N is not None:
         return {}
-    # at the start's extent (nothing pulled out, or a steady start's lead-out) the start's own rope
-    # with clearance is that reference (same conduit, cable inside, loads): not solved twice
+    # at the start's extent (nothing pulled out, or a steady start's lead-out) the start's own ropes
+    # (centreline and with clearance) are those references (same conduit, cable inside, loads):
+    # not solved twice
     start = model.start
-    start_clearance = (getattr(start, "rope_clearance", None)
-                       if pulled_out_m == getattr(start, "lead_out_m", 0.0) else None)
-    return pull_force_references_N(scenario, model.conduit, pulled_out_m, clearance_solution=start_clearance)
+    at_start = pulled_out_m == getattr(start, "lead_out_m", 0.0)
+    return pull_force_references_N(scenario, model.conduit, pulled_out_m,
+                                   clearance_solution=getattr(start, "rope_clearance", None) if at_start else None,
+                                   rope_solution=getattr(start, "rope", None) if at_start else None)
