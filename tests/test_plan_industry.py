@@ -3,34 +3,18 @@ within their published rounding, propagated along the route (rule in that file's
 
 from __future__ import annotations
 
-import math
 import tomllib
 from pathlib import Path
 
 import pytest
 
 from exucable.plan import load_plan_scenario, plan_pull
+from exucable.validate_industry import published_bounds_lbf
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = tomllib.loads((ROOT / "reference" / "industry_values.toml").read_text())
 LBF = 4.4482216152605
 LB_PER_FT = LBF / 0.3048
-
-
-def _bounds(example, rows, mu):
-    """Bound |exact - published| for every published tension: interval propagation of the hand calculation."""
-    published = example["tension_out_lbf"]
-    r, delta = example["tension_rounding_lbf"], example["bend_factor_rounding"]
-    bounds, e, prev_idx, prev_pub = [], 0.0, 0, 0.0
-    for idx, pub in zip(example["sections"], published):
-        between = rows[prev_idx:idx]
-        factor = math.prod(math.exp(mu * math.radians(b["angle_deg"])) for b in between if b["kind"] == "bend")
-        n_bends = sum(b["kind"] == "bend" for b in between)
-        carried = factor * e if example["chained"] else 0.0
-        e = carried + n_bends * delta * max(prev_pub, 0.0) * factor + r
-        bounds.append(e)
-        prev_idx, prev_pub = idx, pub
-    return bounds
 
 
 @pytest.mark.parametrize("example", REFERENCE["example"],
@@ -40,7 +24,7 @@ def test_published_section_tensions_and_swbp(example):
     plan = plan_pull(scenario, spec)
     rows = plan["directions"][example["direction"]]["sections"]
     mu = scenario.contact.friction * plan["weight_correction_factor"]
-    bounds = _bounds(example, rows, mu)
+    bounds = published_bounds_lbf(example, rows, mu)
     for idx, pub, bound in zip(example["sections"], example["tension_out_lbf"], bounds):
         ours = rows[idx - 1]["tension_out_N"] / LBF
         assert abs(ours - pub) <= bound, f"section {idx}: ours {ours:.3f} lbf, published {pub}, bound {bound:.3f}"

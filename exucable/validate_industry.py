@@ -1,0 +1,361 @@
+"""``exucable validate --suite industry``: the published worked pulls of ``scenarios/industry/``.
+
+For every worked example of ``reference/industry_values.toml`` (a manufacturer's manual or a
+calculator vendor's page, each cited there and in its scenario file) one row per solver mode:
+
+- the **published** pulling force with its rounding bound (the manual's hand calculation rounds every
+  section's tension and the bend factors; the bound propagates those roundings along the route,
+  :func:`published_bounds_lbf`);
+- the **centreline rope** (:mod:`exucable.rope`, through :func:`exucable.plan.plan_pull`): what the
+  published calculators compute; checked against the published value within that bound;
+- the **rope with clearance** (``rope_clearance_pull_force_N``, :mod:`exucable.rope_clearance`): the
+  EJ → 0 limit of the cable free to hang in free spans across its clearance;
+- **exucable** on the default mesh and on a mesh refined by :data:`REFINE` (element length and check-point
+  spacing halved): the mesh check is |default − refined| / refined ≤ :data:`MESH_TOLERANCE`; a dynamic
+  run's steady scatter (std/mean over its window) must be ≤ :data:`SCATTER_TOLERANCE`; where both modes
+  ran, |steady − dynamic| / dynamic ≤ :data:`MODE_TOLERANCE`;
+- the **difference from the published value explained**: published − rope is the calculator's rounding
+  (the first check); rope with clearance − rope is the free spans (reference/README.md, "What separates
+  exucable from the rope"); exucable − rope with clearance is what the rope lacks, bending stiffness,
+  measured by √(EJ/T)/R on the route's tightest bend. The study there found exucable within 0.1 % of
+  the rope with clearance for √(EJ/T)/R ≤ 0.01 (:data:`FLEXIBLE_LIMIT`), which is checked where it
+  applies; beyond it no estimate exists yet and the difference is reported, not judged.
+
+Writes ``industry.csv``, ``industry.md`` and ``industry.png`` (each atomically) into the output
+directory, each run's results in ``<out>/<mode>/<example>/level_<k>/``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import time
+import tomllib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .data import data_path
+from .io import atomic_write_text
+from .trust import TRUSTED_STATUSES
+
+__all__ = ["LBF_N", "REFINE", "MESH_TOLERANCE", "SCATTER_TOLERANCE", "MODE_TOLERANCE", "FLEXIBLE_LIMIT",
+           "FLEXIBLE_TOLERANCE", "load_industry_examples", "published_bounds_lbf", "IndustryRow",
+           "IndustryValidation", "validate_industry", "format_industry_table", "write_industry_report"]
+
+#: One pound-force [N] (the published values are in lbf).
+LBF_N = 4.4482216152605
+#: Refinement of the second mesh: element length and check-point spacing divided by this.
+REFINE = 2.0
+#: Issue #10's targets: default mesh within 0.2 % of the refined answer, scatter ≤ 0.2 %, modes within 0.2 %.
+MESH_TOLERANCE = 2e-3
+SCATTER_TOLERANCE = 2e-3
+MODE_TOLERANCE = 2e-3
+#: √(EJ/T)/R up to which the rope-difference study measured exucable within FLEXIBLE_TOLERANCE of the
+#: rope with clearance (reference/README.md: −0.09 … +0.08 % on every case at √(EJ/T)/R ≤ 0.01).
+FLEXIBLE_LIMIT = 0.01
+FLEXIBLE_TOLERANCE = 1e-3
+
+
+def load_industry_examples(path=None) -> list[dict]:
+    """The ``[[example]]`` tables of ``reference/industry_values.toml`` (or of ``path``)."""
+    with open(data_path("reference", "industry_values.toml") if path is None else path, "rb") as f:
+        return tomllib.load(f)["example"]
+
+
+def published_bounds_lbf(example: dict, sections: list[dict], friction: float) -> list[float]:
+    """Bound on |exact − published| [lbf] for each published section tension of ``example``.
+
+    Interval propagation of the hand calculation (rule in the header of
+    ``reference/industry_values.toml``): each published tension is rounded by
+    ``tension_rounding_lbf``; in a ``chained`` calculation the previous rounded value's error is carried
+    through the bend factors e^(μθ) between them (paper Eq. 26), and each bend factor itself was used
+    rounded by ``bend_factor_rounding``.
+
+    Parameters
+    ----------
+    example : dict
+        One ``[[example]]`` table.
+    sections : list of dict
+        The route's sections in pulling order (``kind`` "bend" or "straight", ``angle_deg``), as
+        :func:`exucable.plan.plan_pull` gives them.
+    friction : float
+        The friction coefficient the calculation used (with any weight-correction factor).
+    """
+    r, delta = example["tension_rounding_lbf"], example["bend_factor_rounding"]
+    bounds, e, prev_idx, prev_pub = [], 0.0, 0, 0.0
+    for idx, pub in zip(example["sections"], example["tension_out_lbf"]):
+        between = sections[prev_idx:idx]
+        factor = math.prod(math.exp(friction * math.radians(b["angle_deg"])) for b in between if b["kind"] == "bend")
+        n_bends = sum(b["kind"] == "bend" for b in between)
+        carried = factor * e if example["chained"] else 0.0
+        e = carried + n_bends * delta * max(prev_pub, 0.0) * factor + r
+        bounds.append(e)
+        prev_idx, prev_pub = idx, pub
+    return bounds
+
+
+@dataclass
+class IndustryRow:
+    """One example in one solver mode. Forces in N; relative differences as fractions."""
+
+    example: str                 # scenario stem and direction
+    source: str
+    kind: str
+    mode: str
+    published_N: float
+    published_bound_N: float
+    rope_N: float                # centreline rope, the published calculators' model, whole route
+    flexibility: float           # max over bends of √(EJ/T_out)/R (rope tensions)
+    run_rope_N: float | None = None            # both references for the run's extent of cable (a dynamic
+    run_rope_clearance_N: float | None = None  # run's window has pulled some out; steady: = the route's)
+    values_N: list = field(default_factory=list)        # exucable per mesh level (default first)
+    elements: list = field(default_factory=list)
+    scatter: list = field(default_factory=list)         # std/mean per level (dynamic), None for steady
+    uncertainty_N: list = field(default_factory=list)
+    statuses: list = field(default_factory=list)
+    messages: list = field(default_factory=list)
+    wall_time_s: list = field(default_factory=list)
+
+    @property
+    def value_N(self) -> float:
+        """exucable's answer: the default mesh's."""
+        return self.values_N[0] if self.values_N else float("nan")
+
+    @property
+    def mesh_difference(self) -> float | None:
+        """(default − refined) / refined, None with one level."""
+        if len(self.values_N) < 2:
+            return None
+        return (self.values_N[0] - self.values_N[-1]) / abs(self.values_N[-1])
+
+    @property
+    def trusted(self) -> bool:
+        return bool(self.statuses) and all(s in TRUSTED_STATUSES for s in self.statuses)
+
+    def rel(self, reference) -> float:
+        return (self.value_N - reference) / abs(reference) if reference else float("nan")
+
+    @property
+    def free_span_part(self) -> float | None:
+        """(rope with clearance − rope) / rope: what the free spans across the clearance save."""
+        if self.run_rope_clearance_N is None or not self.run_rope_N:
+            return None
+        return (self.run_rope_clearance_N - self.run_rope_N) / self.run_rope_N
+
+    @property
+    def remainder(self) -> float | None:
+        """(exucable − rope with clearance) / rope with clearance, both for the run's extent: what the
+        rope lacks (bending stiffness)."""
+        return None if self.run_rope_clearance_N is None else self.rel(self.run_rope_clearance_N)
+
+    def checks(self) -> list[tuple[str, bool, str]]:
+        """(name, passed, detail) of each check this row makes."""
+        out = [("rope vs published", abs(self.rope_N - self.published_N) <= self.published_bound_N,
+                f"|{self.rope_N:.5g} − {self.published_N:.5g}| ≤ {self.published_bound_N:.3g} N (published rounding)")]
+        out.append(("trusted status", self.trusted, ", ".join(self.statuses) or "not run"))
+        md = self.mesh_difference
+        if md is not None:
+            out.append(("mesh", abs(md) <= MESH_TOLERANCE,
+                        f"default vs refined {100 * md:+.3f} % (≤ {100 * MESH_TOLERANCE:.1f} %)"))
+        for level, sc in enumerate(self.scatter):
+            if sc is not None:
+                out.append((f"steadiness level {level}", sc <= SCATTER_TOLERANCE,
+                            f"scatter {100 * sc:.3f} % (≤ {100 * SCATTER_TOLERANCE:.1f} %)"))
+        rem = self.remainder
+        if rem is not None and self.flexibility <= FLEXIBLE_LIMIT:
+            out.append(("vs rope with clearance", abs(rem) <= FLEXIBLE_TOLERANCE,
+                        f"{100 * rem:+.3f} % at √(EJ/T)/R = {self.flexibility:.3g} ≤ {FLEXIBLE_LIMIT}"))
+        return out
+
+    @property
+    def passed(self) -> bool:
+        return all(ok for _, ok, _ in self.checks())
+
+    def explanation(self) -> str:
+        """The difference from the published value, part by part."""
+        parts = [f"published − rope {self.published_N - self.rope_N:+.3g} N (rounding, bound ±{self.published_bound_N:.3g} N)"]
+        if self.free_span_part is not None:
+            parts.append(f"free spans {100 * self.free_span_part:+.2f} % (rope with clearance vs rope)")
+        if self.remainder is not None and np.isfinite(self.value_N):
+            regime = ("flexible: the study's 0.1 % applies" if self.flexibility <= FLEXIBLE_LIMIT
+                      else "bending stiffness: no estimate yet (reference/README.md)")
+            parts.append(f"exucable vs rope with clearance {100 * self.remainder:+.2f} % at √(EJ/T)/R = "
+                         f"{self.flexibility:.3g} ({regime})")
+        return "; ".join(parts)
+
+
+@dataclass
+class IndustryValidation:
+    rows: list = field(default_factory=list)
+    wall_time_s: float = 0.0
+    mode_wall_time_s: dict = field(default_factory=dict)
+
+    def mode_differences(self) -> list[tuple[str, float, float]]:
+        """(example, steady, dynamic) where both modes ran on the default mesh."""
+        by = {(r.example, r.mode): r for r in self.rows}
+        return [(ex, by[(ex, "steady")].value_N, by[(ex, "dynamic")].value_N)
+                for ex, m in by if m == "steady" and (ex, "dynamic") in by]
+
+    @property
+    def failures(self) -> list[str]:
+        out = [f"{r.example} ({r.mode}): {name}: {detail}" for r in self.rows for name, ok, detail in r.checks() if not ok]
+        for ex, steady, dynamic in self.mode_differences():
+            d = (steady - dynamic) / abs(dynamic)
+            if not abs(d) <= MODE_TOLERANCE:
+                out.append(f"{ex}: steady vs dynamic {100 * d:+.3f} % (≤ {100 * MODE_TOLERANCE:.1f} %)")
+        return out
+
+
+def _flexibility(scenario, plan_sections) -> float:
+    """max over the route's bends of √(EJ/T)/R with the rope's tension leaving the bend."""
+    ej = scenario.cable.bending_stiffness_N_m2
+    vals = [math.sqrt(ej / s["tension_out_N"]) / s["radius_m"] for s in plan_sections
+            if s["kind"] == "bend" and s.get("radius_m") and s["tension_out_N"] > 0]
+    return max(vals, default=0.0)
+
+
+def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: bool = True,
+                      modes=("steady",), examples=None, progress: Callable[[str], None] | None = None,
+                      scenario_dir=None) -> IndustryValidation:
+    """Run the industry suite; returns its rows and writes its table and figure into ``out_dir``.
+
+    Parameters
+    ----------
+    fast : bool
+        The default mesh only (no refined run, so no mesh check).
+    out_dir : str or os.PathLike
+        Output directory.
+    quiet : bool
+        No progress bars in the runs.
+    modes : iterable of {"steady", "dynamic"}
+        Solver modes; the dynamic one costs minutes per route (``benchmarks/industry_suite.py``).
+    examples : list of dict, optional
+        ``[[example]]`` tables (default: all of ``reference/industry_values.toml``).
+    progress : callable, optional
+        Called with one line of text as each run starts and ends.
+    scenario_dir : path, optional
+        Where the examples' scenario files are (default: the shipped ``scenarios/industry``).
+    """
+    from .plan import plan_pull, plan_spec
+    from .run import run_scenario
+    from .scenario import load_scenario
+
+    say = progress or (lambda line: None)
+    sdir = Path(scenario_dir) if scenario_dir is not None else data_path("scenarios", "industry")
+    out = Path(out_dir)
+    iv = IndustryValidation()
+    t0 = time.perf_counter()
+    levels = (1.0,) if fast else (1.0, REFINE)
+    for mode in modes:
+        tm = time.perf_counter()
+        for ex in examples if examples is not None else load_industry_examples():
+            sc = load_scenario(sdir / ex["scenario"])
+            if ex["direction"] != sc.pull.direction:
+                sc = sc.replace(**{"pull.direction": ex["direction"]})
+            spec = plan_spec(sc)
+            plan = plan_pull(sc, spec)
+            sections = plan["directions"][ex["direction"]]["sections"]
+            mu = sc.contact.friction * plan["weight_correction_factor"]
+            bound = published_bounds_lbf(ex, sections, mu)[-1]
+            name = f"{Path(ex['scenario']).stem}-{ex['direction']}"
+            row = IndustryRow(name, ex["source"], ex["kind"], mode, ex["tension_out_lbf"][-1] * LBF_N, bound * LBF_N,
+                              plan["directions"][ex["direction"]]["pull_force_N"], _flexibility(sc, sections))
+            k0 = None
+            for level, refine in enumerate(levels):
+                say(f"validate industry: {name}, {mode}, mesh level {level} (element length / {refine:g}) ...")
+                res = run_scenario(sc, out / mode / name / f"level_{level}", quiet=quiet, plots=False,
+                                   refine=refine, check_points_per_element=k0, mode=mode)
+                s = res.summary
+                k0 = s["mesh"]["check_points_per_element"] if k0 is None else k0
+                value = s["pull_force_N"] if s["pull_force_N"] is not None else float("nan")
+                row.values_N.append(value)
+                row.elements.append(s["mesh"]["elements"])
+                std = s.get("pull_force_std_N")
+                row.scatter.append(abs(std / value) if mode == "dynamic" and std is not None and value else None)
+                row.uncertainty_N.append(s.get("pull_force_uncertainty_N"))
+                row.statuses.append(s["status"])
+                row.messages.append(s.get("message") or "")
+                row.wall_time_s.append(s["wall_time_s"])
+                if level == 0:
+                    row.run_rope_N = s.get("rope_pull_force_N")
+                    row.run_rope_clearance_N = s.get("rope_clearance_pull_force_N")
+                say(f"  {s['mesh']['elements']} elements: pulling force {value:.6g} N, status {s['status']}, "
+                    f"wall {s['wall_time_s']:.1f} s")
+            iv.rows.append(row)
+        iv.mode_wall_time_s[mode] = time.perf_counter() - tm
+    iv.wall_time_s = time.perf_counter() - t0
+    write_industry_report(iv, out, fast)
+    return iv
+
+
+def _pct(x, digits=3):
+    return "-" if x is None or not np.isfinite(x) else f"{100 * x:+.{digits}f} %"
+
+
+def _g(x, fmt=".6g"):
+    return "-" if x is None or not np.isfinite(x) else format(x, fmt)
+
+
+HEADER = ["example", "mode", "published [N]", "rope [N]", "rope w/ clearance [N] (run's extent)", "exucable [N]", "refined [N]",
+          "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "pass"]
+
+
+def table_rows(iv: IndustryValidation):
+    rows = []
+    for r in iv.rows:
+        sc = r.scatter[0] if r.scatter else None
+        rows.append([r.example, r.mode, f"{r.published_N:.5g} ± {r.published_bound_N:.2g}", _g(r.rope_N),
+                     _g(r.run_rope_clearance_N), _g(r.value_N),
+                     _g(r.values_N[-1]) if len(r.values_N) > 1 else "-", _pct(r.mesh_difference),
+                     "-" if sc is None else f"{100 * sc:.3f} %", _pct(r.rel(r.published_N), 2), _pct(r.rel(r.run_rope_N), 2),
+                     _pct(r.remainder, 2), f"{r.flexibility:.3g}", "PASS" if r.passed else "FAIL"])
+    return HEADER, rows
+
+
+def format_industry_table(iv: IndustryValidation) -> str:
+    from .validate import _text_table
+    text = _text_table(*table_rows(iv))
+    text += "\n\nThe differences, explained:\n" + "\n".join(f"  {r.example} ({r.mode}): {r.explanation()}" for r in iv.rows)
+    diffs = iv.mode_differences()
+    if diffs:
+        text += "\n\nSteady against dynamic (default mesh):\n" + "\n".join(
+            f"  {ex}: steady {s:.6g} N, dynamic {d:.6g} N, {100 * (s - d) / abs(d):+.3f} %" for ex, s, d in diffs)
+    return text
+
+
+def write_industry_report(iv: IndustryValidation, out: Path, fast: bool) -> None:
+    """``industry.csv`` (one row per example and mode), ``industry.md`` and ``industry.png``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["example", "mode", "source", "published_N", "published_bound_N", "rope_pull_force_N",
+                "rope_clearance_pull_force_N", "pull_force_N", "refined_pull_force_N", "mesh_difference",
+                "scatter", "elements", "refined_elements", "flexibility_sqrt_EJ_over_T_per_R", "status",
+                "wall_time_s", "passed"])
+    for r in iv.rows:
+        w.writerow([r.example, r.mode, r.source, repr(r.published_N), repr(r.published_bound_N), repr(r.rope_N),
+                    "" if r.run_rope_clearance_N is None else repr(r.run_rope_clearance_N), repr(r.value_N),
+                    repr(r.values_N[-1]) if len(r.values_N) > 1 else "",
+                    "" if r.mesh_difference is None else repr(r.mesh_difference),
+                    "" if not r.scatter or r.scatter[0] is None else repr(r.scatter[0]),
+                    r.elements[0] if r.elements else "", r.elements[-1] if len(r.elements) > 1 else "",
+                    repr(r.flexibility), ";".join(r.statuses), ";".join(f"{t:.1f}" for t in r.wall_time_s), r.passed])
+    atomic_write_text(out / "industry.csv", buf.getvalue())
+    header, rows = table_rows(iv)
+    md = [f"# exucable industry validation ({'default mesh only' if fast else 'default and refined mesh'})", "",
+          "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    md += ["| " + " | ".join(str(x) for x in row) + " |" for row in rows]
+    md += ["", "## The differences, explained", ""] + [f"- {r.example} ({r.mode}): {r.explanation()}" for r in iv.rows]
+    md += ["", "## Sources", ""] + sorted({f"- {r.example}: {r.source} ({r.kind})" for r in iv.rows})
+    times = ", ".join(f"{m} {t:.1f} s" for m, t in iv.mode_wall_time_s.items())
+    md += ["", f"Wall time {iv.wall_time_s:.1f} s ({times})."]
+    md += [f"- FAIL {f}" for f in iv.failures]
+    atomic_write_text(out / "industry.md", "\n".join(md) + "\n")
+    if iv.rows:
+        from .plots.validation import plot_industry
+        plot_industry(iv, out / "industry.png")

@@ -1,0 +1,76 @@
+"""`exucable validate --suite industry`: the suite's checks, table and files on one small route (the paper's
+Example 2, coarse, whose "published" value is the capstan closed form of reference/paper_values.toml), and the
+published-rounding bound on the shipped examples. The full suite runs behind `-m slow`."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from exucable.data import data_path
+from exucable.plan import plan_pull, plan_spec
+from exucable.reference import load_reference
+from exucable.scenario import load_scenario
+from exucable.validate_industry import (LBF_N, MESH_TOLERANCE, load_industry_examples, published_bounds_lbf,
+                                        validate_industry)
+
+
+def _capstan_example(published_N, rounding_lbf=0.05):
+    return {"scenario": "paper_ex2_bend90.toml", "direction": "forward", "sections": [3],
+            "tension_out_lbf": [published_N / LBF_N], "tension_rounding_lbf": rounding_lbf, "chained": False,
+            "bend_factor_rounding": 0.0, "source": "paper Eq. 26 (capstan), reference/paper_values.toml",
+            "kind": "closed form"}
+
+
+def test_small_route_suite_checks_and_files(tmp_path):
+    capstan = load_reference()["example2"]["pull_force_N"]
+    iv = validate_industry(out_dir=tmp_path, examples=[_capstan_example(capstan)],
+                           scenario_dir=data_path("scenarios", "fast"))
+    (row,) = iv.rows
+    assert row.mode == "steady" and len(row.values_N) == 2 and row.elements[1] == 2 * row.elements[0]
+    # no gravity, thin cable: the rope (capstan) and the rope with clearance coincide, and exucable meets them
+    assert row.rope_N == pytest.approx(capstan, rel=1e-4)
+    assert row.run_rope_clearance_N == pytest.approx(capstan, rel=1e-3)
+    assert abs(row.rel(capstan)) < 1e-3
+    assert abs(row.mesh_difference) <= MESH_TOLERANCE
+    assert abs(row.remainder) < 1e-3
+    # √(EJ/T)/R = 0.024 here, beyond the study's flexible regime (≤ 0.01): reported, not judged
+    assert row.flexibility == pytest.approx(math.sqrt(1e9 * math.pi * 0.0025**4 / 4 / capstan) / 0.5, rel=1e-3)
+    names = {name for name, _, _ in row.checks()}
+    assert {"rope vs published", "mesh", "trusted status"} <= names and "vs rope with clearance" not in names
+    assert "no estimate yet" in row.explanation()
+    assert row.passed and not iv.failures
+    for f in ("industry.csv", "industry.md", "industry.png"):
+        assert (tmp_path / f).stat().st_size > 0
+    assert "capstan" in (tmp_path / "industry.md").read_text()
+
+
+def test_a_wrong_published_value_fails(tmp_path):
+    capstan = load_reference()["example2"]["pull_force_N"]
+    iv = validate_industry(fast=True, out_dir=tmp_path, examples=[_capstan_example(1.01 * capstan)],
+                           scenario_dir=data_path("scenarios", "fast"))
+    assert len(iv.rows[0].values_N) == 1 and iv.rows[0].mesh_difference is None   # --fast: default mesh only
+    assert any("rope vs published" in f for f in iv.failures)
+
+
+@pytest.mark.parametrize("example", load_industry_examples(),
+                         ids=[f"{x['scenario']}-{x['direction']}" for x in load_industry_examples()])
+def test_published_bound_covers_the_rope(example):
+    # the suite's first check, on every shipped example, without a multibody run
+    sc = load_scenario(data_path("scenarios", "industry", example["scenario"]))
+    sc = sc.replace(**{"pull.direction": example["direction"]})
+    plan = plan_pull(sc, plan_spec(sc))
+    d = plan["directions"][example["direction"]]
+    bound = published_bounds_lbf(example, d["sections"], sc.contact.friction * plan["weight_correction_factor"])[-1]
+    assert math.isfinite(bound) and bound >= example["tension_rounding_lbf"]
+    assert abs(d["pull_force_N"] / LBF_N - example["tension_out_lbf"][-1]) <= bound
+
+
+@pytest.mark.slow
+def test_full_industry_suite_steady(tmp_path):
+    iv = validate_industry(out_dir=tmp_path)
+    assert len(iv.rows) == len(load_industry_examples())
+    assert all(r.trusted for r in iv.rows)
+    assert all(name != "rope vs published" or ok for r in iv.rows for name, ok, _ in r.checks())
