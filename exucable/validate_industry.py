@@ -110,6 +110,7 @@ class IndustryRow:
     published_bound_N: float
     rope_N: float                # centreline rope, the published calculators' model, whole route
     flexibility: float           # max over bends of √(EJ/T_out)/R (rope tensions)
+    liftoff_over_2c: float       # max over bends of λ²/(2R) / 2c, λ = √(EJ/T_out)
     run_rope_N: float | None = None            # both references for the run's extent of cable (a dynamic
     run_rope_clearance_N: float | None = None  # run's window has pulled some out; steady: = the route's)
     values_N: list = field(default_factory=list)        # exucable per mesh level (default first)
@@ -182,7 +183,11 @@ class IndustryRow:
             parts.append(f"free spans {100 * self.free_span_part:+.2f} % (rope with clearance vs rope)")
         if self.remainder is not None and np.isfinite(self.value_N):
             regime = ("flexible: the study's 0.1 % applies" if self.flexibility <= FLEXIBLE_LIMIT
-                      else "bending stiffness: no estimate yet (reference/README.md)")
+                      else "bending stiffness, no estimate yet (reference/README.md); lift-off λ²/2R = "
+                      f"{self.liftoff_over_2c:.2g} × 2c: " + ("the beam spans to the outer wall, extra friction "
+                                                               "expected (PULLFLEX)" if self.liftoff_over_2c > 1
+                                                               else "rides the inner wall, no first-order change "
+                                                                    "expected"))
             parts.append(f"exucable vs rope with clearance {100 * self.remainder:+.2f} % at √(EJ/T)/R = "
                          f"{self.flexibility:.3g} ({regime})")
         return "; ".join(parts)
@@ -210,12 +215,16 @@ class IndustryValidation:
         return out
 
 
-def _flexibility(scenario, plan_sections) -> float:
-    """max over the route's bends of √(EJ/T)/R with the rope's tension leaving the bend."""
+def _flexibility(scenario, plan_sections) -> tuple[float, float]:
+    """Over the route's bends, with the rope's tension T leaving each: max √(EJ/T)/R, and max of the
+    lift-off λ²/(2R) (λ = √(EJ/T)) over the 2c across the conduit — above 1 the beam that cannot follow the
+    bend's curvature jump presses the outer wall too (PULLFLEX's bend-end forces; reference/README.md)."""
     ej = scenario.cable.bending_stiffness_N_m2
-    vals = [math.sqrt(ej / s["tension_out_N"]) / s["radius_m"] for s in plan_sections
-            if s["kind"] == "bend" and s.get("radius_m") and s["tension_out_N"] > 0]
-    return max(vals, default=0.0)
+    two_c = 2.0 * (scenario.conduit.inner_radius_m - scenario.cable.radius_m)
+    bends = [(s["tension_out_N"], s["radius_m"]) for s in plan_sections
+             if s["kind"] == "bend" and s.get("radius_m") and s["tension_out_N"] > 0]
+    return (max((math.sqrt(ej / t) / r for t, r in bends), default=0.0),
+            max((ej / t / (2.0 * r) / two_c for t, r in bends), default=0.0))
 
 
 def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: bool = True,
@@ -263,7 +272,7 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
             bound = published_bounds_lbf(ex, sections, mu)[-1]
             name = f"{Path(ex['scenario']).stem}-{ex['direction']}"
             row = IndustryRow(name, ex["source"], ex["kind"], mode, ex["tension_out_lbf"][-1] * LBF_N, bound * LBF_N,
-                              plan["directions"][ex["direction"]]["pull_force_N"], _flexibility(sc, sections))
+                              plan["directions"][ex["direction"]]["pull_force_N"], *_flexibility(sc, sections))
             k0 = None
             for level, refine in enumerate(levels):
                 say(f"validate industry: {name}, {mode}, mesh level {level} (element length / {refine:g}) ...")
@@ -301,7 +310,7 @@ def _g(x, fmt=".6g"):
 
 
 HEADER = ["example", "mode", "published [N]", "rope [N]", "rope w/ clearance [N] (run's extent)", "exucable [N]", "refined [N]",
-          "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "pass"]
+          "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "liftoff/2c", "pass"]
 
 
 def table_rows(iv: IndustryValidation):
@@ -312,7 +321,7 @@ def table_rows(iv: IndustryValidation):
                      _g(r.run_rope_clearance_N), _g(r.value_N),
                      _g(r.values_N[-1]) if len(r.values_N) > 1 else "-", _pct(r.mesh_difference),
                      "-" if sc is None else f"{100 * sc:.3f} %", _pct(r.rel(r.published_N), 2), _pct(r.rel(r.run_rope_N), 2),
-                     _pct(r.remainder, 2), f"{r.flexibility:.3g}", "PASS" if r.passed else "FAIL"])
+                     _pct(r.remainder, 2), f"{r.flexibility:.3g}", f"{r.liftoff_over_2c:.2g}", "PASS" if r.passed else "FAIL"])
     return HEADER, rows
 
 
@@ -335,7 +344,7 @@ def write_industry_report(iv: IndustryValidation, out: Path, fast: bool) -> None
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(["example", "mode", "source", "published_N", "published_bound_N", "rope_pull_force_N",
                 "rope_clearance_pull_force_N", "pull_force_N", "refined_pull_force_N", "mesh_difference",
-                "scatter", "elements", "refined_elements", "flexibility_sqrt_EJ_over_T_per_R", "status",
+                "scatter", "elements", "refined_elements", "flexibility_sqrt_EJ_over_T_per_R", "liftoff_over_2c", "status",
                 "wall_time_s", "passed"])
     for r in iv.rows:
         w.writerow([r.example, r.mode, r.source, repr(r.published_N), repr(r.published_bound_N), repr(r.rope_N),
@@ -344,7 +353,7 @@ def write_industry_report(iv: IndustryValidation, out: Path, fast: bool) -> None
                     "" if r.mesh_difference is None else repr(r.mesh_difference),
                     "" if not r.scatter or r.scatter[0] is None else repr(r.scatter[0]),
                     r.elements[0] if r.elements else "", r.elements[-1] if len(r.elements) > 1 else "",
-                    repr(r.flexibility), ";".join(r.statuses), ";".join(f"{t:.1f}" for t in r.wall_time_s), r.passed])
+                    repr(r.flexibility), repr(r.liftoff_over_2c), ";".join(r.statuses), ";".join(f"{t:.1f}" for t in r.wall_time_s), r.passed])
     atomic_write_text(out / "industry.csv", buf.getvalue())
     header, rows = table_rows(iv)
     md = [f"# exucable industry validation ({'default mesh only' if fast else 'default and refined mesh'})", "",
