@@ -74,3 +74,10 @@ def test_full_industry_suite_steady(tmp_path):
     assert len(iv.rows) == len(load_industry_examples())
     assert all(r.trusted for r in iv.rows)
     assert all(name != "rope vs published" or ok for r in iv.rows for name, ok, _ in r.checks())
+
+
+def test_cli_names_the_examples_when_none_matches(capsys):
+    from exucable.cli import main
+    assert main(["validate", "--suite", "industry", "--example", "no-such-route"]) == 2
+    err = capsys.readouterr().err
+    assert "--example" in err and "gera_wire_pulling_example.toml" in err
