@@ -10,8 +10,10 @@ calculator vendor's page, each cited there and in its scenario file) one row per
   published calculators compute; checked against the published value within that bound;
 - the **rope with clearance** (``rope_clearance_pull_force_N``, :mod:`exucable.rope_clearance`): the
   EJ → 0 limit of the cable free to hang in free spans across its clearance;
-- **exucable** on the default mesh and on a mesh refined by :data:`REFINE` (element length and check-point
-  spacing halved): the mesh check is |default − refined| / refined ≤ :data:`MESH_TOLERANCE`; a dynamic
+- **exucable** on the default mesh and on ``levels − 1`` meshes each refined by :data:`REFINE` (element
+  length and check-point spacing halved), extrapolated with its error estimate (Richardson from the
+  last three levels where the sequence allows, :func:`exucable.convergence.extrapolate`; with two levels
+  the refined value): the mesh check is |default − converged| / converged ≤ :data:`MESH_TOLERANCE`; a dynamic
   run's steady scatter (std/mean over its window) must be ≤ :data:`SCATTER_TOLERANCE`; where both modes
   ran, |steady − dynamic| / dynamic ≤ :data:`MODE_TOLERANCE`;
 - the **difference from the published value explained**: published − rope is the calculator's rounding
@@ -127,11 +129,25 @@ class IndustryRow:
         return self.values_N[0] if self.values_N else float("nan")
 
     @property
+    def converged(self):
+        """The mesh-converged value as an :class:`exucable.convergence.Extrapolation` (three levels or
+        more), the finest value with error |finest − previous| (two levels), None with one level or a
+        failed level."""
+        from .convergence import Extrapolation, extrapolate
+        v = self.values_N
+        if len(v) < 2 or not np.all(np.isfinite(v)):
+            return None
+        if len(v) == 2:
+            return Extrapolation(v[1], abs(v[1] - v[0]), float("nan"), "two levels: the refined value")
+        return extrapolate(v, REFINE, [u or 0.0 for u in self.uncertainty_N])
+
+    @property
     def mesh_difference(self) -> float | None:
-        """(default − refined) / refined, None with one level."""
+        """(default − converged) / converged; None with one level, NaN with a failed level."""
         if len(self.values_N) < 2:
             return None
-        return (self.values_N[0] - self.values_N[-1]) / abs(self.values_N[-1])
+        c = self.converged
+        return float("nan") if c is None else (self.values_N[0] - c.value) / abs(c.value)
 
     @property
     def trusted(self) -> bool:
@@ -161,7 +177,7 @@ class IndustryRow:
         md = self.mesh_difference
         if md is not None:
             out.append(("mesh", abs(md) <= MESH_TOLERANCE,
-                        f"default vs refined {100 * md:+.3f} % (≤ {100 * MESH_TOLERANCE:.1f} %)"))
+                        f"default vs converged {100 * md:+.3f} % (≤ {100 * MESH_TOLERANCE:.1f} %)"))
         for level, sc in enumerate(self.scatter):
             if sc is not None:
                 out.append((f"steadiness level {level}", sc <= SCATTER_TOLERANCE,
@@ -179,6 +195,11 @@ class IndustryRow:
     def explanation(self) -> str:
         """The difference from the published value, part by part."""
         parts = [f"published − rope {self.published_N - self.rope_N:+.3g} N (rounding, bound ±{self.published_bound_N:.3g} N)"]
+        if len(self.values_N) > 1:
+            c = self.converged
+            parts.append("mesh: " + " / ".join(f"{v:.6g}" for v in self.values_N) + " N at "
+                         + " / ".join(str(n) for n in self.elements) + " elements"
+                         + ("" if c is None else f", {c.method.split(':')[0]}"))
         if self.free_span_part is not None:
             parts.append(f"free spans {100 * self.free_span_part:+.2f} % (rope with clearance vs rope)")
         if self.remainder is not None and np.isfinite(self.value_N):
@@ -229,13 +250,13 @@ def _flexibility(scenario, plan_sections) -> tuple[float, float]:
 
 def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: bool = True,
                       modes=("steady",), examples=None, progress: Callable[[str], None] | None = None,
-                      scenario_dir=None) -> IndustryValidation:
+                      scenario_dir=None, levels: int = 3) -> IndustryValidation:
     """Run the industry suite; returns its rows and writes its table and figure into ``out_dir``.
 
     Parameters
     ----------
     fast : bool
-        The default mesh only (no refined run, so no mesh check).
+        The default mesh only (no refined run, so no mesh check); overrides ``levels``.
     out_dir : str or os.PathLike
         Output directory.
     quiet : bool
@@ -248,6 +269,8 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
         Called with one line of text as each run starts and ends.
     scenario_dir : path, optional
         Where the examples' scenario files are (default: the shipped ``scenarios/industry``).
+    levels : int
+        Mesh levels (the default mesh, then each refined by :data:`REFINE`); 3 or more extrapolate.
     """
     from .plan import plan_pull, plan_spec
     from .run import run_scenario
@@ -258,7 +281,7 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
     out = Path(out_dir)
     iv = IndustryValidation()
     t0 = time.perf_counter()
-    levels = (1.0,) if fast else (1.0, REFINE)
+    refines = (1.0,) if fast else tuple(REFINE**k for k in range(max(int(levels), 1)))
     for mode in modes:
         tm = time.perf_counter()
         for ex in examples if examples is not None else load_industry_examples():
@@ -274,7 +297,7 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
             row = IndustryRow(name, ex["source"], ex["kind"], mode, ex["tension_out_lbf"][-1] * LBF_N, bound * LBF_N,
                               plan["directions"][ex["direction"]]["pull_force_N"], *_flexibility(sc, sections))
             k0 = None
-            for level, refine in enumerate(levels):
+            for level, refine in enumerate(refines):
                 say(f"validate industry: {name}, {mode}, mesh level {level} (element length / {refine:g}) ...")
                 res = run_scenario(sc, out / mode / name / f"level_{level}", quiet=quiet, plots=False,
                                    refine=refine, check_points_per_element=k0, mode=mode)
@@ -302,6 +325,11 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
     return iv
 
 
+def _converged(r: IndustryRow) -> str:
+    c = r.converged
+    return "-" if c is None else f"{c.value:.6g} ± {c.error:.2g}"
+
+
 def _pct(x, digits=3):
     return "-" if x is None or not np.isfinite(x) else f"{100 * x:+.{digits}f} %"
 
@@ -310,7 +338,7 @@ def _g(x, fmt=".6g"):
     return "-" if x is None or not np.isfinite(x) else format(x, fmt)
 
 
-HEADER = ["example", "mode", "published [N]", "rope [N]", "rope w/ clearance [N] (run's extent)", "exucable [N]", "refined [N]",
+HEADER = ["example", "mode", "published [N]", "rope [N]", "rope w/ clearance [N] (run's extent)", "exucable [N]", "converged [N]",
           "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "liftoff/2c", "pass"]
 
 
@@ -320,7 +348,7 @@ def table_rows(iv: IndustryValidation):
         sc = r.scatter[0] if r.scatter else None
         rows.append([r.example, r.mode, f"{r.published_N:.5g} ± {r.published_bound_N:.2g}", _g(r.rope_N),
                      _g(r.run_rope_clearance_N), _g(r.value_N),
-                     _g(r.values_N[-1]) if len(r.values_N) > 1 else "-", _pct(r.mesh_difference),
+                     _converged(r), _pct(r.mesh_difference),
                      "-" if sc is None else f"{100 * sc:.3f} %", _pct(r.rel(r.published_N), 2), _pct(r.rel(r.run_rope_N), 2),
                      _pct(r.remainder, 2), f"{r.flexibility:.3g}", f"{r.liftoff_over_2c:.2g}", "PASS" if r.passed else "FAIL"])
     return HEADER, rows
@@ -344,20 +372,21 @@ def write_industry_report(iv: IndustryValidation, out: Path, fast: bool) -> None
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(["example", "mode", "source", "published_N", "published_bound_N", "rope_pull_force_N",
-                "rope_clearance_pull_force_N", "pull_force_N", "refined_pull_force_N", "mesh_difference",
-                "scatter", "elements", "refined_elements", "flexibility_sqrt_EJ_over_T_per_R", "liftoff_over_2c", "status",
+                "rope_clearance_pull_force_N", "pull_force_N", "level_pull_forces_N", "converged_pull_force_N", "converged_error_N", "mesh_difference",
+                "scatter", "elements", "flexibility_sqrt_EJ_over_T_per_R", "liftoff_over_2c", "status",
                 "wall_time_s", "passed"])
     for r in iv.rows:
         w.writerow([r.example, r.mode, r.source, repr(r.published_N), repr(r.published_bound_N), repr(r.rope_N),
                     "" if r.run_rope_clearance_N is None else repr(r.run_rope_clearance_N), repr(r.value_N),
-                    repr(r.values_N[-1]) if len(r.values_N) > 1 else "",
+                    ";".join(repr(v) for v in r.values_N), "" if r.converged is None else repr(r.converged.value),
+                    "" if r.converged is None else repr(r.converged.error),
                     "" if r.mesh_difference is None else repr(r.mesh_difference),
                     "" if not r.scatter or r.scatter[0] is None else repr(r.scatter[0]),
-                    r.elements[0] if r.elements else "", r.elements[-1] if len(r.elements) > 1 else "",
+                    ";".join(str(n) for n in r.elements),
                     repr(r.flexibility), repr(r.liftoff_over_2c), ";".join(r.statuses), ";".join(f"{t:.1f}" for t in r.wall_time_s), r.passed])
     atomic_write_text(out / "industry.csv", buf.getvalue())
     header, rows = table_rows(iv)
-    md = [f"# exucable industry validation ({'default mesh only' if fast else 'default and refined mesh'})", "",
+    md = [f"# exucable industry validation ({'default mesh only' if fast else 'default and refined meshes'})", "",
           "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     md += ["| " + " | ".join(str(x) for x in row) + " |" for row in rows]
     md += ["", "## The differences, explained", ""] + [f"- {r.example} ({r.mode}): {r.explanation()}" for r in iv.rows]

@@ -27,6 +27,9 @@ def add_arguments(p) -> None:
                    help="paper suite: run only these cases (repeatable)")
     p.add_argument("--example", action="append", metavar="NAME",
                    help="industry suite: run only the examples whose scenario file name contains NAME (repeatable)")
+    p.add_argument("--levels", type=int, default=3,
+                   help="industry suite: mesh levels, the default mesh then each refined by 2 (default 3: "
+                        "Richardson extrapolation; 2: the refined value)")
     p.add_argument("--mode", action="append", choices=list(MODES),
                    help="run only these solver modes (repeatable; default: paper both, and their difference; "
                         "industry steady only, as the dynamic runs take minutes to tens of minutes per route)")
@@ -55,6 +58,10 @@ def _paper(args) -> int:
 
 def _industry(args) -> int:
     from ..validate_industry import format_industry_table, load_industry_examples, validate_industry
+    if args.levels < 1:
+        print(f"exucable validate: error: --levels: at least 1 (3 for an extrapolation), got {args.levels}",
+              file=sys.stderr)
+        return 2
     examples = load_industry_examples()
     if args.example:
         examples = [e for e in examples if any(n in e["scenario"] for n in args.example)]
@@ -64,7 +71,7 @@ def _industry(args) -> int:
             return 2
     out = Path(args.out) / "industry"
     iv = validate_industry(fast=args.fast, out_dir=out, quiet=args.quiet, modes=tuple(args.mode or ("steady",)),
-                           examples=examples, progress=None if args.quiet else _say)
+                           examples=examples, progress=None if args.quiet else _say, levels=args.levels)
     print(format_industry_table(iv))
     for f in iv.failures:
         print(f"industry: FAIL {f}", file=sys.stderr)
