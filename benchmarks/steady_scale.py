@@ -5,23 +5,35 @@ through straights of ~75 m with a bend every ~80 m, alternating horizontal and v
 radius 3 m), built by :func:`route_scenario`; the default mesh is one element per metre (each
 element turns ≤ 0.33 rad in a bend) with the default 20 check points per element.
 
-For each length and mode (the dynamic mode only up to ``--dynamic-max`` metres: it integrates
-until steady, hundreds of steps) it prints wall time (build + solve), Newton iterations, peak
-memory of the process (the increase of ru_maxrss over the run, so measure the lengths in
-increasing order) and the pulling force against the rope solution; then the exponent p of a
-least-squares fit wall ∝ L^p over the lengths solved in steady mode, measured in this one run.
+Each length and mode (the dynamic mode only up to ``--dynamic-max`` metres: it integrates until
+steady, hundreds of steps) runs in its own process, which first runs a 10 m route of the same
+mode (loading the compiled kernels) and then the measured one, whole process (scenario → build
+→ solve → result files). It prints wall time (and the build's and the solve's share), Newton
+iterations, the process's peak memory (ru_maxrss) and its increase over the measured run, the
+time and memory per element, the solve's and the contact kernel's time per Newton iteration and
+element (flat if nothing is quadratic in the elements), the check points per element (the mesh
+rule gives a tenser cable more) and the memory per check point, and the pulling force against the centreline rope and the rope
+with clearance; then the exponent p of a least-squares fit wall ∝ L^p over the lengths solved
+in steady mode, measured in this one run.
 
+``--tolerance-check`` solves the longest route again in steady mode with the stop tolerance
+divided by 100 and prints how far the pulling force moves (how converged it is); ``--mesh-check``
+solves it with twice the elements.
 Then, if ``--example4`` is given, steady Example 4 against dynamic Example 4, whole process
 (scenario → build → solve → result files), and their ratio, in this one run.
 
-Run: ``nice .venv/bin/python benchmarks/steady_scale.py [--lengths 10 100 1000] [--example4]``.
+Run: ``nice .venv/bin/python benchmarks/steady_scale.py [--lengths 10 100 1000] [--dynamic-max 100]
+[--tolerance-check] [--mesh-check] [--example4]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import resource
 import shutil
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -85,34 +97,96 @@ def timed(scenario) -> dict:
     return {"wall_s": wall, "summary": s, "peak_rss_MB": rss1 / 1024.0, "rss_increase_MB": (rss1 - rss0) / 1024.0}
 
 
-def report(length, mode, r) -> str:
-    s = r["summary"]
-    F, rope = s["pull_force_N"], s["rope_pull_force_N"]
-    dev = f"{100 * (F / rope - 1):+.2f} %" if F is not None and rope else "-"
-    return (f"{length:8.0f} m  {mode:8s} {s['status']:7s} wall {r['wall_s']:8.2f} s  "
-            f"(solve {s['wall_time_s']:7.2f} s)  Newton {s['newton_iterations']:6d}  "
-            f"elements {s['scenario']['cable']['elements']:5d}  peak RSS {r['peak_rss_MB']:7.0f} MB "
-            f"(+{r['rss_increase_MB']:.0f})  F {F if F is None else round(F, 2)} N  rope {rope:.2f} N ({dev})")
+def one_case(length_m: float, mode: str, elements_per_m: float = 1.0) -> dict:
+    """One route in this process, after a 10 m warm-up of the same mode (the JSON a child prints)."""
+    run_scenario(route_scenario(10.0, mode), None, plots=False)
+    r = timed(route_scenario(length_m, mode, elements_per_m))
+    s = r.pop("summary")
+    keep = ("status", "message", "pull_force_N", "rope_pull_force_N", "rope_clearance_pull_force_N",
+            "newton_iterations", "steps", "wall_time_s", "build_time_s", "kernel_time_s")
+    return dict(r, length_m=length_m, mode=mode, elements=s["scenario"]["cable"]["elements"],
+                check_points_per_element=s["mesh"]["check_points_per_element"], **{k: s[k] for k in keep})
+
+
+def in_child(length_m: float, mode: str, elements_per_m: float = 1.0) -> dict:
+    """:func:`one_case` in a fresh process, so that its peak memory is its own."""
+    cmd = [sys.executable, __file__, "--case", f"{length_m:g}", mode, f"{elements_per_m:g}"]
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _percent(value, ref) -> str:
+    return f"{100 * (value / ref - 1):+.2f} %" if value is not None and ref else "-"
+
+
+def report(r) -> str:
+    F, n = r["pull_force_N"], r["elements"]
+    per = max(r["newton_iterations"], 1) * n
+    cp = r["check_points_per_element"]
+    return (f"{r['length_m']:6.0f} m  {r['mode']:7s} {r['status']:6s} wall {r['wall_s']:7.2f} s "
+            f"(build {r['build_time_s']:6.2f}, solve {r['wall_time_s']:6.2f})  Newton {r['newton_iterations']:5d}  "
+            f"elements {n:5d}  {1e3 * r['wall_s'] / n:6.2f} ms/element  peak RSS {r['peak_rss_MB']:5.0f} MB "
+            f"(+{r['rss_increase_MB']:4.0f} MB, {1024 * r['rss_increase_MB'] / n:5.1f} kB/element)  "
+            f"F {'-' if F is None else f'{F:.2f}'} N  vs rope {_percent(F, r['rope_pull_force_N'])}, "
+            f"vs rope with clearance {_percent(F, r['rope_clearance_pull_force_N'])}\n"
+            f"{'':17s}per Newton iteration and element: solve {1e6 * r['wall_time_s'] / per:6.1f} µs, "
+            f"of which contact kernel {1e6 * r['kernel_time_s'] / per:6.1f} µs; {cp} check points per element "
+            f"(the mesh rule's, grows with the tension), {1024 * r['rss_increase_MB'] / (n * cp):5.2f} kB per check point")
+
+
+def mesh_check(length_m: float, base: dict) -> str:
+    """Pulling force of the steady solve on the route with twice the elements, against ``base``'s."""
+    r = in_child(length_m, "steady", elements_per_m=2.0)
+    F0, F1 = base["pull_force_N"], r["pull_force_N"]
+    return (f"mesh check, {length_m:g} m steady: F = {F0:.4f} N with {base['elements']} elements, "
+            f"{F1:.4f} N with {r['elements']} ({r['status']}, wall {r['wall_s']:.1f} s): change "
+            f"{100 * (F1 / F0 - 1):+.4f} %")
+
+
+def tolerance_check(length_m: float) -> str:
+    """Pulling force of the steady solve at the default stop tolerance and at 1/100 of it."""
+    from exucable.model.build import build_model
+    from exucable.solve_steady import STATIC_TOLERANCE, solve_steady, steady_forces
+
+    forces = []
+    for tol in (STATIC_TOLERANCE, STATIC_TOLERANCE / 100.0):
+        model = build_model(route_scenario(length_m))
+        out = solve_steady(model, tolerance=tol)
+        if out.status != "ok":
+            return f"tolerance check at {length_m:g} m: {tol:g} failed ({out.message})"
+        forces.append((tol, steady_forces(model)[0], out.steps, out.newton_iterations))
+    (t0, f0, s0, n0), (t1, f1, s1, n1) = forces
+    return (f"tolerance check, {length_m:g} m steady: F = {f0:.6f} N at {t0:g} ({s0} pseudo-time steps, {n0} Newton), "
+            f"{f1:.6f} N at {t1:g} ({s1} steps, {n1} Newton): change {100 * (f1 / f0 - 1):+.2e} %")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--lengths", type=float, nargs="+", default=[10.0, 100.0, 1000.0])
-    ap.add_argument("--dynamic-max", type=float, default=10.0,
-                    help="largest route [m] also run in dynamic mode (default 10)")
+    ap.add_argument("--dynamic-max", type=float, default=100.0,
+                    help="largest route [m] also run in dynamic mode (default 100)")
+    ap.add_argument("--tolerance-check", action="store_true",
+                    help="solve the longest route again at 1/100 of the stop tolerance")
     ap.add_argument("--example4", action="store_true", help="also steady vs dynamic Example 4")
+    ap.add_argument("--mesh-check", action="store_true",
+                    help="solve the longest route again in steady mode with twice the elements")
+    ap.add_argument("--case", nargs=3, metavar=("LENGTH_M", "MODE", "ELEMENTS_PER_M"), help=argparse.SUPPRESS)
     args = ap.parse_args()
-    # warm-up: compile/load the kernels outside the timings
-    run_scenario(route_scenario(10.0), None, plots=False)
-    walls = []
+    if args.case:
+        print(json.dumps(one_case(float(args.case[0]), args.case[1], float(args.case[2]))))
+        return
+    walls, steady_runs = [], {}
     for L in sorted(args.lengths):
         for mode in ("steady", "dynamic"):
             if mode == "dynamic" and L > args.dynamic_max:
                 continue
-            r = timed(route_scenario(L, mode))
-            print(report(L, mode, r), flush=True)
-            if mode == "steady" and r["summary"]["status"] != "failed":
+            r = in_child(L, mode)
+            print(report(r), flush=True)
+            if mode == "steady" and r["status"] != "failed":
                 walls.append((L, r["wall_s"]))
+                steady_runs[L] = r
     if len(walls) >= 2:
         L, w = np.array(walls).T
         p = np.polyfit(np.log(L), np.log(w), 1)[0]
@@ -120,13 +194,19 @@ def main() -> None:
         if len(walls) >= 3:
             p_hi = np.log(w[-1] / w[-2]) / np.log(L[-1] / L[-2])
             print(f"        between the two longest routes: exponent {p_hi:.2f}")
+    if args.tolerance_check:
+        print(tolerance_check(max(args.lengths)), flush=True)
+    if args.mesh_check and max(args.lengths) in steady_runs:
+        print(mesh_check(max(args.lengths), steady_runs[max(args.lengths)]), flush=True)
     if args.example4:
         sc = load_scenario(ROOT / "scenarios" / "paper_ex4_spatial.toml")
         rd = timed(sc)
         rs = timed(parse_scenario({**sc.to_dict(), "solver": {**sc.solver.to_dict(), "mode": "steady"}},
                                   ROOT, default_name="ex4"))
-        print(report(0, "dynamic", rd).replace("       0 m", "Example 4"))
-        print(report(0, "steady", rs).replace("       0 m", "Example 4"))
+        for name, r in (("dynamic", rd), ("steady", rs)):
+            s = r["summary"]
+            print(f"Example 4 {name:7s} {s['status']:6s} wall {r['wall_s']:7.2f} s  Newton {s['newton_iterations']:6d}  "
+                  f"F {s['pull_force_N']:.3f} N")
         print(f"Example 4, whole process: dynamic {rd['wall_s']:.2f} s / steady {rs['wall_s']:.2f} s = "
               f"{rd['wall_s'] / rs['wall_s']:.1f}x; pulling force steady - dynamic "
               f"{100 * (rs['summary']['pull_force_N'] / rd['summary']['pull_force_N'] - 1):+.3f} %")

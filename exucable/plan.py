@@ -4,12 +4,16 @@ What the installation calculators (Polywater Pull-Planner, Southwire SIMpull, Ca
 and Southwire manuals' hand calculations) give for a route and a cable set, from exucable's rope
 reference (:mod:`exucable.rope`): for each direction the tension entering and leaving every section,
 the sidewall bearing pressure (SWBP) in every bend, the limit checks with margins, and the recommended
-direction (the lower maximum tension among the directions that violate no limit).
+direction (the lower maximum tension among the directions that violate no limit). With ``engine =
+"steady"`` or ``"dynamic"`` each direction is also run on the multibody model of one cable
+(:func:`exucable.run.run_scenario`), whose section tensions and windowed SWBP replace the rope's, the rope's
+kept beside them.
 
 Several cables per duct enter as the calculators have them (:mod:`exucable.engineering`): the weight of
 all cables W = n·w, and friction multiplied by the weight correction factor w_c, so that the rope
 equation gives T_out = T_in + w_c μ W L on a level straight and T_out = T_in e^{w_c μ θ} in a bend
-without weight (Polywater, "Weight Correction Factor in Pulling Tension Calculations"). The rope keeps
+without weight (Polywater, "Weight Correction Factor in Pulling Tension Calculations"; with
+``cable.weight_correction_in_bends = false``, T_in e^{μ θ} as in SEC TES-P-104.05). The rope keeps
 gravity exactly on slopes and vertical bends, where the calculators use approximations.
 
 The scenario keys used here beyond the simulation's: ``cable.count``, ``cable.arrangement``,
@@ -20,6 +24,7 @@ imperial with ``display.units = "imperial"``, converted to SI when the file is r
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,6 +36,7 @@ from exucable.errors import ExucableError, ScenarioError
 from exucable.geometry.centreline import Centreline
 from exucable.rope import sidewall_pressure_N_per_m, solve_rope
 from exucable.scenario import Scenario, load_scenario, parse_scenario
+from exucable.trust import TRUSTED_STATUSES
 from exucable.units import SYSTEMS
 
 __all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES"]
@@ -69,6 +75,8 @@ class PlanSpec:
     limits : PlanLimits
     feed_from_reel : bool
         Also compute the pull-in history (``pull.feed_from_reel``).
+    weight_correction_in_bends : bool
+        The weight correction factor multiplies the friction in bends too (``cable.weight_correction_in_bends``).
     """
 
     count: int = 1
@@ -76,6 +84,7 @@ class PlanSpec:
     units: str = "si"
     limits: PlanLimits = field(default_factory=PlanLimits)
     feed_from_reel: bool = False
+    weight_correction_in_bends: bool = True
 
 
 def plan_spec(scenario: Scenario, units: str | None = None) -> PlanSpec:
@@ -94,7 +103,8 @@ def plan_spec(scenario: Scenario, units: str | None = None) -> PlanSpec:
         raise ExucableError(f"--units: must be one of {', '.join(SYSTEMS)}, got {units!r}")
     return PlanSpec(count=scenario.cable.count, arrangement=scenario.cable.arrangement,
                     units=units or scenario.display.units, limits=limits,
-                    feed_from_reel=scenario.pull.feed_from_reel)
+                    feed_from_reel=scenario.pull.feed_from_reel,
+                    weight_correction_in_bends=scenario.cable.weight_correction_in_bends)
 
 
 def parse_plan_scenario(data: dict, base_dir: Path, default_name: str = "scenario",
@@ -229,7 +239,84 @@ def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: floa
     return out
 
 
-def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
+def _finite_or_none(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry: dict, progress: bool) -> dict:
+    """One direction's plan entry from the multibody model, the rope's values kept beside.
+
+    The scenario is run in ``engine``'s solver mode with ``pull.direction = name`` (the reverse pull is
+    the reversed route). Section tensions are the cable's tension (EA·ε at its nodes) interpolated at
+    the section boundaries along the conduit (``s_conduit_m``); a bend's SWBP is the peak of the
+    windowed sidewall pressure over the bend (:mod:`exucable.pressure`: the contact forces of the check
+    points within ±w/2, over w), with the bend body's mean windowed pressure and the point loads at
+    its ends beside it. A dynamic run's tensions are those of its last state; its pulling force is the
+    mean over its steady window.
+    """
+    from exucable.run import cable_tension_along_conduit, run_scenario  # builds an Exudyn model
+
+    sc = dataclasses.replace(scenario, pull=dataclasses.replace(scenario.pull, direction=name))
+    result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine)
+    summary = result.summary
+    s_c, T_c = cable_tension_along_conduit(result.model)
+    order = np.argsort(s_c)
+    s_c, T_c = np.asarray(s_c, dtype=float)[order], np.asarray(T_c, dtype=float)[order]
+    L = scenario.build_conduit().centreline.length_m
+    to_conduit = (lambda s: s) if name == "forward" else (lambda s: L - s)
+
+    def tension(s_pull):
+        return float(np.interp(to_conduit(s_pull), s_c, T_c))
+
+    bends = iter(summary["bends"] if name == "forward" else summary["bends"][::-1])
+    rows = []
+    running = tension(0.0)
+    for r in rope_entry["sections"]:
+        a, b = r["s_start_m"], r["s_start_m"] + r["length_m"]
+        lo, hi = sorted((to_conduit(a), to_conduit(b)))
+        inside = T_c[(s_c >= lo) & (s_c <= hi)]
+        t_in, t_out = tension(a), tension(b)
+        running = max(running, t_in, t_out, float(np.max(inside)) if inside.size else t_out)
+        row = dict(r, tension_in_N=t_in, tension_out_N=t_out, max_tension_so_far_N=running,
+                   rope_tension_in_N=r["tension_in_N"], rope_tension_out_N=r["tension_out_N"],
+                   rope_sidewall_pressure_N_per_m=r["sidewall_pressure_N_per_m"])
+        if r["sidewall_pressure_N_per_m"] is not None:
+            bend = next(bends)
+            row.update(sidewall_pressure_N_per_m=float(bend["peak_pressure_N_per_m"]),
+                       mean_sidewall_pressure_N_per_m=_finite_or_none(bend["mean_pressure_N_per_m"]),
+                       rope_windowed_sidewall_pressure_N_per_m=float(bend["rope_peak_pressure_N_per_m"]),
+                       entry_point_load_N=float(bend["entry_point_load_N"]),
+                       entry_s_conduit_m=float(bend["entry_s_conduit_m"]),
+                       exit_point_load_N=float(bend["exit_point_load_N"]),
+                       exit_s_conduit_m=float(bend["exit_s_conduit_m"]))
+        rows.append(row)
+    s_pull = np.clip(np.array([to_conduit(s) for s in s_c]), 0.0, L)
+    back = np.argsort(s_pull)
+    pressures = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+    return {
+        # a run that failed before its first converged state has no pulling force
+        "pull_force_N": float("nan") if summary["pull_force_N"] is None else summary["pull_force_N"],
+        "max_tension_N": max(r["max_tension_so_far_N"] for r in rows),
+        "max_sidewall_pressure_N_per_m": max(pressures) if pressures else None,
+        "slack": rope_entry["slack"],
+        "sections": rows,
+        "profile": {"s_m": s_pull[back].tolist(), "tension_N": T_c[back].tolist()},
+        "rope_pull_force_N": rope_entry["pull_force_N"],
+        "rope_max_tension_N": rope_entry["max_tension_N"],
+        "rope_max_sidewall_pressure_N_per_m": rope_entry["max_sidewall_pressure_N_per_m"],
+        "rope_profile": rope_entry["profile"],
+        "status": summary["status"],
+        "message": summary["message"],
+        "flags": summary.get("flags", []),
+        "pull_force_std_N": summary.get("pull_force_std_N"),
+        "pressure_window_m": summary.get("pressure_window_m"),
+        "elements": int(result.model.layout.element_length_m.size),
+        "wall_time_s": summary["wall_time_s"],
+    }
+
+
+def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress: bool = False) -> dict:
     """Plan a pull in both directions.
 
     Parameters
@@ -238,7 +325,12 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
         Route, cable (one of the ``spec.count`` identical cables), friction, back tension, gravity.
     spec : PlanSpec
     engine : {"rope", "steady", "dynamic"}
-        Only ``"rope"`` is available in this version (see Raises).
+        ``"rope"``: the quasi-static rope (instant). ``"steady"`` / ``"dynamic"``: the multibody model of
+        one cable (:func:`exucable.run.run_scenario` in that solver mode, one run per direction, the
+        reverse run on the reversed route); the rope's values stay beside each section's
+        (``rope_*`` keys), see :func:`_multibody_direction`.
+    progress : bool
+        Show the multibody runs' progress bars on a terminal (stderr).
 
     Returns
     -------
@@ -252,14 +344,14 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
     Raises
     ------
     ExucableError
-        ``engine`` other than ``"rope"``: the multibody engines are not wired into planning yet.
+        An unknown ``engine``; ``cable.count`` > 1 with a multibody engine (it simulates one cable).
     """
     if engine not in ENGINES:
         raise ExucableError(f"--engine: must be one of {', '.join(ENGINES)}, got {engine!r}")
-    if engine != "rope":
-        raise ExucableError(
-            f"--engine {engine}: planning with the multibody model is not available in this version "
-            "(the steady solver is being built; the dynamic one is not wired into `plan` yet); use --engine rope")
+    if engine != "rope" and spec.count != 1:
+        raise ScenarioError("cable.count", f"--engine {engine} simulates one cable, got {spec.count}; plan "
+                                           "several cables per duct with --engine rope (weight correction "
+                                           "factor), or set cable.count = 1")
     if scenario.pull.force_N is not None:
         raise ScenarioError("pull.force", "exucable plan computes the pulling force from the back tension; give "
                                           "pull.back_tension (the reel's) instead of a prescribed pull.force")
@@ -273,13 +365,15 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
     g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
     w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
     mu_eff = wc * scenario.contact.friction
+    # in bends: w_c μ (IEEE 1185, AEIC CG5, Polywater) or μ (SEC TES-P-104.05's worked example)
+    mu_bend = None if spec.weight_correction_in_bends else scenario.contact.friction
     back = scenario.pull.back_tension_N
     centreline = scenario.build_conduit().centreline
 
     directions = {}
     for name in ("forward", "reverse"):
         curve = centreline if name == "forward" else centreline.reversed()
-        rope = solve_rope(centreline, mu_eff, w_total, back, name)
+        rope = solve_rope(centreline, mu_eff, w_total, back, name, bend_friction=mu_bend)
         rows = _sections(curve, rope, w_total, swbp_factor)
         bends = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
         entry = {
@@ -290,7 +384,14 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
             "sections": rows,
             "profile": {"s_m": (rope.s_cable_m).tolist(), "tension_N": rope.tension_N.tolist()},
         }
+        if engine != "rope":
+            entry = _multibody_direction(scenario, name, engine, entry, progress)
         entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
+        if engine != "rope":
+            # a run that failed or is flagged (exucable.trust) gives numbers no check should pass on
+            entry["checks"].append({"name": "multibody_run", "passed": entry["status"] in TRUSTED_STATUSES,
+                                    "value": None, "limit": None, "margin": None, "quantity": None,
+                                    "where": f"status {entry['status']}" + (f": {entry['message']}" if entry["message"] else "")})
         entry["passed"] = all(c["passed"] for c in entry["checks"])
         if spec.feed_from_reel:
             entry["pull_in"] = _pull_in_history(curve, rope)
@@ -304,6 +405,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope") -> dict:
         "directions": directions,
         "recommended_direction": recommended,
         "weight_correction_factor": wc,
+        "weight_correction_in_bends": spec.weight_correction_in_bends,
         "sidewall_pressure_factor": swbp_factor,
         "jam_ratio": jam.jam_ratio,
         "jam_risk": jam.risk,

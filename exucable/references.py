@@ -27,7 +27,8 @@ from .rope_clearance import solve_rope_with_clearance
 __all__ = ["pull_force_references_N", "reference_drift_N_per_s"]
 
 
-def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_clearance: bool = True) -> dict:
+def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_clearance: bool = True,
+                            clearance_solution=None) -> dict:
     """Pulling force of both flexible references once ``pulled_out_m`` of cable has left the conduit.
 
     Parameters
@@ -40,6 +41,9 @@ def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_c
         Length of cable pulled out past the conduit's exit since the start [m], v·t.
     with_clearance : bool
         Also solve the rope with clearance (the costlier of the two).
+    clearance_solution : ClearanceRopeSolution, optional
+        The rope with clearance already solved for this conduit and extent (the start's, at
+        ``pulled_out_m`` 0): used instead of solving it again.
 
     Returns
     -------
@@ -63,7 +67,9 @@ def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_c
     rope = solve_rope(centre, mu, w, back, cable_length_m=inside).pull_force_N + head
     clearance = conduit.inner_radius_m - sc.cable.radius_m
     clear = None
-    if clearance > 0.0 and with_clearance:
+    if clearance > 0.0 and with_clearance and clearance_solution is not None:
+        clear = clearance_solution.pull_force_N + head
+    elif clearance > 0.0 and with_clearance:
         try:
             clear = solve_rope_with_clearance(centre, clearance, mu, w, back, cable_length_m=inside).pull_force_N + head
         except ModelError:

@@ -198,8 +198,11 @@ def _end_of_slack(g0: Callable[[float], float], s_lo: float, s_hi: float) -> flo
     return float(brentq(g0, grid[i - 1], grid[i], xtol=1e-14 * max(1.0, abs(s_hi)), rtol=1e-15))
 
 
-def _integrate(curve, mu: float, w: float, s0: float, s1: float, trailing_N: float, dense: bool):
+def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, trailing_N: float, dense: bool,
+               mu_curved: float | None = None):
     """Integrate the rope ODE from s0 to s1 on ``curve``; return (T(s1) [N], branches, slack).
+
+    ``mu_curved``: friction in curved pieces (default ``mu_straight``).
 
     branches (only if ``dense``): list of (s_lo, s_hi, piece_lo, piece_hi, fn, nodes) in curve coordinates,
     ``fn`` the vectorised tension T(s) [N] on [s_lo, s_hi], ``nodes`` the integrator's steps (for maxima).
@@ -209,12 +212,14 @@ def _integrate(curve, mu: float, w: float, s0: float, s1: float, trailing_N: flo
     tension = float(trailing_N)
     for lo, hi, plo, phi in _piece_intervals(curve, s0, s1):
         s_min, s_max = _inside(plo, phi)
+        curved = bool(np.linalg.norm(_as_rows(curve.curvature_vector(np.array([0.5 * (lo + hi)])), 1)[0]) > 0.0)
+        mu = mu_curved if (curved and mu_curved is not None) else mu_straight
 
-        def rate(s, y, s_min=s_min, s_max=s_max):
+        def rate(s, y, s_min=s_min, s_max=s_max, mu_here=mu):
             # s is clamped into the piece so that RK stages at the piece's end use this piece's curvature.
             sc = min(max(s, s_min), s_max)
             load, tz = _transverse_load(curve, np.array([sc]), np.array([y[0]]), w)
-            return [mu * np.linalg.norm(load[0]) + w * tz[0]]
+            return [mu_here * np.linalg.norm(load[0]) + w * tz[0]]
 
         def g0(s, rate=rate):
             return rate(s, [0.0])[0]
@@ -289,7 +294,8 @@ def _validate(centreline, friction, w, direction, cable_length_m):
 
 
 def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0.0, trailing_tension_N: float = 0.0,
-               direction: str = "forward", cable_length_m: float | None = None, n_output: int = 801) -> RopeSolution:
+               direction: str = "forward", cable_length_m: float | None = None, n_output: int = 801,
+               bend_friction: float | None = None) -> RopeSolution:
     """Tension along a rope pulled steadily through a conduit, given the trailing (back) tension.
 
     Integrates ``dT/ds = μ|T κn − w(e_z − (e_z·t)t)| + w(e_z·t)`` piece by piece (restarting at every piece
@@ -317,11 +323,21 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
         part of the conduit (forward: from s = L − cable_length to L).
     n_output : int
         Number of points of the output profile (uniform in cable length).
+    bend_friction : float, optional
+        Friction coefficient in curved pieces (bends, helices) [-], default ``friction``. Lets a pull
+        plan apply a calculation convention that corrects friction differently on straights and in bends
+        (``cable.weight_correction_in_bends``).
 
     Returns
     -------
     RopeSolution
     """
+    if bend_friction is not None:
+        bend_mu = float(bend_friction)
+        if not np.isfinite(bend_mu) or bend_mu < 0.0:
+            raise ModelError("bend_friction", f"bend friction coefficient must be finite and >= 0, got {bend_friction!r}")
+    else:
+        bend_mu = None
     mu, w, length, conduit_length = _validate(centreline, friction, weight_per_length_N_per_m, direction,
                                               cable_length_m)
     trailing = float(trailing_tension_N)
@@ -331,7 +347,7 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
         raise ModelError("n_output", "n_output must be >= 2")
     curve = centreline if direction == "forward" else centreline.reversed()
     s0 = conduit_length - length  # trailing end, in the coordinates of `curve`
-    pull, raw_branches, slack = _integrate(curve, mu, w, s0, conduit_length, trailing, dense=True)
+    pull, raw_branches, slack = _integrate(curve, mu, w, s0, conduit_length, trailing, dense=True, mu_curved=bend_mu)
 
     # Branches in cable coordinates (s_cable = s_curve − s0).
     # The first and last branch are widened to exactly [0, length] so that rounding of s0 leaves no gap.

@@ -284,4 +284,7 @@ def extent_references(scenario, model, pulled_out_m: float) -> dict:
 
     if scenario.pull.force_N is not None:
         return {}
-    return pull_force_references_N(scenario, model.conduit, pulled_out_m)
+    # at the start's extent the start's own rope with clearance is that reference (same conduit, cable
+    # length, loads): not solved twice
+    start_clearance = getattr(model.start, "rope_clearance", None) if pulled_out_m == 0.0 else None
+    return pull_force_references_N(scenario, model.conduit, pulled_out_m, clearance_solution=start_clearance)

@@ -220,6 +220,9 @@ class CableSpec(_Spec):
         Identical cables of this kind in the duct (1…4; ``exucable plan`` only).
     arrangement : str
         ``"auto"`` or their arrangement in the duct (:data:`exucable.engineering.ARRANGEMENTS`).
+    weight_correction_in_bends : bool
+        ``exucable plan``: apply the weight correction factor to the friction in bends too (default) or
+        on straights only.
     """
 
     _SECTION: ClassVar[str] = "cable"
@@ -236,6 +239,7 @@ class CableSpec(_Spec):
     bending_stiffness_given_N_m2: float | None = _default("cable.bending_stiffness")
     count: int = _default("cable.count")
     arrangement: str = _default("cable.arrangement")
+    weight_correction_in_bends: bool = _default("cable.weight_correction_in_bends")
 
     def _check(self) -> None:
         if self.elements is not None and self.element_length_m is not None:

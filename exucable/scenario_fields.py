@@ -172,6 +172,10 @@ FIELDS: tuple[Field, ...] = (
       choices=("auto", "single", "triangular", "cradled", "diamond"), ours=True,
       rule="`single` (1), `triangular` (2, 3), `cradled` (3, 4), `diamond` (4); `auto`: 3 cables triangular for "
            "D/d < 2.5 else cradled, 4 diamond for D/d < 3.0 else cradled (Cableizer CR_pull)"),
+    F("cable.weight_correction_in_bends", "weight_correction_in_bends", "bool", "", True, ours=True,
+      rule="`exucable plan`, several cables: `true` (IEEE 1185, AEIC CG5, Polywater): the weight correction factor "
+           "w_c multiplies the friction in bends too, T_out = T_in e^(w_c μ θ); `false`: on straights only, "
+           "T_out = T_in e^(μ θ) in bends (SEC TES-P-104.05's worked example)"),
     F("conduit.inner_radius", "inner_radius_m", "float", "m", gt=0.0, rule="> `cable.radius`"),
     F("conduit.start", "start_m", "vector3", "m", (0.0, 0.0, 0.0), rule="3 numbers; path routes only"),
     F("conduit.heading", "heading", "vector3", "", (1.0, 0.0, 0.0), nonzero=True,

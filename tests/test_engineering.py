@@ -19,6 +19,12 @@ LBF = 4.4482216152605
 CMIL = math.pi / 4 * (0.0254e-3) ** 2
 
 
+def _diameters_m(i) -> tuple[float, float]:
+    """(duct inner diameter, cable diameter) [m] from inputs given in inches or centimetres."""
+    unit, suffix = (IN, "_in") if "duct_inner_diameter_in" in i else (0.01, "_cm")
+    return i["duct_inner_diameter" + suffix] * unit, i["cable_diameter" + suffix] * unit
+
+
 def _evaluate(entry):
     f, i = entry["function"], entry["inputs"]
     if f == "max_tension_from_conductors_N":
@@ -28,8 +34,7 @@ def _evaluate(entry):
     if f == "T/R":
         return (i["tension_lbf"] * LBF) / (i["radius_ft"] * 0.3048) / (LBF / 0.3048)
     if f == "weight_correction_factor":
-        return eng.weight_correction_factor(i["count"], i["arrangement"], i["duct_inner_diameter_in"] * IN,
-                                            i["cable_diameter_in"] * IN)
+        return eng.weight_correction_factor(i["count"], i["arrangement"], *_diameters_m(i))
     if f == "clearance_m":
         return eng.clearance_m(i["count"], i["arrangement"], i["duct_inner_diameter_in"] * IN,
                                i["cable_diameter_in"] * IN) / IN

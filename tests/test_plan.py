@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -72,6 +73,19 @@ def test_three_cables_use_weight_correction_and_bundle_weight():
     assert _plan(cable__count=3)["arrangement"] == "cradled"  # auto: D/d = 5 >= 2.5
 
 
+@pytest.mark.parametrize("in_bends", [True, False])
+def test_weight_correction_in_bends_or_on_straights_only(in_bends):
+    """Without gravity the rope is the capstan law: the bend's factor is e^(w_c mu theta) by default (IEEE 1185)
+    and e^(mu theta) with cable.weight_correction_in_bends = false (SEC TES-P-104.05's worked example)."""
+    plan = _plan(cable__count=3, cable__arrangement="cradled", cable__weight_correction_in_bends=in_bends,
+                 gravity={"g": 0.0})
+    wc, mu = plan["weight_correction_factor"], 0.3
+    assert wc > 1.05 and plan["weight_correction_in_bends"] is in_bends
+    bend = plan["directions"]["forward"]["sections"][1]
+    factor = math.exp((wc if in_bends else 1.0) * mu * math.pi / 2)
+    assert bend["tension_out_N"] == pytest.approx(bend["tension_in_N"] * factor, rel=1e-9)
+
+
 def test_vertical_bends_are_named():
     plan = _plan(conduit__path=[{"straight": 10.0}, {"bend": 30.0, "radius": 5.0, "turn": "up"}, {"straight": 10.0},
                                 {"bend": 30.0, "radius": 5.0, "turn": "down"}, {"straight": 10.0}])
@@ -133,10 +147,18 @@ def test_bad_inputs_are_refused_with_the_key(over, key):
     assert exc.value.key == key
 
 
-def test_multibody_engines_say_they_are_not_available():
+@pytest.mark.parametrize("engine", ["steady", "dynamic"])
+def test_multibody_engines_refuse_several_cables_naming_the_key(engine):
+    scenario, spec = parse_plan_scenario(_data(cable__count=3), ROOT)
+    with pytest.raises(ScenarioError, match="--engine rope") as exc:
+        plan_pull(scenario, spec, engine=engine)
+    assert exc.value.key == "cable.count"
+
+
+def test_an_unknown_engine_is_refused():
     scenario, spec = parse_plan_scenario(_data(), ROOT)
-    with pytest.raises(ExucableError, match="use --engine rope"):
-        plan_pull(scenario, spec, engine="steady")
+    with pytest.raises(ExucableError, match="--engine"):
+        plan_pull(scenario, spec, engine="fem")
 
 
 class _Page(HTMLParser):
@@ -265,3 +287,19 @@ def test_a_prescribed_pull_force_is_refused_and_slack_is_reported():
                  conduit__path=[{"straight": 20.0}], pull__back_tension=0.0)
     assert plan["directions"]["reverse"]["slack"] and plan["directions"]["reverse"]["pull_force_N"] == 0.0
     assert not plan["directions"]["forward"]["slack"]
+
+
+def test_readme_links_an_industry_report_and_shows_its_picture():
+    """Issue #16 "Done when": the HTML report of one industry route is linked from the README, with a picture."""
+    readme = (ROOT / "README.md").read_text()
+    assert "(docs/plan_example/report.html)" in readme and "![plan report](docs/plan_example/preview.png)" in readme
+    example = ROOT / "docs" / "plan_example"
+    assert (example / "preview.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    page = _Page()
+    page.feed((example / "report.html").read_text())
+    assert page.external == [] and page.imgs and all(src.startswith("data:image/png;base64,") for src in page.imgs)
+    assert {"sections-forward", "sections-reverse", "checks-forward", "recommended"} <= page.ids
+    plan = json.loads((example / "plan.json").read_text())
+    scenario = ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml"
+    assert plan["inputs"]["scenario"] == parse_plan_scenario(tomllib.loads(scenario.read_text()), ROOT)[0].name
+

@@ -3,18 +3,20 @@ within their published rounding, propagated along the route (rule in that file's
 
 from __future__ import annotations
 
+import math
 import tomllib
 from pathlib import Path
 
 import pytest
 
 from exucable.plan import load_plan_scenario, plan_pull
-from exucable.validate_industry import published_bounds_lbf
+from exucable.validate_industry import published_bounds_N, published_values
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = tomllib.loads((ROOT / "reference" / "industry_values.toml").read_text())
 LBF = 4.4482216152605
-LB_PER_FT = LBF / 0.3048
+FT = 0.3048
+LB_PER_FT = LBF / FT
 
 
 @pytest.mark.parametrize("example", REFERENCE["example"],
@@ -23,16 +25,43 @@ def test_published_section_tensions_and_swbp(example):
     scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / example["scenario"])
     plan = plan_pull(scenario, spec)
     rows = plan["directions"][example["direction"]]["sections"]
-    mu = scenario.contact.friction * plan["weight_correction_factor"]
-    bounds = published_bounds_lbf(example, rows, mu)
-    for idx, pub, bound in zip(example["sections"], example["tension_out_lbf"], bounds):
-        ours = rows[idx - 1]["tension_out_N"] / LBF
-        assert abs(ours - pub) <= bound, f"section {idx}: ours {ours:.3f} lbf, published {pub}, bound {bound:.3f}"
-    for idx, pub in zip(example.get("bend_sections", []), example.get("sidewall_pressure_lb_per_ft", [])):
+    mu = scenario.contact.friction
+    mu_bend = mu * plan["weight_correction_factor"] if spec.weight_correction_in_bends else mu
+    w = plan["inputs"]["weight_per_length_one_cable_N_per_m"] * plan["count"]
+    pub = published_values(example)
+    bounds = published_bounds_N(example, rows, mu_bend, w)
+    for idx, value, bound in zip(example["sections"], pub["tension_N"], bounds):
+        ours = rows[idx - 1]["tension_out_N"]
+        assert abs(ours - value) <= bound, f"section {idx}: ours {ours:.2f} N, published {value:.2f} N, bound {bound:.2f}"
+    for idx, value in zip(example.get("bend_sections", []), pub["pressure_N_per_m"]):
         e_t = bounds[example["sections"].index(idx)]
-        ours = rows[idx - 1]["sidewall_pressure_N_per_m"] / LB_PER_FT
-        bound = e_t / example["bend_radius_ft"] + example["pressure_rounding_lb_per_ft"]
-        assert abs(ours - pub) <= bound, f"bend {idx}: ours {ours:.3f} lb/ft, published {pub}, bound {bound:.3f}"
+        row = rows[idx - 1]
+        if example.get("sidewall_pressure_of") == "bundle":
+            ours = row["tension_out_N"] / row["radius_m"]
+            # and exucable's own SWBP is the most loaded cable's: T/R times the arrangement's factor
+            assert row["sidewall_pressure_N_per_m"] == pytest.approx(ours * plan["sidewall_pressure_factor"], rel=0.02)
+        else:
+            ours = row["sidewall_pressure_N_per_m"]
+        bound = e_t / pub["radius_m"] + pub["pressure_rounding_N_per_m"]
+        assert abs(ours - value) <= bound, f"bend {idx}: ours {ours:.3f} N/m, published {value:.3f}, bound {bound:.3f}"
+
+
+def test_errata_follow_from_their_printed_operands():
+    """A corrected value is the printed operands' arithmetic (reference header, `erratum`), re-evaluated here."""
+    tes = next(x for x in REFERENCE["example"] if "erratum" in x)
+    printed, corrected = tes["tension_out_N"], tes["tension_out_corrected_N"]
+    # the standard truncates to whole newtons (TB of Sect. 4.5.1: 3002.5 printed 3002)
+    assert math.floor(printed[2] * 1.48) == corrected[3] != printed[3]          # TB = TC x 1.48
+    assert corrected[4] - corrected[3] == printed[4] - printed[3] == 3002        # TA = TB + the 60 m add-on
+    assert math.floor(9.8 * 60 * (3.15 * 1.01) * 0.5 * 1.07 * 3) == 3002         # that add-on, Eq. 05-1 as printed
+
+
+def test_tes_weight_correction_is_the_published_occupancy_factor():
+    """TES-P-104.05 p. 10: OF = 1/sqrt(1 - (4.13/(15.4 - 4.13))^2) = 1.07 for the three cables."""
+    scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "sec_tes_p_104_05_three_cables.toml")
+    plan = plan_pull(scenario, spec)
+    assert round(plan["weight_correction_factor"], 2) == 1.07 and plan["arrangement"] == "triangular"
+    assert plan["weight_correction_in_bends"] is False
 
 
 def test_commscope_recommends_the_direction_the_manual_finds_easier():
@@ -41,3 +70,10 @@ def test_commscope_recommends_the_direction_the_manual_finds_easier():
     plan = plan_pull(scenario, spec)
     assert plan["recommended_direction"] == "reverse"
     assert plan["directions"]["reverse"]["pull_force_N"] < plan["directions"]["forward"]["pull_force_N"]
+
+
+def test_tes_recommends_the_direction_the_standard_finds_easier():
+    # Sect. 4.5.2: "Pulling from at point (F) to at point (A) results in considerably less tension".
+    scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "sec_tes_p_104_05_three_cables.toml")
+    plan = plan_pull(scenario, spec)
+    assert plan["recommended_direction"] == "reverse" and plan["passed"]

@@ -119,7 +119,7 @@ def test_a_route_that_needs_continuation(monkeypatch):
 
     def budgeted(model, lam):
         # the first call is the full-load attempt from the start: 2 steps; then the default
-        monkeypatch.setattr(ss, "MAX_PSEUDO_STEPS", 2 if not stages else 80)
+        monkeypatch.setattr(ss, "MAX_PSEUDO_STEPS_TOTAL", 2 if not stages else 400)
         stages.append(lam)
         set_scale(model, lam)
 
@@ -129,6 +129,26 @@ def test_a_route_that_needs_continuation(monkeypatch):
     assert "continuation in the load scale" in out.message
     assert stages[0] == 1.0 and len(stages) >= 3 and stages[-1] == 1.0
     assert abs(out.history.pull_force_N[-1] / direct.history.pull_force_N[-1] - 1) < 1e-5
+
+
+def test_pseudo_time_budget_is_on_progress_not_on_the_count(monkeypatch):
+    """A solve that keeps making progress is not cut off: Example 2 (coarse) takes 13 pseudo-time
+    steps (11 converged), its residual halving at least every 4, so a budget of 5 steps *without
+    halving* lets it finish at the full loads (a budget of 5 steps in all would have sent it to the
+    load continuation), to the pulling force of the default budget."""
+    from dataclasses import replace
+
+    import exucable.solve_steady as ss
+    from exucable.model.build import build_model
+
+    sc = fast("paper_ex2_bend90")
+    sc = replace(sc, solver=replace(sc.solver, mode="steady"))
+    default = ss.solve_steady(build_model(sc))
+    monkeypatch.setattr(ss, "MAX_PSEUDO_STEPS", 5)
+    out = ss.solve_steady(build_model(sc))
+    assert out.status == "ok" and "continuation" not in out.message, out.message
+    assert out.steps > 5
+    assert out.history.pull_force_N[-1] == pytest.approx(default.history.pull_force_N[-1], rel=1e-12)
 
 
 def test_steady_mode_refuses_a_start_without_pretension():

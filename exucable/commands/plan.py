@@ -21,6 +21,11 @@ __all__ = ["add_arguments", "main", "write_plan"]
 
 SECTION_COLUMNS = ("index", "kind", "plane", "slope_deg", "angle_deg", "radius_m", "length_m", "tension_in_N",
                    "tension_out_N", "sidewall_pressure_N_per_m", "max_tension_so_far_N")
+#: Extra section columns of a multibody plan (``--engine steady|dynamic``): the rope's values beside,
+#: the bend body's mean windowed pressure and the point loads at the bend ends [N] with their places.
+MULTIBODY_SECTION_COLUMNS = ("rope_tension_in_N", "rope_tension_out_N", "rope_sidewall_pressure_N_per_m",
+                             "rope_windowed_sidewall_pressure_N_per_m", "mean_sidewall_pressure_N_per_m",
+                             "entry_point_load_N", "entry_s_conduit_m", "exit_point_load_N", "exit_s_conduit_m")
 CHECK_COLUMNS = ("direction", "name", "passed", "value", "limit", "margin", "where", "quantity")
 
 
@@ -28,7 +33,9 @@ def add_arguments(p) -> None:
     p.add_argument("scenario", help="scenario file (TOML), with optional [limits], cable.count, cable.arrangement")
     p.add_argument("--out", default=None, help="output directory (default: plan_<scenario name>)")
     p.add_argument("--engine", choices=ENGINES, default="rope",
-                   help="rope (default, instant); steady or dynamic: the multibody model (not available yet)")
+                   help="rope (default, instant, any cable.count); steady (one static solve per direction) or "
+                        "dynamic (a dynamic run per direction, with progress): the multibody model of one cable, "
+                        "the rope's values beside")
     p.add_argument("--units", choices=SYSTEMS, default=None,
                    help="units of the printed tables and the report (default: the scenario's display.units); "
                         "the file's bare numbers are always read in its own display.units")
@@ -54,7 +61,8 @@ def write_plan(out_dir, plan: dict, scenario, units: str) -> list[Path]:
     for name in ("forward", "reverse"):
         d = plan["directions"][name]
         path = out / f"sections_{name}.csv"
-        atomic_write_text(path, _text_csv(SECTION_COLUMNS, d["sections"]))
+        columns = SECTION_COLUMNS + (MULTIBODY_SECTION_COLUMNS if plan["engine"] != "rope" else ())
+        atomic_write_text(path, _text_csv(columns, d["sections"]))
         written.append(path)
         if "pull_in" in d:
             path = out / f"pull_in_{name}.csv"
@@ -91,7 +99,7 @@ def main(args) -> int:
     from exucable.units import display_unit, from_si
 
     scenario, spec = load_plan_scenario(args.scenario, units=args.units)
-    plan = plan_pull(scenario, spec, engine=args.engine)
+    plan = plan_pull(scenario, spec, engine=args.engine, progress=True)
     units = spec.units
     f = display_unit("force", units)
     print(f"{scenario.name}: {plan['count']} cable(s), {plan['arrangement']}, weight correction "
@@ -101,6 +109,11 @@ def main(args) -> int:
         d = plan["directions"][name]
         print(f"\n{name} pull: pull force {from_si(d['pull_force_N'], 'force', units):.4g} {f}, "
               f"max tension {from_si(d['max_tension_N'], 'force', units):.4g} {f}")
+        if "rope_pull_force_N" in d:
+            print(f"  {plan['engine']} engine, {d['elements']} elements: status {d['status']}"
+                  f"{'; ' + d['message'] if d['message'] else ''}; rope: pull force "
+                  f"{from_si(d['rope_pull_force_N'], 'force', units):.4g} {f}, max tension "
+                  f"{from_si(d['rope_max_tension_N'], 'force', units):.4g} {f}")
         _print_table(*section_rows(d, units))
         if d["slack"]:
             print("  note: the cable runs slack somewhere (a downhill stretch steeper than the friction angle): "
@@ -109,8 +122,9 @@ def main(args) -> int:
             value, limit, unit = check_in_units(c, units)
             margin = "" if c["margin"] is None else f", margin {100 * c['margin']:.1f} %"
             limit = "" if limit is None else f", limit {limit:.4g} {unit}"
-            print(f"  check {c['name']}: {'pass' if c['passed'] else 'FAIL'} (value {value:.4g} {unit}"
-                  f"{limit}{margin}; {c['where']})")
+            value = "" if value is None else f"value {value:.4g} {unit}"
+            print(f"  check {c['name']}: {'pass' if c['passed'] else 'FAIL'} ({value}"
+                  f"{limit}{margin}{'; ' if value else ''}{c['where']})")
     out = Path(args.out) if args.out else Path(f"plan_{scenario.name}")
     write_plan(out, plan, scenario, units)
     print(f"\nrecommended direction: {plan['recommended_direction']}"

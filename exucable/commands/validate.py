@@ -73,6 +73,8 @@ def _industry(args) -> int:
     iv = validate_industry(fast=args.fast, out_dir=out, quiet=args.quiet, modes=tuple(args.mode or ("steady",)),
                            examples=examples, progress=None if args.quiet else _say, levels=args.levels)
     print(format_industry_table(iv))
+    for n in iv.skipped:
+        print(f"industry: skipped {n}")
     for f in iv.failures:
         print(f"industry: FAIL {f}", file=sys.stderr)
     n_pass = sum(r.passed for r in iv.rows)

@@ -390,7 +390,8 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
             h.guide = add_guide(mbs, lead_node, t_exit, 1.0e6,
                                 2.0 * np.sqrt(1.0e6 * c.mass_per_length_kg_per_m * L_cable / layout.n_elements),
                                 node_index=len(cable.nodes) - 1)
-    h.reference_drift_N_per_s = reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s)
+    # the reference's drift is along a time history, which a steady solve does not have
+    h.reference_drift_N_per_s = 0.0 if steady else reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s)
     sp = sc.solver
     h.recorder = Recorder(h, sp.output_interval_s, sp.steady_stop, sp.steady_window_s, sp.steady_tolerance)
     return h

@@ -337,6 +337,9 @@ class InitialLayout:
     mesh : exucable.mesh.MeshPlan or None
         The cable mesh (elements, check points per element) by the rule of :mod:`exucable.mesh`
         or the scenario's override, with its warnings.
+    rope_clearance : exucable.rope_clearance.ClearanceRopeSolution or None
+        The rope with clearance whose path the start follows (None where it is not used: a
+        force-controlled pull, no clearance, no pretension, or a cable that runs slack).
     """
 
     conduit: object
@@ -346,6 +349,7 @@ class InitialLayout:
     exit_tangent: np.ndarray
     entry_tangent: np.ndarray
     mesh: object = None
+    rope_clearance: object = None
 
     @property
     def leading_position_m(self) -> np.ndarray:
@@ -462,7 +466,8 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
                           offset_fn, clearance_m=clearance if with_contact else None)
     else:
         cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, 0.0)
+        free = None
     t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
     t_entry = np.asarray(centre.tangent(centre.length_m - L_cable), dtype=float)
     return InitialLayout(conduit=conduit, rope=rope, cable=cable, weight_per_length_N_per_m=w,
-                         exit_tangent=t_exit, entry_tangent=t_entry, mesh=mesh)
+                         exit_tangent=t_exit, entry_tangent=t_entry, mesh=mesh, rope_clearance=free)

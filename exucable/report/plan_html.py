@@ -62,6 +62,10 @@ def section_rows(direction: dict, units: str) -> tuple[list[str], list[list]]:
                     display_unit("force_per_length", units), display_unit("length", units))
     header = ["#", "section", "plane / slope", f"length [{ln}]", f"radius [{ln}]", f"T in [{f}]", f"T out [{f}]",
               f"SWBP [{p}]", f"max T so far [{f}]"]
+    # a multibody plan keeps the rope's values beside each section's
+    beside = bool(direction["sections"]) and "rope_tension_out_N" in direction["sections"][0]
+    if beside:
+        header += [f"rope T out [{f}]", f"rope SWBP [{p}]", f"end point loads in/out [{f}]"]
     rows = []
     for r in direction["sections"]:
         if r["kind"] == "straight":
@@ -72,9 +76,17 @@ def section_rows(direction: dict, units: str) -> tuple[list[str], list[list]]:
             radius = from_si(r["radius_m"], "length", units)
         swbp = None if r["sidewall_pressure_N_per_m"] is None else from_si(r["sidewall_pressure_N_per_m"],
                                                                           "force_per_length", units)
-        rows.append([r["index"], r["kind"], where, from_si(r["length_m"], "length", units), radius,
-                     from_si(r["tension_in_N"], "force", units), from_si(r["tension_out_N"], "force", units),
-                     swbp, from_si(r["max_tension_so_far_N"], "force", units)])
+        row = [r["index"], r["kind"], where, from_si(r["length_m"], "length", units), radius,
+               from_si(r["tension_in_N"], "force", units), from_si(r["tension_out_N"], "force", units),
+               swbp, from_si(r["max_tension_so_far_N"], "force", units)]
+        if beside:
+            rope_p = r["rope_sidewall_pressure_N_per_m"]
+            loads = (None if "entry_point_load_N" not in r else
+                     f"{from_si(r['entry_point_load_N'], 'force', units):.3g} / "
+                     f"{from_si(r['exit_point_load_N'], 'force', units):.3g}")
+            row += [from_si(r["rope_tension_out_N"], "force", units),
+                    None if rope_p is None else from_si(rope_p, "force_per_length", units), loads]
+        rows.append(row)
     del fl
     return header, rows
 
@@ -96,7 +108,11 @@ def _tension_figure(plan: dict, units: str) -> str:
         prof = plan["directions"][name]["profile"]
         s = from_si(np.asarray(prof["s_m"]), "length", units)
         t = from_si(np.asarray(prof["tension_N"]), "force", units)
-        ax.plot(s, t, style, label=f"{name} (pull force {from_si(plan['directions'][name]['pull_force_N'], 'force', units):.4g})")
+        line, = ax.plot(s, t, style, label=f"{name} (pull force {from_si(plan['directions'][name]['pull_force_N'], 'force', units):.4g})")
+        rope = plan["directions"][name].get("rope_profile")
+        if rope is not None:
+            ax.plot(from_si(np.asarray(rope["s_m"]), "length", units), from_si(np.asarray(rope["tension_N"]), "force", units),
+                    ":", color=line.get_color(), lw=1.0, label=f"{name}, rope")
     ax.set_xlabel(f"distance from the cable's tail along the route [{display_unit('length', units)}]")
     ax.set_ylabel(f"tension [{display_unit('force', units)}]")
     ax.grid(alpha=0.3)
@@ -158,6 +174,15 @@ def _input_rows(plan: dict, units: str) -> list[list]:
     return rows
 
 
+_ENGINE_NOTE = {
+    "rope": "quasi-static rope, exucable.rope",
+    "steady": "multibody model of the cable, steady sliding in one static solve per direction; the rope's "
+              "values beside; SWBP: peak windowed pressure in each bend",
+    "dynamic": "multibody model of the cable, dynamic run per direction (tensions of its last state, pull force "
+               "averaged over its steady window); the rope's values beside; SWBP: peak windowed pressure in each bend",
+}
+
+
 def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, units: str = "si") -> str:
     """The report page as one HTML string.
 
@@ -181,7 +206,7 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
              f"<p class='verdict {'ok' if passed else 'bad'}' id='verdict'>"
              f"{'All checks pass' if passed else 'A check fails in both directions'} — recommended direction: "
              f"<b id='recommended'>{rec}</b>, pull force {from_si(plan['directions'][rec]['pull_force_N'], 'force', units):.4g} {f}</p>",
-             f"<p class='note'>Engine: {plan['engine']} (quasi-static rope, exucable.rope). {plan['count']} cable(s), "
+             f"<p class='note'>Engine: {plan['engine']} ({_ENGINE_NOTE[plan['engine']]}). {plan['count']} cable(s), "
              f"arrangement {plan['arrangement']}, weight correction factor {plan['weight_correction_factor']:.4g}, "
              f"jam ratio {plan['jam_ratio']:.3g} (risk: {plan['jam_risk']}), clearance "
              f"{from_si(plan['clearance_m'], 'length', units, small=True):.3g} {display_unit('length', units, small=True)}.</p>"]
@@ -220,8 +245,10 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
         # pull, so the history is the tension curve above read as "force at the rig vs pulled length".
         parts += ["<h2 id='pull-in'>Pull-in history</h2><p>Tension at the rig while the cable's head advances from "
                   "the entrance (rope, quasi-static, pulling line taken frictionless): with the head at a distance x "
-                  "the rig pulls the tension at x of the figure <i>Tension along the route</i>, read as force against "
-                  "pulled length. Tables: <code>pull_in_forward.csv</code>, <code>pull_in_reverse.csv</code>.</p>"]
+                  "the rig pulls the rope's tension at x of the figure <i>Tension along the route</i>, read as force "
+                  "against pulled length"
+                  f"{'' if plan['engine'] == 'rope' else ' (from the rope with every engine)'}. Tables: "
+                  "<code>pull_in_forward.csv</code>, <code>pull_in_reverse.csv</code>.</p>"]
     parts += ["<h2>Inputs</h2>", _table(["input", "SI", f"{units}"], _input_rows(plan, units), left=(0,)),
               "<p class='note'>Generated by exucable plan. SI values in plan.json and the CSV files beside this page.</p>",
               "</body></html>"]
