@@ -108,7 +108,7 @@ def plot_validation_figures(vr, out, ref: dict | None = None) -> list:
 def plot_industry(iv, path):
     """Bars per industry example and mode, relative to the published value: the centreline rope, the
     rope with clearance and exucable (with the published rounding bound as a band)."""
-    fig = new_figure(figsize=(8.0, 4.0))
+    fig = new_figure(figsize=(9.0, 4.5), layout="constrained")
     ax = fig.subplots()
     rows = iv.rows
     x = np.arange(len(rows))
@@ -121,7 +121,8 @@ def plot_industry(iv, path):
         rel = [100 * (v / r.published_N - 1) if v is not None else np.nan for v, r in zip(vals, rows)]
         ax.bar(x + (k - 1) * 0.25, rel, width=0.25, label=label)
     ax.axhline(0.0, color="k", lw=0.8)
-    ax.set_xticks(x, [f"{r.example}\n({r.mode})" for r in rows], fontsize=7, rotation=15)
+    ax.set_xticks(x, [f"{r.example.replace('_', ' ')}\n({r.mode})" for r in rows], fontsize=7, rotation=12,
+                  ha="right")
     ax.set_ylabel("pulling force vs published [%]")
     ax.set_title("Industry worked pulls (exucable validate --suite industry)")
     ax.legend(fontsize=7)
