@@ -42,6 +42,9 @@ def main(argv=None) -> int:
             iv = validate_industry(fast=not args.refined, out_dir=Path(args.out) / f"{Path(ex['scenario']).stem}-"
                                    f"{ex['direction']}", modes=(mode,), examples=[ex])
             total = time.perf_counter() - t0
+            if not iv.rows:
+                print(f"{ex['scenario']} ({ex['direction']}): skipped: {'; '.join(iv.skipped)}", flush=True)
+                continue
             (r,) = iv.rows
             for level, (n, wall, value, status) in enumerate(zip(r.elements, r.wall_time_s, r.values_N, r.statuses)):
                 rows.append({"example": r.example, "mode": mode, "level": level, "elements": n, "solve_wall_s": wall,
