@@ -77,3 +77,19 @@ def test_cli_names_the_examples_when_none_matches(capsys):
     assert main(["validate", "--suite", "industry", "--example", "no-such-route"]) == 2
     err = capsys.readouterr().err
     assert "--example" in err and "gera_wire_pulling_example.toml" in err
+
+
+def test_mode_difference_and_scatter_checks_without_runs():
+    from exucable.validate_industry import IndustryRow, IndustryValidation
+    steady = IndustryRow("r", "src", "closed form", "steady", 100.0, 1.0, 100.0, 0.0, 0.0, 100.0, 100.0)
+    dynamic = IndustryRow("r", "src", "closed form", "dynamic", 100.0, 1.0, 100.0, 0.0, 0.0, 99.0, 99.0)
+    steady.values_N, steady.statuses = [100.0], ["ok"]
+    dynamic.values_N, dynamic.statuses, dynamic.scatter = [99.0], ["steady"], [0.003]
+    iv = IndustryValidation(rows=[steady, dynamic])
+    (ex, s, d, shift), = iv.mode_differences()
+    assert (s, d) == (100.0, 99.0) and shift == pytest.approx(-0.01)
+    fails = iv.failures
+    assert any("steady vs dynamic +1.010 %" in f for f in fails)
+    assert any("steadiness level 0: scatter 0.300 %" in f for f in fails)
+    dynamic.values_N, dynamic.scatter, dynamic.run_rope_clearance_N = [99.9], [0.001], 99.9
+    assert iv.failures == []
