@@ -47,11 +47,7 @@ def main(argv: list[str]) -> int:
     cmd, rest = argv[0], argv[1:]
     if cmd == "test":
         return subprocess.call([str(PY), "-m", "pytest", *rest], cwd=ROOT)
-    # the main job validates the method of record, the dynamic run; the steady solve's own
-    # validation (`--mode steady`) still fails Fig. 12's one-coil case and drifts under mesh
-    # refinement on helices (README, "Two solver modes"): it is opt-in until that is mended
-    if not any(a == "--mode" or a.startswith("--mode=") for a in rest):
-        rest = ["--mode", "dynamic", *rest]
+    # the main job validates both solver modes and tables their difference (README, "Two solver modes")
     return subprocess.call([str(PY), "-m", "exucable", "validate", *rest], cwd=ROOT)
 
 

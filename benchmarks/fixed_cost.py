@@ -14,6 +14,7 @@ Target: ``exucable run --no-plots`` within 0.6 s of ``import exudyn``.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import re
 import statistics
@@ -37,12 +38,18 @@ def trivial_scenario(directory: Path) -> Path:
     return path
 
 
-def timed(cmd) -> float:
+def timed(cmd, out_dir: Path | None = None) -> float:
+    """Whole-process wall time [s] of ``cmd``. A run of 1 ms cannot be steady: ``exucable run``
+    then exits 1 with status ``not_steady`` (the trust flags), which is accepted here, checked in
+    ``out_dir/summary.json``; any other failure raises."""
     t0 = time.perf_counter()
     out = subprocess.run(cmd, capture_output=True, text=True)
     dt = time.perf_counter() - t0
     if out.returncode != 0:
-        raise RuntimeError(f"{' '.join(map(str, cmd))} failed:\n{out.stderr[-2000:]}")
+        summary = out_dir / "summary.json" if out_dir is not None else None
+        status = json.loads(summary.read_text()).get("status") if summary and summary.exists() else None
+        if status != "not_steady":
+            raise RuntimeError(f"{' '.join(map(str, cmd))} failed (status {status}):\n{out.stderr[-2000:]}")
     return dt
 
 
@@ -70,12 +77,13 @@ def main(argv=None) -> int:
             "exucable run --no-plots": [str(exe), "run", str(sc), "-o", str(tmp / "a"), "-q", "--no-plots"],
             "exucable run (figures)": [str(exe), "run", str(sc), "-o", str(tmp / "b"), "-q"],
         }
-        timed(cases["exucable run --no-plots"][:])        # warm the disk cache and the kernel cache
+        outs = {"exucable run --no-plots": tmp / "a", "exucable run (figures)": tmp / "b"}
+        timed(cases["exucable run --no-plots"], outs["exucable run --no-plots"])  # warm the disk and kernel caches
         times = {k: [] for k in cases}
         load0 = os.getloadavg()[0]
         for _ in range(args.repeat):
             for k, cmd in cases.items():
-                times[k].append(timed(cmd))
+                times[k].append(timed(cmd, outs.get(k)))
         med = {k: statistics.median(v) for k, v in times.items()}
         floor = med["python -c 'import exudyn'"]
         print(f"# Fixed cost of exucable run — load average {load0:.1f} -> {os.getloadavg()[0]:.1f} "

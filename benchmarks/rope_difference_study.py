@@ -54,6 +54,10 @@ CASES = {
                    mass_kg_per_m=1.0, friction=0.3, back_tension_N=200.0, radius_m=5.0),
     "downbend": dict(path=[{"straight": 5.0}, {"bend": 60.0, "radius": 5.0, "turn": "down"}, {"straight": 3.0}],
                      mass_kg_per_m=1.0, friction=0.3, back_tension_N=200.0, radius_m=5.0),
+    # a tight horizontal bend (R 0.5 m, about 28 cable diameters) where a bending length of up to
+    # 0.3 R still lifts off less than the clearance: the bending-stiffness study's case
+    "tight": dict(path=[{"straight": 2.0}, {"bend": 90.0, "radius": 0.5, "turn": "left"}, {"straight": 2.0}],
+                  mass_kg_per_m=0.21, friction=0.5, back_tension_N=100.0, radius_m=0.5),
 }
 
 
@@ -214,11 +218,16 @@ SWEEP = [
 ]
 
 
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_case_arguments(p) -> None:
+    """``--case``, ``--clearance`` [m] and ``--ej`` [N m²]: one row instead of the sweep."""
     p.add_argument("--case", choices=sorted(CASES))
     p.add_argument("--clearance", type=float, help="clearance c [m]")
     p.add_argument("--ej", type=float, help="bending stiffness EJ [N m²]")
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_case_arguments(p)
     p.add_argument("--no-gravity", action="store_true")
     p.add_argument("--element-length", type=float, default=0.1, help="[m]")
     p.add_argument("--check-spacing", type=float, default=0.005, help="[m]")
@@ -226,6 +235,8 @@ def main(argv=None) -> int:
     p.add_argument("--figure", help="plot the rows of --json (or of this run) to this PNG")
     p.add_argument("--from-json", help="read exucable's rows from this JSON file instead of running (the "
                    "references are recomputed)")
+    p.add_argument("--mesh-check", help="steady solves of every case at the study's mesh and two refinements "
+                   "(exucable converge's extrapolation); write the rows to this JSON file")
     p.add_argument("--clearance-limit", action="store_true",
                    help="only the rope with clearance against the centreline rope as c → 0 (seconds)")
     a = p.parse_args(argv)
@@ -236,6 +247,9 @@ def main(argv=None) -> int:
               f"{r['free_span_estimate_pct']:+.4f} % |")
     print()
     if a.clearance_limit:
+        return 0
+    if a.mesh_check:
+        mesh_check(a.mesh_check, a.element_length, a.check_spacing)
         return 0
     if a.from_json:
         rows = [rereference(r) for r in json.loads(Path(a.from_json).read_text())]
@@ -258,6 +272,45 @@ def main(argv=None) -> int:
     if a.figure:
         plot(rows, limit, a.figure)
     return 0
+
+
+def mesh_check(path: str, element_length_m: float, check_spacing_m: float) -> list[dict]:
+    """The study's mesh against two refinements (halving the element length and the check-point
+    spacing), each case solved in steady mode (no start-up, no scatter: the mesh alone)."""
+    import tempfile
+
+    from exucable.commands.converge import converge
+    from exucable.scenario import parse_scenario
+
+    print("| case | gravity | c [mm] | EJ [N m²] | elements × check points | pulling force per level [N] | "
+          "extrapolated [N] | study mesh vs extrapolated | observed order | wall per level [s] |\n"
+          "|---|---|---|---|---|---|---|---|---|---|", flush=True)
+    rows = []
+    for case, grav, c, ej in SWEEP:
+        data = scenario_dict(case, c, ej, grav, element_length_m, check_spacing_m, 1.0)
+        sc = parse_scenario(data, ROOT, default_name=data["name"])
+        with tempfile.TemporaryDirectory() as tmp:
+            rep = converge(sc, tmp, levels=3, ratio=2.0, mode="steady")
+        lv = rep["levels"]
+        row = {"case": case, "gravity": grav, "clearance_m": c, "EJ_N_m2": ej,
+               "meshes": [f"{r['elements']}×{r['check_points_per_element']}" for r in lv],
+               "values_N": [r["value_N"] for r in lv], "statuses": [r["status"] for r in lv],
+               "wall_s": [r["wall_time_s"] for r in lv], "extrapolated_N": rep["extrapolated_N"],
+               "error_N": rep["error_N"], "order": rep["observed_order"], "method": rep["method"],
+               "default_vs_extrapolated": rep.get("default_vs_extrapolated"),
+               "default_vs_finest": lv[0]["value_N"] / lv[-1]["value_N"] - 1.0}
+        rows.append(row)
+        ext = "n/a" if row["extrapolated_N"] is None else f"{row['extrapolated_N']:.3f} ± {row['error_N']:.2g}"
+        dv = row["default_vs_extrapolated"]
+        dv = f"{100 * dv:+.3f} %" if dv is not None else f"{100 * row['default_vs_finest']:+.3f} % (vs finest)"
+        order = "n/a" if row["order"] is None else f"{row['order']:.2g}"
+        print(f"| {case} | {'yes' if grav else 'no'} | {c * 1e3:g} | {ej:g} | {' / '.join(row['meshes'])} | "
+              f"{' / '.join(f'{v:.3f}' for v in row['values_N'])} | {ext} | {dv} | {order} | "
+              f"{' / '.join(f'{w:.0f}' for w in row['wall_s'])} |", flush=True)
+        tmp_json = Path(path + ".tmp")
+        tmp_json.write_text(json.dumps(rows, indent=1))
+        tmp_json.replace(path)
+    return rows
 
 
 def plot(rows, limit, path) -> None:

@@ -86,7 +86,9 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
     s_c, T_c = cable_tension_along_conduit(model)
     lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
     bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
-                       rope.tension_N, rope_p, w, lam, model.scenario.pull.direction)
+                       rope.tension_N, rope_p, w, lam, model.scenario.pull.direction,
+                       bending_stiffness_N_m2=model.scenario.cable.bending_stiffness_N_m2,
+                       element_length_m=float(np.max(model.layout.element_length_m)))
     i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
     info = {"pressure_window_m": w,
             "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
@@ -141,7 +143,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     ``solver.mode``.
     """
     from .model.build import build_model
-    from .solve import Progress, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
+    from .solve import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
@@ -149,6 +151,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     if sc.cable.count != 1:
         raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
                                         "plan several cables per duct with `exucable plan`")
+    _refuse_pulling_the_cable_out(sc)
     t_start = time.perf_counter()
     model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element)
     build_s = time.perf_counter() - t_start
@@ -158,12 +161,13 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         from .solve_steady import solve_steady
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
         h = out.history.arrays()
-        # one static state, the start's extent of cable in the conduit (nothing pulled out yet):
-        # the result is the last (converged) pseudo-time step's; no time history, no scatter
+        # one static state, the start's extent of cable in the conduit (laid out past the exit by
+        # the steady lead-out, model.layout.steady_lead_out_m): the result is the last (converged)
+        # pseudo-time step's; no time history, no scatter
         drift = 0.0
         st = SteadyState(out.status != "failed", 0.0, 0.0, 0.0, 0.0)
         i0 = max(len(h["time_s"]) - 1, 0)
-        refs = extent_references(sc, model, 0.0)
+        refs = extent_references(sc, model, model.start.lead_out_m)
         pf = None
     else:
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
@@ -175,7 +179,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         h = out.history.arrays()
         drift = expected_drift_N_per_s(model)
         st = detect_steady_state(h["time_s"], h[steady_quantity(model)], sp.steady_window_s, sp.steady_tolerance,
-                                 expected_drift_N_per_s=drift)
+                                 expected_drift_N_per_s=drift, earliest_s=earliest_steady_s(model))
         i0 = int(np.searchsorted(h["time_s"], st.from_s)) if np.isfinite(st.from_s) else 0
         refs = window_references(sc, model, h["time_s"][i0:])
         # the uncertainty is of the mean about the drift the references explain (the cable's changing
@@ -264,6 +268,28 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     return result
 
 
+def _refuse_pulling_the_cable_out(sc) -> None:
+    """Refuse a velocity-controlled dynamic pull whose drive would pull the whole cable out of its
+    conduit before ``solver.end_time``: nothing inside is left to pull, and the references at the
+    cable's extent do not exist. Refused before the run, so no result is lost afterwards."""
+    from .model.rig import ramped_displacement
+
+    sp = sc.solver
+    if sp.mode != "dynamic" or sc.pull.force_N is not None:
+        return
+    v, ramp, length = sc.pull.speed_m_per_s, sc.pull.ramp_time_s, sc.cable_length_m
+    pulled_m = ramped_displacement(sp.end_time_s, v, ramp)
+    if pulled_m < length:
+        return
+    # the time the drive has pulled the whole cable out (the ramp is monotone: invert it on a bracket)
+    from scipy.optimize import brentq
+    t_out = brentq(lambda t: ramped_displacement(t, v, ramp) - length, 0.0, sp.end_time_s)
+    raise ModelError("solver.end_time",
+                     f"at {v:g} m/s the drive pulls {pulled_m:.4g} m by {sp.end_time_s:g} s, but the cable is "
+                     f"{length:.4g} m long: it has left its conduit at {t_out:.3g} s. Set solver.end_time "
+                     f"well below {t_out:.3g} s, lower pull.speed, or lengthen the cable")
+
+
 def window_references(scenario, model, window_time_s) -> dict:
     """Both flexible references (:mod:`exucable.references`) for the cable's extent at the mean
     time of the averaging window ``window_time_s`` [s] of a velocity-controlled pull; ``{}`` for a
@@ -284,7 +310,9 @@ def extent_references(scenario, model, pulled_out_m: float) -> dict:
 
     if scenario.pull.force_N is not None:
         return {}
-    # at the start's extent the start's own rope with clearance is that reference (same conduit, cable
-    # length, loads): not solved twice
-    start_clearance = getattr(model.start, "rope_clearance", None) if pulled_out_m == 0.0 else None
+    # at the start's extent (nothing pulled out, or a steady start's lead-out) the start's own rope
+    # with clearance is that reference (same conduit, cable inside, loads): not solved twice
+    start = model.start
+    start_clearance = (getattr(start, "rope_clearance", None)
+                       if pulled_out_m == getattr(start, "lead_out_m", 0.0) else None)
     return pull_force_references_N(scenario, model.conduit, pulled_out_m, clearance_solution=start_clearance)

@@ -16,9 +16,13 @@ from typing import Literal
 import numpy as np
 import exudyn as exu
 
-from .model.recorder import History, Recorder, expected_drift_N_per_s, steady_quantity
+from .model.recorder import History, Recorder, earliest_steady_s, expected_drift_N_per_s, steady_quantity
+
+# the first step is solver.step / START_STEP_DIVISOR (see simulate)
+START_STEP_DIVISOR = 128
 
 __all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "expected_drift_N_per_s",
+           "earliest_steady_s",
            "Progress"]
 
 
@@ -117,14 +121,31 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
     sp = model.scenario.solver
     steady_stop = sp.steady_stop if steady_stop is None else steady_stop
     recorder = Recorder(model, sp.output_interval_s, steady_stop, sp.steady_window_s, sp.steady_tolerance,
-                        progress=progress.update if progress is not None else None)
+                        progress=progress.update if progress is not None else None,
+                        earliest_steady_s=earliest_steady_s(model))
     history = recorder.history
     mbs = model.mbs
     # Exudyn 1.13 returns {"function": f, "type": "Python"} for a set function, 0 for none
     previous = mbs.GetPostStepUserFunction()
     users = previous.get("function") if isinstance(previous, dict) else (previous or None)
 
+    solver = exu.MainSolverImplicitSecondOrder()
+    settings = solver_settings(sp)
+    # Exudyn's generalized-alpha starts at its maximum step (its initialStepSize is for the
+    # error-controlled integrators only) and halves it after each failed attempt; a failed attempt
+    # burns all its Newton iterations. The pre-tensioned start needs steps of about step/128
+    # (measured: Example 4 fails at 10 ... 0.16 ms, seven attempts, 84 iterations, before 78 µs
+    # passes). So the first step is capped there and the cap is lifted after it: the usual step
+    # control then doubles the step as Newton allows.
+    ti = settings.timeIntegration
+    max_steps = ti.numberOfSteps
+    ti.numberOfSteps = max(max_steps, int(np.ceil(sp.end_time_s / (sp.step_s / START_STEP_DIVISOR))))
+    lifted = [max_steps == ti.numberOfSteps]
+
     def post_step(mbs, t):
+        if not lifted[0] and t > 0.0:
+            solver.it.maxStepSize = sp.end_time_s / max_steps
+            lifted[0] = True
         if snapshots is not None:
             snapshots.step(t, model.pull_force_N(t))
         go_on = recorder(mbs, t)
@@ -133,8 +154,6 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
         return go_on
 
     mbs.SetPostStepUserFunction(post_step)
-    solver = exu.MainSolverImplicitSecondOrder()
-    settings = solver_settings(sp)
     t0 = time.perf_counter()
     status, message = "ok", ""
     try:

@@ -108,7 +108,8 @@ def _window_stats(t, f):
 
 
 def detect_steady_state(time_s, force_N, min_window_s: float, rel_tolerance: float = 1e-3,
-                        abs_tolerance_N: float = 1e-6, expected_drift_N_per_s: float = 0.0) -> SteadyState:
+                        abs_tolerance_N: float = 1e-6, expected_drift_N_per_s: float = 0.0,
+                        earliest_s: float = 0.0) -> SteadyState:
     """Find the longest final window in which the force is steady.
 
     A window [t0, t_end] is steady when it is at least ``min_window_s`` long and both the drift
@@ -120,6 +121,10 @@ def detect_steady_state(time_s, force_N, min_window_s: float, rel_tolerance: flo
     under gravity, :mod:`exucable.references`): it is taken off the force before the tests, so a
     force that follows its moving reference is steady; the mean reported is of the force itself,
     and belongs to the window's mean time.
+
+    ``earliest_s`` [s]: no window starts before it (the start-up damper's fade,
+    ``solver.startup_time``: a start-up transient that happens to stay within the tolerance must
+    not enter the mean).
     """
     t = np.asarray(time_s, dtype=float)
     f = np.asarray(force_N, dtype=float)
@@ -138,14 +143,15 @@ def detect_steady_state(time_s, force_N, min_window_s: float, rel_tolerance: flo
 
     last = int(np.searchsorted(t, t_end - min_window_s, side="right")) - 1
     last = max(last, 0)
+    first = int(np.searchsorted(t, earliest_s * (1 - 1e-12), side="left"))  # earliest window start
     good, stats = ok(last)
-    if t_end - t[last] < min_window_s * (1 - 1e-9) or not good:
+    if t_end - t[last] < min_window_s * (1 - 1e-9) or not good or last < first:
         return SteadyState(False, float(t[last]), *stats)
     # extend the window backwards while it stays steady (coarse-to-fine scan over saved times)
     lo = last
-    step = max(1, last // 64)
+    step = max(1, (last - first) // 64)
     while step >= 1:
-        while lo - step >= 0:
+        while lo - step >= first:
             g, st = ok(lo - step)
             if not g:
                 break

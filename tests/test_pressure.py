@@ -21,35 +21,54 @@ def _ex2_route():
     return centreline_from_path([0, 0, 0], [1, 0, 0], [Straight(1.0), Bend(90.0, 0.5, "left"), Straight(1.0)])
 
 
-def test_bend_table_recovers_a_known_distribution():
-    """Check points every mm carry the capstan rope's T/R plus 2 N and 3 N at the bend's ends:
-    the body mean is T/R and the point loads come back as forces at their places."""
+def _stiff_cable_loads(spread_points: int):
+    """Check points every 0.1 mm carry the capstan rope's T/R, except where a stiff cable lifts off
+    after the bend's start (12 mm) and before its end (8 mm); there it lands with 2 N and 3 N,
+    each spread over ``spread_points`` points as a mesh spreads them."""
     cl = _ex2_route()
     mu, T2, R = 0.2, 150.0, 0.5
+    s1 = 1.0 + np.pi * R / 2
 
     def rope(s):
         T = T2 * np.exp(mu * np.clip((s - 1.0) / R, 0.0, np.pi / 2))
-        return T, np.where((s > 1.0) & (s < 1.0 + np.pi * R / 2), T / R, 0.0)
+        return T, np.where((s > 1.0) & (s < s1), T / R, 0.0)
 
-    s = np.arange(0.0005, cl.length_m, 0.001)            # a point per mm carries its mm of load
+    s = np.arange(0.00005, cl.length_m, 0.0001)          # a point per 0.1 mm carries its 0.1 mm of load
     T, p = rope(s)
-    F = p * 0.001                                         # (the cells at the bend's ends err by < 0.05 N)
+    F = p * 0.0001
+    F[(s > 1.0) & (s < 1.012)] = 0.0
+    F[(s > s1 - 0.008) & (s < s1)] = 0.0
+    for place, load in ((1.012, 2.0), (s1 - 0.008, 3.0)):
+        i = np.argmin(abs(s - place))
+        F[i - spread_points // 2:i + spread_points // 2 + 1] += load / spread_points
     s_rope = np.linspace(0.0, cl.length_m, 300001)
     T_rope, p_rope = rope(s_rope)
-    F[np.argmin(abs(s - 1.003))] += 2.0
-    F[np.argmin(abs(s - (1.0 + np.pi * R / 2 - 0.003)))] += 3.0
+    return cl, s, F, T, s_rope, T_rope, p_rope, s1
+
+
+@pytest.mark.parametrize("spread_points", [1, 7])
+def test_bend_table_recovers_a_known_distribution(spread_points):
+    """The body mean is T/R, and the point loads come back as forces at their places whether
+    concentrated on one check point or spread over several (their moments fix both)."""
+    cl, s, F, T, s_rope, T_rope, p_rope, s1 = _stiff_cable_loads(spread_points)
     w = default_window_m(cl)
     assert w == 0.25
-    rows = bend_table(cl.pieces, s, F, s, T, s_rope, T_rope, p_rope, w, bending_length_m=0.012)
+    rows = bend_table(cl.pieces, s, F, s, T, s_rope, T_rope, p_rope, w, bending_length_m=0.012,
+                      element_length_m=0.003)
     assert len(rows) == 1
     b = rows[0]
     assert abs(b["mean_pressure_vs_rope"]) < 1e-3
-    assert b["entry_point_load_N"] == pytest.approx(2.0, abs=0.05) and b["entry_s_conduit_m"] == pytest.approx(1.0)
-    assert b["exit_point_load_N"] == pytest.approx(3.0, abs=0.05)
+    # a point carries 0.1 mm: the load's place is known to its spread, the load to the body's
+    # pressure (300–410 N/m) over half a point's share, 0.02 N
+    assert b["entry_point_load_N"] == pytest.approx(2.0, abs=0.03)
+    assert b["entry_s_conduit_m"] == pytest.approx(1.012, abs=4e-4)
+    assert b["exit_point_load_N"] == pytest.approx(3.0, abs=0.03)
+    assert b["exit_s_conduit_m"] == pytest.approx(s1 - 0.008, abs=4e-4)
     assert b["tension_in_N"] == pytest.approx(150.0, rel=1e-3)
     assert b["tension_out_N"] == pytest.approx(150 * np.exp(0.1 * np.pi), rel=1e-3)
-    rev = bend_table(cl.pieces, s, F, s, T, s_rope, T_rope, p_rope, w, 0.012, direction="reverse")[0]
-    assert rev["entry_point_load_N"] == pytest.approx(3.0, abs=0.05) and rev["tension_in_N"] == b["tension_out_N"]
+    rev = bend_table(cl.pieces, s, F, s, T, s_rope, T_rope, p_rope, w, 0.012, direction="reverse",
+                     element_length_m=0.003)[0]
+    assert rev["entry_point_load_N"] == b["exit_point_load_N"] and rev["tension_in_N"] == b["tension_out_N"]
 
 
 @pytest.fixture(scope="module")

@@ -57,7 +57,9 @@ def test_a_sound_run_is_trusted_and_states_its_uncertainty(tmp_path):
     ({"contact": {"stiffness": 5.0}}, "outside_conduit"),      # issue #10: 52 mm outside, reported "ok"
     ({"contact": {"stiffness": 3.0e3}}, "penetration"),         # in the wall, not through it
     ({"solver": {"end_time": 0.05}}, "not_steady"),
-    ({"pull": {"speed": 5.0}}, "dynamic"),                      # ρA v² = 0.49 N on a 28 N pull
+    # ρA v² = 0.49 N on a 28 N pull; over 0.3 s, since 0.6 s at 5 m/s would pull 3 m out of the
+    # 1.785 m cable (a run that converges that far ends in the reference's "left its conduit" error)
+    ({"pull": {"speed": 5.0}, "solver": {"end_time": 0.3}}, "dynamic"),
 ])
 def test_untrustworthy_runs_are_flagged_with_place_and_time(change, status, tmp_path):
     res = run_scenario(_tiny(**change), tmp_path, plots=False)
@@ -98,3 +100,17 @@ def test_the_issue_s_50_m_per_s_pull_is_dynamic():
                            pull_force_N=205.0, steady_window_s=0.2, steady_tolerance=1e-3, end_time_s=1.0,
                            base_status="steady")
     assert status == "dynamic" and flags[0]["value"] == pytest.approx(rhoA * 2500 / 205.0)
+
+
+def test_a_pull_that_would_empty_the_conduit_is_refused_before_it_runs(tmp_path):
+    """5 m/s for 0.6 s pulls 3 m of a 1.785 m cable: refused naming solver.end_time and the time the
+    cable has left (1.785 m / 5 m/s plus half the ramp), before anything runs or is written."""
+    from exucable.errors import ModelError
+    from exucable.model.rig import ramped_displacement
+
+    sc = _tiny(pull={"speed": 5.0}, solver={"end_time": 0.6})
+    with pytest.raises(ModelError, match=r"solver\.end_time") as err:
+        run_scenario(sc, tmp_path / "out")
+    t_out = float(str(err.value).split("left its conduit at ")[1].split(" s")[0])
+    assert ramped_displacement(t_out, 5.0, sc.pull.ramp_time_s) == pytest.approx(sc.cable_length_m, rel=2e-3)
+    assert not (tmp_path / "out").exists()

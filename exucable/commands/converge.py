@@ -27,8 +27,11 @@ CONVERGE_COLUMNS = ("level", "refine", "elements", "element_length_m", "check_po
                     "uncertainty_N", "drift_N_per_s", "wall_time_s")
 
 
-def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool = True, progress=None) -> dict:
+def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool = True, progress=None,
+             mode: str | None = None) -> dict:
     """Run ``scenario`` on ``levels`` meshes refined by ``ratio``; returns the report (also written).
+
+    ``mode`` (``"dynamic"``/``"steady"``) overrides ``solver.mode`` at every level.
 
     The quantity is the run's steady quantity: the pulling force, or for a force-controlled pull
     the trailing tension [N]. ``progress(level, summary)`` is called after each level.
@@ -42,7 +45,7 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
     for level in range(levels):
         refine = ratio**level
         res = run_scenario(sc, out / f"level_{level}", quiet=quiet, plots=False, refine=refine,
-                           check_points_per_element=k0)
+                           check_points_per_element=k0, mode=mode)
         s = res.summary
         mesh = s["mesh"]
         k0 = mesh["check_points_per_element"] if k0 is None else k0
@@ -59,7 +62,7 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
         statuses.append(s["status"])
         if progress is not None:
             progress(level, s)
-    report = {"name": sc.name, "quantity": q, "ratio": ratio, "levels": rows,
+    report = {"name": sc.name, "quantity": q, "ratio": ratio, "mode": mode or sc.solver.mode, "levels": rows,
               "trusted": all(st in TRUSTED_STATUSES for st in statuses)}
     values = [r["value_N"] for r in rows]
     try:
@@ -81,6 +84,9 @@ def add_arguments(p) -> None:
     p.add_argument("--ratio", type=float, default=2.0, help="refinement ratio of the element length (default 2)")
     p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>-converge)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bars")
+    p.add_argument("--mode", choices=("dynamic", "steady"), default=None,
+                   help="solve every level dynamically or as one static solve of steady sliding "
+                        "(overrides solver.mode)")
 
 
 def _f(v, fmt=".6g"):
@@ -104,7 +110,7 @@ def main(args) -> int:
               f"wall {s['wall_time_s']:.1f} s", flush=True)
 
     print(f"{sc.name}: {args.levels} levels, element length refined by {args.ratio:g} per level", flush=True)
-    rep = converge(sc, out, args.levels, args.ratio, quiet=args.quiet, progress=progress)
+    rep = converge(sc, out, args.levels, args.ratio, quiet=args.quiet, progress=progress, mode=args.mode)
     print(f"\n{'level':>5} {'elements':>8} {'h [m]':>9} {'points/el':>9} {rep['quantity']:>22} {'± [N]':>9} {'status':>10}")
     for r in rep["levels"]:
         print(f"{r['level']:>5} {r['elements']:>8} {r['element_length_m']:>9.4g} {r['check_points_per_element']:>9} "

@@ -22,7 +22,7 @@ from ..references import reference_drift_N_per_s
 from ..tension import tension_at
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, InitialLayout, initial_layout
-from .recorder import Recorder
+from .recorder import Recorder, earliest_steady_s
 from .rig import Drive, Guide, add_drive, add_end_force, add_guide, add_reel, add_tangential_drive, smooth_ramp
 
 if TYPE_CHECKING:  # names for the annotations only
@@ -393,7 +393,8 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
     # the reference's drift is along a time history, which a steady solve does not have
     h.reference_drift_N_per_s = 0.0 if steady else reference_drift_N_per_s(sc, conduit, sc.solver.end_time_s)
     sp = sc.solver
-    h.recorder = Recorder(h, sp.output_interval_s, sp.steady_stop, sp.steady_window_s, sp.steady_tolerance)
+    h.recorder = Recorder(h, sp.output_interval_s, sp.steady_stop, sp.steady_window_s, sp.steady_tolerance,
+                          earliest_steady_s=earliest_steady_s(h))
     return h
 
 

@@ -24,7 +24,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["CableLayout", "InitialLayout", "initial_layout", "lay_cable", "contact_offsets", "extended_point", "extended_tangent"]
+__all__ = ["CableLayout", "InitialLayout", "initial_layout", "lay_cable", "steady_lead_out_m", "contact_offsets", "extended_point", "extended_tangent"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -182,11 +182,13 @@ def lay_cable(
     clearance_m: float | None = None,
     fit_points_per_element: int = 8,
     correction_iterations: int = 8,
+    lead_out_m: float = 0.0,
 ) -> CableLayout:
     """Lay a cable of ``n_elements`` equal material elements into the leading part of a conduit.
 
-    The trailing end sits at ``s = L - cable_length_m``; the pre-stretch (1 + T/EA) may carry the
-    leading end past the conduit's exit, along the exit tangent (where the rig holds it).
+    The trailing end sits at ``s = L - cable_length_m + lead_out_m``; the pre-stretch (1 + T/EA)
+    (and ``lead_out_m``) carry the leading end past the conduit's exit, along the exit tangent
+    (where the rig holds it).
 
     Parameters
     ----------
@@ -211,9 +213,12 @@ def lay_cable(
         axis than its target offset (at most ``correction_iterations`` refits).
     fit_points_per_element : int
         Gauss points per element of the least-squares fit.
+    lead_out_m : float
+        Unstretched-path length [m] of cable laid beyond the exit along the exit tangent, as if
+        pulled out that far (see :func:`steady_lead_out_m`); T and the offset there are the exit's.
     """
     L = float(centreline.length_m)
-    s0 = L - float(cable_length_m)
+    s0 = L - float(cable_length_m) + float(lead_out_m)
     # Fine grid along s, long enough to hold the stretched cable (strain < 50 % is asserted below).
     ds = cable_length_m / (n_elements * points_per_element)
     s_end_max = s0 + 1.5 * cable_length_m
@@ -337,9 +342,13 @@ class InitialLayout:
     mesh : exucable.mesh.MeshPlan or None
         The cable mesh (elements, check points per element) by the rule of :mod:`exucable.mesh`
         or the scenario's override, with its warnings.
+    lead_out_m : float
+        Cable laid beyond the exit along the exit tangent at the start [m] (steady mode,
+        :func:`steady_lead_out_m`; 0 otherwise): the start is the cable pulled out that far.
     rope_clearance : exucable.rope_clearance.ClearanceRopeSolution or None
-        The rope with clearance whose path the start follows (None where it is not used: a
-        force-controlled pull, no clearance, no pretension, or a cable that runs slack).
+        The rope with clearance whose path the start follows, for the cable inside the conduit at
+        the start (None where it is not used: a force-controlled pull, no clearance, no
+        pretension, or a cable that runs slack).
     """
 
     conduit: object
@@ -349,6 +358,7 @@ class InitialLayout:
     exit_tangent: np.ndarray
     entry_tangent: np.ndarray
     mesh: object = None
+    lead_out_m: float = 0.0
     rope_clearance: object = None
 
     @property
@@ -362,7 +372,48 @@ class InitialLayout:
         return self.cable.position_m[0].copy()
 
 
-def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: float):
+#: Length of straight cable between the last bend's end and the rig in a steady solve, in bending
+#: lengths √(EJ/T) of the cable at the exit [-] (see :func:`steady_lead_out_m`). Measured on
+#: Fig. 12's one coil (80 elements, 1.5 m lead-in; 2026-11-29), steady minus capstan at 1 / 2.5 /
+#: 5 / 10 / 20 bending lengths: +0.09 / +0.00 / -0.034 / -0.050 / -0.052 %: settled from 10 on.
+LEAD_OUT_BENDING_LENGTHS = 10.0
+
+
+def steady_lead_out_m(centreline, bending_stiffness_N_m2: float, exit_tension_N: float) -> float:
+    """Cable to lay beyond the exit for a steady solve [m], so that the rig sits at least
+    ``LEAD_OUT_BENDING_LENGTHS`` bending lengths λ = √(EJ/T) past the end of the last bend.
+
+    Why: the steady solve holds the leading end where the start put it, free to turn (a pinned
+    end: no bending moment). Laid flush with the exit of a route that ends in a bend (a helix's
+    top, Example 4's last bend), that end sits a few millimetres past the bend, inside the
+    bending boundary layer λ (4 cm on Fig. 12's coil): the cable must unbend from 1/R to zero
+    curvature within it, presses on the wall at the bend's end, and its extra friction raised the
+    pulling force by +0.7 % once the mesh resolved λ (the error grew under refinement, 2026-11-29).
+    A real rig sits far out on the exit line, where the moment has decayed as e^(-x/λ); the
+    dynamic run reaches that state as it pulls the end out. Routes ending on a straight at least
+    that long need no lead-out (0).
+
+    Parameters
+    ----------
+    centreline : Centreline
+        Pull-oriented centreline (the leading end at its end).
+    bending_stiffness_N_m2 : float
+        EJ [N·m²].
+    exit_tension_N : float
+        Tension at the exit [N] (the rope's pulling force).
+    """
+    if bending_stiffness_N_m2 <= 0.0 or exit_tension_N <= 0.0:
+        return 0.0
+    straight = 0.0
+    for piece in reversed(centreline.pieces):
+        if piece.is_curved:
+            break
+        straight += piece.length_m
+    need = LEAD_OUT_BENDING_LENGTHS * float(np.sqrt(bending_stiffness_N_m2 / exit_tension_N))
+    return max(0.0, need - straight)
+
+
+def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: float, cable_length_m: float):
     """The rope with clearance for the start of a velocity-controlled pull, or None (force-controlled,
     no clearance, or a cable that runs slack somewhere)."""
     from ..errors import ModelError
@@ -372,7 +423,7 @@ def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: f
         return None
     try:
         return solve_rope_with_clearance(centreline, clearance_m, scenario.contact.friction, w_N_per_m,
-                                         scenario.pull.back_tension_N, cable_length_m=scenario.cable_length_m)
+                                         scenario.pull.back_tension_N, cable_length_m=cable_length_m)
     except ModelError:
         return None
 
@@ -426,11 +477,19 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     L_cable = sc.cable_length_m
     g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
     w = c.mass_per_length_kg_per_m * g
-    common = dict(friction=sc.contact.friction, weight_per_length_N_per_m=w, cable_length_m=L_cable)
-    if sc.pull.force_N is not None:
-        rope = solve_rope_for_pull_force(centre, pull_force_N=sc.pull.force_N, **common)
-    else:
-        rope = solve_rope(centre, trailing_tension_N=sc.pull.back_tension_N, **common)
+    common = dict(friction=sc.contact.friction, weight_per_length_N_per_m=w)
+
+    def rope_for(length_m):
+        if sc.pull.force_N is not None:
+            return solve_rope_for_pull_force(centre, pull_force_N=sc.pull.force_N, **common, cable_length_m=length_m)
+        return solve_rope(centre, trailing_tension_N=sc.pull.back_tension_N, **common, cable_length_m=length_m)
+
+    rope = rope_for(L_cable)
+    lead_out = 0.0
+    if sc.solver.mode == "steady" and sc.solver.pretension:
+        lead_out = steady_lead_out_m(centre, c.bending_stiffness_N_m2, rope.pull_force_N)
+        if lead_out > 0.0:
+            rope = rope_for(L_cable - lead_out)    # the reference of the cable as laid: less inside
     clearance = conduit.inner_radius_m - c.radius_m
     mesh = plan_cable_mesh(sc, conduit, rope, refine, check_points_per_element)
     n_el = mesh.elements
@@ -442,7 +501,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         # half an element so the nodes can follow it
         T_ref = max(float(np.max(rope.tension_N)), 1e-6)
         blend = max(0.5 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
-        free = _clearance_rope_start(sc, centre, w, clearance) if with_contact else None
+        free = _clearance_rope_start(sc, centre, w, clearance, L_cable - lead_out) if with_contact else None
         path = {}
         if free is not None:
             # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
@@ -463,11 +522,12 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
             return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
 
         cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, tension_fn,
-                          offset_fn, clearance_m=clearance if with_contact else None)
+                          offset_fn, clearance_m=clearance if with_contact else None, lead_out_m=lead_out)
     else:
         cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, 0.0)
         free = None
     t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
-    t_entry = np.asarray(centre.tangent(centre.length_m - L_cable), dtype=float)
+    t_entry = np.asarray(centre.tangent(centre.length_m - L_cable + lead_out), dtype=float)
     return InitialLayout(conduit=conduit, rope=rope, cable=cable, weight_per_length_N_per_m=w,
-                         exit_tangent=t_exit, entry_tangent=t_entry, mesh=mesh, rope_clearance=free)
+                         exit_tangent=t_exit, entry_tangent=t_entry, mesh=mesh, lead_out_m=lead_out,
+                         rope_clearance=free)

@@ -13,7 +13,7 @@ import numpy as np
 from ..tension import detect_steady_state, tension_at, tension_profile
 from ..trust import AxisGauge, cable_sample_points
 
-__all__ = ["History", "Recorder", "expected_drift_N_per_s", "record_state", "steady_quantity"]
+__all__ = ["History", "Recorder", "earliest_steady_s", "expected_drift_N_per_s", "record_state", "steady_quantity"]
 
 
 @dataclass
@@ -30,6 +30,13 @@ class History:
 
     def arrays(self) -> dict[str, np.ndarray]:
         return {k: np.asarray(v, dtype=float) for k, v in self.__dict__.items()}
+
+
+def earliest_steady_s(cable) -> float:
+    """Where a steady window may start [s]: after the start-up damper has faded
+    (``solver.startup_time``), 0 without one."""
+    damper = getattr(cable, "startup_damper", None)
+    return float(damper.duration) if damper is not None else 0.0
 
 
 def steady_quantity(cable) -> str:
@@ -97,6 +104,8 @@ class Recorder:
         Window [s] and relative drift/scatter bound of the steady check.
     progress : callable, optional
         ``progress(t, text)`` after each record.
+    earliest_steady_s : float
+        No steady window starts before this time [s] (see :func:`earliest_steady_s`).
 
     Attributes
     ----------
@@ -105,12 +114,13 @@ class Recorder:
     """
 
     def __init__(self, cable, output_interval_s: float, steady_stop: bool = False, steady_window_s: float = 0.2,
-                 steady_tolerance: float = 1e-3, progress=None):
+                 steady_tolerance: float = 1e-3, progress=None, earliest_steady_s: float = 0.0):
         self.cable = cable
         self.output_interval_s = float(output_interval_s)
         self.steady_stop = steady_stop
         self.steady_window_s = steady_window_s
         self.steady_tolerance = steady_tolerance
+        self.earliest_steady_s = float(earliest_steady_s)
         self.progress = progress
         self.history = History()
         self.stopped_steady = False
@@ -127,7 +137,8 @@ class Recorder:
         if self.steady_stop and t >= self.steady_window_s:
             st = detect_steady_state(self.history.time_s, getattr(self.history, steady_quantity(self.cable)),
                                      self.steady_window_s, self.steady_tolerance,
-                                     expected_drift_N_per_s=expected_drift_N_per_s(self.cable))
+                                     expected_drift_N_per_s=expected_drift_N_per_s(self.cable),
+                                     earliest_s=self.earliest_steady_s)
             if st.steady:
                 self.stopped_steady = True
                 return False
