@@ -152,6 +152,8 @@ class IndustryRow:
     rope_N: float                # centreline rope, the published calculators' model, whole route
     flexibility: float           # max over bends of √(EJ/T_out)/R (rope tensions)
     liftoff_over_2c: float       # max over bends of λ²/(2R) / 2c, λ = √(EJ/T_out)
+    stiff_estimate: float = float("nan")   # exucable/stiff_bend.py along the route, vs the rope
+    stiff_estimate_fits: bool = False      # every bend within that model's validity (offset ≤ 2c)
     run_rope_N: float | None = None            # both references for the run's extent of cable (a dynamic
     run_rope_clearance_N: float | None = None  # run's window has pulled some out; steady: = the route's)
     values_N: list = field(default_factory=list)        # exucable per mesh level (default first)
@@ -243,13 +245,15 @@ class IndustryRow:
             parts.append(f"free spans {100 * self.free_span_part:+.2f} % (rope with clearance vs rope)")
         if self.remainder is not None and np.isfinite(self.value_N):
             regime = ("flexible: the study's 0.1 % applies" if self.flexibility <= FLEXIBLE_LIMIT
-                      else "bending stiffness, no estimate yet (reference/README.md); lift-off λ²/2R = "
+                      else "bending stiffness; lift-off λ²/2R = "
                       f"{self.liftoff_over_2c:.2g} × 2c: " + ("the beam spans to the outer wall, extra friction "
                                                                "expected (PULLFLEX)" if self.liftoff_over_2c > 1
                                                                else "rides the inner wall, no first-order change "
                                                                     "expected"))
             parts.append(f"exucable vs rope with clearance {100 * self.remainder:+.2f} % at √(EJ/T)/R = "
-                         f"{self.flexibility:.3g} ({regime})")
+                         f"{self.flexibility:.3g} ({regime}); the stiff-bend model (exucable/stiff_bend.py, bend "
+                         f"by bend, no free spans) predicts {100 * self.stiff_estimate:+.2f} % vs the rope"
+                         + ("" if self.stiff_estimate_fits else " but is outside its validity (offset > 2c)"))
         return "; ".join(parts)
 
 
@@ -294,6 +298,25 @@ def _flexibility(scenario, plan_sections) -> tuple[float, float]:
              if s["kind"] == "bend" and s.get("radius_m") and s["tension_out_N"] > 0]
     return (max((math.sqrt(ej / t) / r for t, r in bends), default=0.0),
             max((ej / t / (2.0 * r) / two_c for t, r in bends), default=0.0))
+
+
+def _stiff_estimate(scenario, plan_sections) -> tuple[float, bool]:
+    """Bending stiffness' change of the pulling force against the rope, from :func:`exucable.stiff_bend.stiff_bend`
+    bend by bend along the route (the rope's straights' add-ons kept, free spans and weight in bends not):
+    (T_stiff − T_rope) / T_rope, and whether every bend is within that model's validity (offset ≤ 2c)."""
+    from .stiff_bend import stiff_bend
+    c = scenario.conduit.inner_radius_m - scenario.cable.radius_m
+    ej, mu = scenario.cable.bending_stiffness_N_m2, scenario.contact.friction
+    t, fits = plan_sections[0]["tension_in_N"], True
+    for sec in plan_sections:
+        if sec["kind"] == "bend" and t > 0:
+            sb = stiff_bend(t, mu, math.radians(sec["angle_deg"]), sec["radius_m"] - c, ej)
+            fits = fits and sb.fits(c)
+            t = sb.tension_out_N
+        else:
+            t += sec["tension_out_N"] - sec["tension_in_N"]
+    rope = plan_sections[-1]["tension_out_N"]
+    return (t - rope) / rope, fits
 
 
 def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: bool = True,
@@ -353,6 +376,7 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
             name = f"{Path(ex['scenario']).stem}-{ex['direction']}"
             row = IndustryRow(name, ex["source"], ex["kind"], mode, published_values(ex)["tension_N"][-1], bound,
                               plan["directions"][ex["direction"]]["pull_force_N"], *_flexibility(sc, sections))
+            row.stiff_estimate, row.stiff_estimate_fits = _stiff_estimate(sc, sections)
             k0 = None
             for level, refine in enumerate(refines):
                 say(f"validate industry: {name}, {mode}, mesh level {level} (element length / {refine:g}) ...")
@@ -396,7 +420,7 @@ def _g(x, fmt=".6g"):
 
 
 HEADER = ["example", "mode", "published [N]", "rope [N]", "rope w/ clearance [N] (run's extent)", "exucable [N]", "converged [N]",
-          "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "liftoff/2c", "pass"]
+          "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "liftoff/2c", "stiff-bend est.", "pass"]
 
 
 def table_rows(iv: IndustryValidation):
@@ -407,7 +431,8 @@ def table_rows(iv: IndustryValidation):
                      _g(r.run_rope_clearance_N), _g(r.value_N),
                      _converged(r), _pct(r.mesh_difference),
                      "-" if sc is None else f"{100 * sc:.3f} %", _pct(r.rel(r.published_N), 2), _pct(r.rel(r.run_rope_N), 2),
-                     _pct(r.remainder, 2), f"{r.flexibility:.3g}", f"{r.liftoff_over_2c:.2g}", "PASS" if r.passed else "FAIL"])
+                     _pct(r.remainder, 2), f"{r.flexibility:.3g}", f"{r.liftoff_over_2c:.2g}",
+                     _pct(r.stiff_estimate, 2) + ("" if r.stiff_estimate_fits else " (outside)"), "PASS" if r.passed else "FAIL"])
     return HEADER, rows
 
 

@@ -41,7 +41,8 @@ def test_small_route_suite_checks_and_files(tmp_path):
     assert row.flexibility == pytest.approx(math.sqrt(1e9 * math.pi * 0.0025**4 / 4 / capstan) / 0.5, rel=1e-3)
     names = {name for name, _, _ in row.checks()}
     assert {"rope vs published", "mesh", "trusted status"} <= names and "vs rope with clearance" not in names
-    assert "no estimate yet" in row.explanation() and row.liftoff_over_2c < 1   # rides the inner wall
+    assert "stiff-bend model" in row.explanation() and row.liftoff_over_2c < 1   # rides the inner wall
+    assert row.stiff_estimate_fits and -1e-3 < row.stiff_estimate <= 0.0   # second order, negative
     assert row.passed and not iv.failures
     for f in ("industry.csv", "industry.md", "industry.png"):
         assert (tmp_path / f).stat().st_size > 0
@@ -81,8 +82,10 @@ def test_cli_names_the_examples_when_none_matches(capsys):
 
 def test_mode_difference_and_scatter_checks_without_runs():
     from exucable.validate_industry import IndustryRow, IndustryValidation
-    steady = IndustryRow("r", "src", "closed form", "steady", 100.0, 1.0, 100.0, 0.0, 0.0, 100.0, 100.0)
-    dynamic = IndustryRow("r", "src", "closed form", "dynamic", 100.0, 1.0, 100.0, 0.0, 0.0, 99.0, 99.0)
+    steady = IndustryRow("r", "src", "closed form", "steady", 100.0, 1.0, 100.0, 0.0, 0.0, run_rope_N=100.0,
+                         run_rope_clearance_N=100.0)
+    dynamic = IndustryRow("r", "src", "closed form", "dynamic", 100.0, 1.0, 100.0, 0.0, 0.0, run_rope_N=99.0,
+                          run_rope_clearance_N=99.0)
     steady.values_N, steady.statuses = [100.0], ["ok"]
     dynamic.values_N, dynamic.statuses, dynamic.scatter = [99.0], ["steady"], [0.003]
     iv = IndustryValidation(rows=[steady, dynamic])
