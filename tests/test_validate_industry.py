@@ -67,8 +67,8 @@ def test_several_cable_examples_are_skipped_with_the_reason(tmp_path):
 @pytest.mark.slow
 def test_full_industry_suite_steady(tmp_path):
     iv = validate_industry(out_dir=tmp_path)
-    # what holds today (2026-11-29); the mesh targets on the 500 ft route, Gera and MachineCalcs do not yet
-    # (reference/README.md, "Industry worked pulls in the multibody model"), and the suite exits 1 for them
+    # what holds today (2026-11-29); Gera's finest mesh does not solve yet (reference/README.md, "Industry
+    # worked pulls in the multibody model"), and the suite exits 1 for it
     assert len(iv.rows) + len(iv.skipped) >= 5 and all(r.statuses[0] in ("ok", "steady") for r in iv.rows)
     assert all(name != "rope vs published" or ok for r in iv.rows for name, ok, _ in r.checks())
 
