@@ -570,6 +570,9 @@ class SolverSpec(_Spec):
     mode : {"dynamic", "steady"}
         ``"dynamic"``: integrate the paper's dynamics in time; ``"steady"``: solve the steady
         sliding state in one static solve (:mod:`exucable.solve_steady`).
+    steady_lead_out_m : float or None
+        Steady mode: cable laid out past the conduit's exit at the start [m] (None: the rule of
+        :func:`exucable.model.layout.steady_lead_out_m`, 10 bending lengths past the last bend).
     """
 
     _SECTION: ClassVar[str] = "solver"
@@ -588,6 +591,7 @@ class SolverSpec(_Spec):
     steady_tolerance: float = _default("solver.steady_tolerance")
     pretension: bool = _default("solver.pretension")
     mode: str = _default("solver.mode")
+    steady_lead_out_m: float | None = _default("solver.steady_lead_out")
 
     def _check(self) -> None:
         if self.mode == "steady" and not self.pretension:

@@ -276,6 +276,11 @@ FIELDS: tuple[Field, ...] = (
            "needs `solver.pretension = true`; on a route ending in a bend the start is laid out past the exit so that "
            "the rig sits 10 bending lengths √(EJ/T) beyond the bend, and `reference_pulled_out_m` says how far); "
            "the `solver` time keys are then unused"),
+    F("solver.steady_lead_out", "steady_lead_out_m", "float", "m", None, ge=0.0, ours=True,
+      default_doc="the rule in `solver.mode`",
+      rule="≥ 0; steady mode only: cable laid out past the conduit's exit at the start (the state a dynamic pull "
+           "reaches after pulling that far: `exucable validate` sets it to the dynamic run's "
+           "`reference_pulled_out_m` to compare both modes in the same state)"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
       rule="array of times in [0, `solver.end_time`]: the whole state is written at each "

@@ -200,3 +200,16 @@ def test_steady_lead_out_clears_the_last_bend():
     assert steady_lead_out_m(helix, 0.0307, 18.74) == pytest.approx(LEAD_OUT_BENDING_LENGTHS * lam)
     assert steady_lead_out_m(bend, 0.0307, 18.74) == 0.0
     assert steady_lead_out_m(helix, 0.0, 18.74) == 0.0
+
+
+def test_steady_lead_out_given_is_used_and_bounded():
+    """``solver.steady_lead_out`` (what `exucable validate` sets to the dynamic run's extent) lays
+    the leading end that far past the exit, and one as long as the cable is refused by its key."""
+    from exucable.errors import ModelError
+    from exucable.model.layout import initial_layout
+
+    sc = load_scenario(data_path("scenarios", "fast", "paper_ex2_bend90.toml")).replace(
+        **{"solver.mode": "steady", "solver.steady_lead_out": 0.05})
+    assert initial_layout(sc).lead_out_m == pytest.approx(0.05)
+    with pytest.raises(ModelError, match=r"solver\.steady_lead_out"):
+        initial_layout(sc.replace(**{"solver.steady_lead_out": sc.cable_length_m}))

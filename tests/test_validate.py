@@ -29,10 +29,14 @@ def test_fast_validation_passes_every_check(fast_validation):
     assert cases == {"Ex. 1", "Ex. 2", "Ex. 3", "Fig. 12", "Ex. 4"}
     for mode in ("dynamic", "steady"):       # every case in both solver modes
         assert sum(c.case == "Fig. 12" and c.mode == mode for c in vr.checks) == 3
-    # and their difference, one row per check (bounds: reference/README.md explains the coarse
-    # meshes' larger ones; here only that the two methods land near each other, within 1 %)
+    # and their difference, one row per check. Every velocity-controlled pull is compared in the
+    # same state (the steady cable laid out as far as the dynamic run had pulled it): there the
+    # issue's bound, 0.2 %, holds even on the coarse meshes (measured 2026-11-29: at most 0.07 %).
+    # Example 3's force-controlled pull has no such extent (its own lead-out): within 1 %.
     diffs = vr.differences
     assert len(diffs) == len(vr.checks) // 2
+    assert {d.case for d in diffs if d.same_state} == {"Ex. 1", "Ex. 2", "Fig. 12", "Ex. 4"}
+    assert all(d.agrees for d in diffs if d.same_state), format_table(vr)
     assert all(abs(d.rel_difference) < 1e-2 for d in diffs), format_table(vr)
 
 

@@ -466,6 +466,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     -------
     InitialLayout
     """
+    from ..errors import ModelError
     from ..rope import solve_rope, solve_rope_for_pull_force
 
     sc = scenario
@@ -487,7 +488,11 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     rope = rope_for(L_cable)
     lead_out = 0.0
     if sc.solver.mode == "steady" and sc.solver.pretension:
-        lead_out = steady_lead_out_m(centre, c.bending_stiffness_N_m2, rope.pull_force_N)
+        lead_out = (steady_lead_out_m(centre, c.bending_stiffness_N_m2, rope.pull_force_N)
+                    if sc.solver.steady_lead_out_m is None else float(sc.solver.steady_lead_out_m))
+        if lead_out >= L_cable:
+            raise ModelError("solver.steady_lead_out", f"{lead_out:.4g} m laid out past the exit leaves none of the "
+                             f"{L_cable:.4g} m cable in the conduit; give less than the cable's length")
         if lead_out > 0.0:
             rope = rope_for(L_cable - lead_out)    # the reference of the cable as laid: less inside
     clearance = conduit.inner_radius_m - c.radius_m
