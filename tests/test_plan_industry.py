@@ -10,62 +10,13 @@ from pathlib import Path
 import pytest
 
 from exucable.plan import load_plan_scenario, plan_pull
+from exucable.validate_industry import published_bounds_N, published_values
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = tomllib.loads((ROOT / "reference" / "industry_values.toml").read_text())
 LBF = 4.4482216152605
 FT = 0.3048
 LB_PER_FT = LBF / FT
-
-
-def _published(example) -> dict:
-    """The example's published numbers in N, N/m and m, whichever units it was printed in."""
-    if "tension_out_N" in example:
-        tension = example.get("tension_out_corrected_N", example["tension_out_N"])
-        return {"tension_N": list(map(float, tension)), "rounding_N": example["tension_rounding_N"],
-                "pressure_N_per_m": example.get("sidewall_pressure_N_per_m", []),
-                "radius_m": example.get("bend_radius_m"), "pressure_rounding_N_per_m": example.get("pressure_rounding_N_per_m")}
-    tension = example.get("tension_out_corrected_lbf", example["tension_out_lbf"])
-    return {"tension_N": [t * LBF for t in tension], "rounding_N": example["tension_rounding_lbf"] * LBF,
-            "pressure_N_per_m": [p * LB_PER_FT for p in example.get("sidewall_pressure_lb_per_ft", [])],
-            "radius_m": example["bend_radius_ft"] * FT if "bend_radius_ft" in example else None,
-            "pressure_rounding_N_per_m": example.get("pressure_rounding_lb_per_ft", 0.0) * LB_PER_FT}
-
-
-def _bounds(example, rows, mu_bend, w_N_per_m):
-    """Bound |exact - published| [N] for every published tension: interval propagation of the hand calculation.
-
-    Per step from the previous published value to the next: the carried error times the bend factors
-    between (chained calculations), the bend factors' rounding, the weight correction factor's rounding
-    on the straights' add-ons, the weight in the bends the hand calculation drops (``bend_weight_ignored``)
-    and the printed value's own rounding (reference/industry_values.toml header).
-    """
-    pub = _published(example)
-    delta = example["bend_factor_rounding"]
-    wc_rel = example.get("weight_correction_rounding", 0.0) / example.get("weight_correction_published", 1.0)
-    bounds, e, prev_idx, prev_pub = [], 0.0, 0, 0.0
-    for idx, value in zip(example["sections"], pub["tension_N"]):
-        between = rows[prev_idx:idx]
-        bends = [b for b in between if b["kind"] == "bend"]
-        factor = math.prod(math.exp(mu_bend * math.radians(b["angle_deg"])) for b in bends)
-        carried = factor * e if example["chained"] else 0.0
-        # within the step, in pull order: a straight's add-on error, a bend multiplies what came before
-        # and adds the weight the hand calculation drops in it
-        step = 0.0
-        for r in between:
-            if r["kind"] == "straight":
-                step += wc_rel * (r["tension_out_N"] - r["tension_in_N"])
-                continue
-            grow = math.exp(mu_bend * math.radians(r["angle_deg"]))
-            step *= grow
-            if example.get("bend_weight_ignored", False):
-                R = r["radius_m"]
-                step += ((grow - 1.0) * w_N_per_m**2 * R**2 / (2.0 * r["tension_in_N"]) if r["plane"] == "horizontal"
-                         else (grow - 1.0) * w_N_per_m * R)
-        e = carried + len(bends) * delta * max(prev_pub, 0.0) * factor + pub["rounding_N"] + step
-        bounds.append(e)
-        prev_idx, prev_pub = idx, value
-    return bounds
 
 
 @pytest.mark.parametrize("example", REFERENCE["example"],
@@ -77,8 +28,8 @@ def test_published_section_tensions_and_swbp(example):
     mu = scenario.contact.friction
     mu_bend = mu * plan["weight_correction_factor"] if spec.weight_correction_in_bends else mu
     w = plan["inputs"]["weight_per_length_one_cable_N_per_m"] * plan["count"]
-    pub = _published(example)
-    bounds = _bounds(example, rows, mu_bend, w)
+    pub = published_values(example)
+    bounds = published_bounds_N(example, rows, mu_bend, w)
     for idx, value, bound in zip(example["sections"], pub["tension_N"], bounds):
         ours = rows[idx - 1]["tension_out_N"]
         assert abs(ours - value) <= bound, f"section {idx}: ours {ours:.2f} N, published {value:.2f} N, bound {bound:.2f}"

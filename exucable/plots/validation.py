@@ -103,3 +103,27 @@ def plot_validation_figures(vr, out, ref: dict | None = None) -> list:
         save_figure(fig, out / "fig14_ex4_pull_force.png", bbox_inches="tight")
         written.append(out / "fig14_ex4_pull_force.png")
     return written
+
+
+def plot_industry(iv, path):
+    """Bars per industry example and mode, relative to the published value: the centreline rope, the
+    rope with clearance and exucable (with the published rounding bound as a band)."""
+    fig = new_figure(figsize=(9.0, 4.5), layout="constrained")
+    ax = fig.subplots()
+    rows = iv.rows
+    x = np.arange(len(rows))
+    bound = np.array([100 * r.published_bound_N / r.published_N for r in rows])
+    ax.bar(x, 2 * bound, bottom=-bound, width=0.9, color="0.9", label="published ± its rounding bound")
+    series = [("centreline rope", [r.rope_N for r in rows]),
+              ("rope with clearance", [r.run_rope_clearance_N for r in rows]),
+              ("exucable (default mesh)", [r.value_N for r in rows])]
+    for k, (label, vals) in enumerate(series):
+        rel = [100 * (v / r.published_N - 1) if v is not None else np.nan for v, r in zip(vals, rows)]
+        ax.bar(x + (k - 1) * 0.25, rel, width=0.25, label=label)
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xticks(x, [f"{r.example.replace('_', ' ')}\n({r.mode})" for r in rows], fontsize=7, rotation=12,
+                  ha="right")
+    ax.set_ylabel("pulling force vs published [%]")
+    ax.set_title("Industry worked pulls (exucable validate --suite industry)")
+    ax.legend(fontsize=7)
+    return save_figure(fig, path)
