@@ -28,7 +28,7 @@ __all__ = ["pull_force_references_N", "reference_drift_N_per_s"]
 
 
 def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_clearance: bool = True,
-                            clearance_solution=None) -> dict:
+                            clearance_solution=None, rope_solution=None) -> dict:
     """Pulling force of both flexible references once ``pulled_out_m`` of cable has left the conduit.
 
     Parameters
@@ -44,6 +44,8 @@ def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_c
     clearance_solution : ClearanceRopeSolution, optional
         The rope with clearance already solved for this conduit and extent (the start's, at
         ``pulled_out_m`` 0): used instead of solving it again.
+    rope_solution : RopeSolution, optional
+        Likewise the centreline rope already solved for this conduit and extent (the start's).
 
     Returns
     -------
@@ -64,7 +66,9 @@ def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_c
                          f"{sc.cable_length_m:.4g} m)")
     head = w * float(np.asarray(centre.tangent(centre.length_m))[2]) * out
     mu, back = sc.contact.friction, sc.pull.back_tension_N
-    rope = solve_rope(centre, mu, w, back, cable_length_m=inside).pull_force_N + head
+    if rope_solution is None:
+        rope_solution = solve_rope(centre, mu, w, back, cable_length_m=inside)
+    rope = rope_solution.pull_force_N + head
     clearance = conduit.inner_radius_m - sc.cable.radius_m
     clear = None
     if clearance > 0.0 and with_clearance and clearance_solution is not None:

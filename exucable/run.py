@@ -57,10 +57,14 @@ def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | N
     s, p, pen = points["s_conduit_m"], points["normal_force_per_length_N_per_m"], points["penetration_m"]
     peak = float(p.max()) if p.size else 0.0
     if s.size > max_rows:
-        groups = np.array_split(np.arange(s.size), max_rows)
-        s = np.array([s[g].mean() for g in groups])
-        p = np.array([p[g].mean() for g in groups])
-        pen = np.array([pen[g].max() for g in groups])
+        # the groups of np.array_split (contiguous, sizes differing by one), reduced at once
+        size, extra = divmod(s.size, max_rows)
+        counts = np.full(max_rows, size)
+        counts[:extra] += 1
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        s = np.add.reduceat(s, starts) / counts
+        p = np.add.reduceat(p, starts) / counts
+        pen = np.maximum.reduceat(pen, starts)
     return {"s_conduit_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
 
 
@@ -310,9 +314,11 @@ def extent_references(scenario, model, pulled_out_m: float) -> dict:
 
     if scenario.pull.force_N is not None:
         return {}
-    # at the start's extent (nothing pulled out, or a steady start's lead-out) the start's own rope
-    # with clearance is that reference (same conduit, cable inside, loads): not solved twice
+    # at the start's extent (nothing pulled out, or a steady start's lead-out) the start's own ropes
+    # (centreline and with clearance) are those references (same conduit, cable inside, loads):
+    # not solved twice
     start = model.start
-    start_clearance = (getattr(start, "rope_clearance", None)
-                       if pulled_out_m == getattr(start, "lead_out_m", 0.0) else None)
-    return pull_force_references_N(scenario, model.conduit, pulled_out_m, clearance_solution=start_clearance)
+    at_start = pulled_out_m == getattr(start, "lead_out_m", 0.0)
+    return pull_force_references_N(scenario, model.conduit, pulled_out_m,
+                                   clearance_solution=getattr(start, "rope_clearance", None) if at_start else None,
+                                   rope_solution=getattr(start, "rope", None) if at_start else None)

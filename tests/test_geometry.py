@@ -343,3 +343,24 @@ def test_plot_route_writes_png(tmp_path, line):
     data = out.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
     assert [p.name for p in tmp_path.iterdir()] == ["route.png"]  # no temp file left behind
+
+
+def test_one_point_evaluation_equals_the_array_path():
+    """A single arc length (the rope ODE's right-hand side) takes a shortcut to its piece: the same
+    values, bit for bit, as the same point evaluated within an array, at piece boundaries too, and
+    the same refusal outside [0, L]."""
+    from exucable.geometry import Bend, Straight, centreline_from_path
+
+    c = centreline_from_path([0, 0, 0], [1, 0, 0], [Straight(2.0), Bend(90, 1.5, "left"), Bend(30, 2.0, "up"),
+                                                     Straight(1.0)])
+    s_all = np.concatenate([np.linspace(0.0, c.length_m, 37), [2.0, 2.0 + 1.5 * np.pi / 2]])
+    for method in ("point", "tangent", "curvature_vector"):
+        f = getattr(c, method)
+        many = f(s_all)
+        for s, row in zip(s_all, many):
+            assert np.array_equal(f(float(s)), row) and np.array_equal(f(np.array([s]))[0], row)
+            assert f(float(s)).shape == (3,) and f(np.array([s])).shape == (1, 3)
+    with pytest.raises(ValueError, match="arc length outside"):
+        c.point(c.length_m + 1.0)
+    with pytest.raises(ValueError, match="arc length outside"):
+        c.tangent(float("nan"))

@@ -117,3 +117,20 @@ def test_route_draws_each_paper_scenario(name, tmp_path):
     assert png.stat().st_size > 10000
     for row in ("length", "turning", "segments", "bend radius"):
         assert row in p.stdout.lower(), p.stdout
+
+
+def test_contact_profile_groups_are_those_of_array_split():
+    """Beyond max_rows the profile averages consecutive points in np.array_split's groups (the
+    definition, evaluated group by group here): mean pressure and position, largest penetration."""
+    from exucable.run import contact_profile
+
+    rng = np.random.default_rng(7)
+    n, rows = 10007, 300
+    pts = {"s_conduit_m": np.sort(rng.uniform(0, 50, n)), "normal_force_per_length_N_per_m": rng.uniform(0, 9, n),
+           "penetration_m": rng.uniform(0, 1e-4, n)}
+    prof, peak = contact_profile(pts, max_rows=rows)
+    groups = np.array_split(np.arange(n), rows)
+    assert peak == pts["normal_force_per_length_N_per_m"].max()
+    for key, reduce in (("s_conduit_m", np.mean), ("normal_force_per_length_N_per_m", np.mean), ("penetration_m", np.max)):
+        want = np.array([reduce(pts[key][g]) for g in groups])
+        assert np.allclose(prof[key], want, rtol=1e-14, atol=0.0), key

@@ -91,6 +91,26 @@ def test_numba_equals_numpy():
     assert np.abs(a.jac_q_blocks - b.jac_q_blocks).max() < 1e-9 * np.abs(a.jac_q_blocks).max()
 
 
+def test_numba_points_equal_numpy():
+    """The compiled per-point state (post-processing and the steady solve's outside-the-conduit
+    check) is the numpy reference's: v = V ∂r/∂x, its normal and friction forces, the segment and
+    the arc length; with a second cable half out of contact (moved to the axis) as well."""
+    cond = bend_conduit()
+    q, L = cable_in_bend(cond, np.random.default_rng(6))
+    q_free = q.reshape(-1, 6).copy()
+    q_free[2:, :3] = cond.centreline.point(np.linspace(0.35, 0.95, 5))[2:]
+    for coords in (q, q_free.reshape(-1)):
+        a = kernels(cond, L, "numpy").points(coords, np.zeros_like(coords))
+        b = kernels(cond, L, "numba").points(coords, np.ones_like(coords))   # q_t is ignored
+        assert np.array_equal(a.segment, b.segment)
+        assert np.array_equal(a.in_contact, b.in_contact)
+        for name in ("position_m", "velocity_m_per_s", "s_conduit_m", "penetration_m", "normal_force_N",
+                     "sliding_velocity_m_per_s", "friction_force_N"):
+            x, y = getattr(a, name), getattr(b, name)
+            assert np.allclose(x, y, rtol=1e-10, atol=1e-12 * max(1.0, np.nanmax(np.abs(x)))), name
+    assert 0 < np.count_nonzero(a.in_contact) < a.in_contact.size
+
+
 def test_friction_opposes_the_flow_toward_the_leading_end():
     """Check-point velocities are V ∂r/∂x (nodes numbered from the trailing end), so the friction
     force on the cable points back along the cable: its total, dotted with the local tangent, is

@@ -317,13 +317,17 @@ def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open
 
 
 @njit(**_JIT)
-def _points_kernel(q, qt, length, n1, n2, n3, n4, omega, seg, off, cand, gap, stiffness, damping,
-                   exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2, inv_href, tab, sel,
-                   open_first, open_last, smooth, seg_piece, pieces, seg_phi, n_newton, inv_onset,
-                   out_seg, out_p, out_v, out_res, out_f, out_g, out_hf):
+def _points_kernel(q, qt, length, n1, n2, n3, n4, r1, r2, r3, r4, steady_speed, omega, seg, off,
+                   cand, gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
+                   inv_href, tab, sel, open_first, open_last, smooth, seg_piece, pieces, seg_phi,
+                   n_newton, inv_onset, out_seg, out_p, out_v, out_res, out_f, out_g, out_hf):
     """Per check point state for post-processing, by the same steps as :func:`_contact_kernel`:
     nearest segment (-1 without candidates), P, v, residual P - Pc (NaN without candidates),
-    weighted normal force w f_n, |v_τ|² and μ w f_n/√(|v_τ|² + ε²)."""
+    weighted normal force w f_n, |v_τ|² and μ w f_n/√(|v_τ|² + ε²).
+
+    The velocity is ``_positions(qt)`` with the tables r1..r4: the dynamic kernel's v = S(ξ) q̇
+    (Eq. 8) with r = n and ``steady_speed`` 0; steady sliding's v = V ∂r/∂x with r = dN/dξ,
+    qt = q and ``steady_speed`` = V [m/s] (as :func:`exucable.contact.steady._steady_kernel`)."""
     n_k = n1.shape[0]
     for e in range(length.shape[0]):
         c0 = off[e]
@@ -332,7 +336,14 @@ def _points_kernel(q, qt, length, n1, n2, n3, n4, omega, seg, off, cand, gap, st
         b = 6 * e
         r0 = e * n_k
         _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])  # Eq. 2
-        _positions(qt, b, le, n1, n2, n3, n4, tab[_VX], tab[_VY], tab[_VZ])  # Eq. 8
+        _positions(qt, b, le, r1, r2, r3, r4, tab[_VX], tab[_VY], tab[_VZ])  # Eq. 8
+        if steady_speed != 0.0:
+            # r = dN/dξ: _positions gave L ∂r/∂x
+            vs = steady_speed / le
+            for k in range(n_k):
+                tab[_VX, k] *= vs
+                tab[_VY, k] *= vs
+                tab[_VZ, k] *= vs
         for k in range(n_k):
             out_p[r0 + k, 0] = tab[_PX, k]
             out_p[r0 + k, 1] = tab[_PY, k]
@@ -887,15 +898,23 @@ class FastKernel:
         """Per check point (element-major): nearest segment (-1: none), P [m], v [m/s], residual
         P - Pc [m] (NaN without a segment), weighted normal force w·f_n [N], sliding speed |v_τ|
         [m/s] and friction force [N] (both 0 where there is no force)."""
+        return self.point_state_with_rates(q, q_t, self._n, 0.0)
+
+    def point_state_with_rates(self, q, rate_source, rate_tables, steady_speed_m_per_s):
+        """:meth:`point_state` with the velocity v = ``_positions(rate_source, rate_tables)``,
+        times V/L_e if ``steady_speed_m_per_s`` V is not 0 (steady sliding: v = V ∂r/∂x with the
+        tables dN/dξ and ``rate_source`` = q; see :mod:`exucable.contact.steady`)."""
         q = np.ascontiguousarray(q, dtype=float)
-        q_t = np.ascontiguousarray(q_t, dtype=float)
+        q_t = np.ascontiguousarray(rate_source, dtype=float)
         off, cand = self.candidates(q)
         m = self.n_el * self.nh.shape[0]
         segment = np.empty(m, dtype=np.int64)
         p, v, res = np.empty((m, 3)), np.empty((m, 3)), np.empty((m, 3))
         f, g, hf = np.empty(m), np.empty(m), np.empty(m)
         n1, n2, n3, n4 = self._n
-        _points_kernel(q, q_t, self.length, n1, n2, n3, n4, self.omega, self.seg, off, cand, self.gap,
+        r1, r2, r3, r4 = rate_tables
+        _points_kernel(q, q_t, self.length, n1, n2, n3, n4, r1, r2, r3, r4, float(steady_speed_m_per_s),
+                       self.omega, self.seg, off, cand, self.gap,
                        *self._law_arguments(), self.inv_href, self._tab, self._sel, self.open_first,
                        self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
                        NEWTON_ITERATIONS, self._inverse_onset(), segment, p, v, res, f, g, hf)

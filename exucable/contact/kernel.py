@@ -348,6 +348,12 @@ class ContactKernel:
             in_contact=delta > 0.0,
         )
 
+    def point_segments(self, q) -> np.ndarray:
+        """Each check point's nearest conduit segment (-1: none within R: outside the conduit),
+        element-major: :meth:`points`' ``segment`` without the profiles' post-processing."""
+        q = self._check(q, "q")
+        return self._impl.point_state(q, np.zeros_like(q))["segment"]
+
     def _arc_length(self, p, seg, residual) -> np.ndarray:
         """Centreline arc length of each point's closest point Pc [m] (NaN without a segment):
         linear along the segment between its vertices' arc lengths, or on the smooth wall the

@@ -64,11 +64,10 @@ class SteadySlidingKernel(ContactKernel):
         self.speed_m_per_s = float(speed_m_per_s)
         self._dnh = hermite_unit_derivative(self.xi)
         self._base_law = self.law
-        reference = _SteadyReference(self)
         if self.backend == "numba":
-            self._impl = _SteadyFast(self._impl, self._dnh, self.speed_m_per_s, reference)
+            self._impl = _SteadyFast(self._impl, self._dnh, self.speed_m_per_s)
         else:
-            self._impl = reference
+            self._impl = _SteadyReference(self)
 
     def set_friction_scale(self, scale: float) -> None:
         """Scale μ_k and μ_s by ``scale`` [-] (a continuation parameter; 1 = the scenario's law)."""
@@ -174,9 +173,8 @@ class _SteadyFast:
     """Compiled steady-sliding evaluation sharing a :class:`~exucable.contact.fast.FastKernel`'s
     tables, broad phase and work buffers."""
 
-    def __init__(self, fast, dnh_unit, speed_m_per_s, reference):
+    def __init__(self, fast, dnh_unit, speed_m_per_s):
         self.fast = fast
-        self.reference = reference
         self.speed = float(speed_m_per_s)
         self._d = [np.ascontiguousarray(dnh_unit[:, i]) for i in range(4)]
         nh = fast.nh
@@ -189,8 +187,9 @@ class _SteadyFast:
         return self.fast.candidates(q)
 
     def point_state(self, q, q_t):
-        """Per check point state (post-processing only: the numpy reference's)."""
-        return self.reference.point_state(q, q_t)
+        """Per check point state, compiled (tested against the numpy reference's); ``q_t`` is
+        ignored: v = V ∂r/∂x."""
+        return self.fast.point_state_with_rates(q, q, self._d, self.speed)
 
     def evaluate(self, q, q_t, jacobian):
         """As :meth:`FastKernel.evaluate`; ``q_t`` is ignored and the q̇-blocks are zero."""

@@ -299,6 +299,11 @@ class Centreline:
     def _check_s(self, s_m) -> np.ndarray:
         s = np.asarray(s_m, dtype=float)
         tol = _S_RTOL * self.length_m
+        if s.size == 1:
+            x = s.item()
+            if not (math.isfinite(x) and -tol <= x <= self.length_m + tol):
+                raise ValueError(f"arc length outside [0, {self.length_m:.9g}] m")
+            return np.full(s.shape, min(max(x, 0.0), self.length_m))
         if np.any(~np.isfinite(s)) or np.any(s < -tol) or np.any(s > self.length_m + tol):
             raise ValueError(f"arc length outside [0, {self.length_m:.9g}] m")
         return np.clip(s, 0.0, self.length_m)
@@ -311,6 +316,13 @@ class Centreline:
 
     def _evaluate(self, s_m, method: str) -> np.ndarray:
         s = self._check_s(s_m)
+        if s.size == 1:
+            # one point (the rope ODE's right-hand side, ~1000 calls a solve): its piece directly,
+            # without the grouping below
+            idx = min(max(int(np.searchsorted(self._s_start, s.item(), side="right")) - 1, 0), len(self.pieces) - 1)
+            piece = self.pieces[idx]
+            u = s.reshape(1) - piece.s_start_m
+            return getattr(piece, method)(u).reshape(s.shape + (3,))
         flat = s.reshape(-1)
         idx = np.clip(np.searchsorted(self._s_start, flat, side="right") - 1, 0, len(self.pieces) - 1)
         out = np.empty((flat.size, 3))
