@@ -63,6 +63,13 @@ _PENALTY = 1.0e3
 # it stays finite at the wall, where the penalty takes over).
 _TROUGH_LINEAR_FROM = 0.98
 _TOL_PULL = 1e-9
+# In 3D the cable lifts off and lands on the floor node by node, and the penalty's kinks stall Newton
+# near round-off: a residual of 1e-6 of the tension (~1e-4 N here, against node weights of ~0.02 N)
+# moves the pull by ~1e-7, far below the 1e-4 the model is read at.
+_SHAPE_TOL_3D = 1e-6
+_TOL_PULL_3D = 1e-7
+_SHAPE_STALL_3D = 1e-4
+_SMOOTH_3D = 1e-4
 
 
 class BeamConduitError(RuntimeError):
@@ -267,8 +274,8 @@ class _Chain:
 def solve_planar_beam(pieces, clearance_m: float, friction: float, weight_N_per_m: float,
                       bending_stiffness_N_m2: float, back_tension_N: float, spacing_m: float,
                       head_offset_m: float | None = None, trough_weight_N_per_m: float | None = None,
-                      start_bending_stiffness_N_m2: float | None = None) -> PlanarBeamSolution:
-    """Steady pull of a planar beam through a planar route, by continuation in EJ.
+                      start_bending_stiffness_N_m2: float | None = None, three_d: bool = False) -> PlanarBeamSolution:
+    """Steady pull of a beam through a planar route, by continuation in EJ.
 
     Parameters
     ----------
@@ -287,13 +294,17 @@ def solve_planar_beam(pieces, clearance_m: float, friction: float, weight_N_per_
         Tension at the trailing end [N] (> 0).
     spacing_m : float
         Node spacing h [m]; resolve the bending length √(EJ/T) with ~10 nodes.
-    head_offset_m : float, optional
-        Pin the leading end at this offset [m] (a rig); default free.
+    head_offset_m : float or (float, float), optional
+        Pin the leading end at this offset [m] (a rig; with ``three_d`` along n and up); default free.
     trough_weight_N_per_m : float, optional
         The weight that centres the cable in the trough (default ``weight_N_per_m``); a small value
         without gravity fixes the otherwise free lateral position of a straight far from a bend.
     start_bending_stiffness_N_m2 : float, optional
         Where the continuation starts (default T h², λ = h).
+    three_d : bool
+        Nodes move in their whole normal plane inside the round conduit, under their weight (free
+        spans over the floor, the trough bridged by the stiffness); default: in the bend plane only,
+        the weight as the trough's potential and floor friction.
 
     Returns
     -------
@@ -304,14 +315,17 @@ def solve_planar_beam(pieces, clearance_m: float, friction: float, weight_N_per_
     args = (pieces, clearance_m, friction, weight_N_per_m)
     kw = dict(head_offset_m=head_offset_m, trough_weight_N_per_m=trough_weight_N_per_m, tension_scale_N=back_tension_N)
     ej = start_bending_stiffness_N_m2 or min(bending_stiffness_N_m2, back_tension_N * spacing_m ** 2)
-    chain = _Chain(*args, ej, back_tension_N, spacing_m, **kw)
+    cls = _Chain3D if three_d else _Chain
+    chain = cls(*args, ej, back_tension_N, spacing_m, **kw)
     d = np.clip(chain.kap * 1e12, -clearance_m, clearance_m)   # the rope's: on each bend's inner wall
+    if three_d:                                                # ... and on the floor
+        d = np.stack([d, -np.sqrt(np.maximum(clearance_m ** 2 - d * d, 0.0))], 1)
     sol = chain.solve(d, soften=True)
     factor = 2.0
     while ej < bending_stiffness_N_m2:
         nxt = min(bending_stiffness_N_m2, ej * factor)
         try:
-            sol = _Chain(*args, nxt, back_tension_N, spacing_m, **kw).solve(sol.offset_m.copy())
+            sol = cls(*args, nxt, back_tension_N, spacing_m, **kw).solve(sol.offset_m.copy())
         except BeamConduitError:
             factor = math.sqrt(factor)
             if factor < 1.0 + 1e-3:
@@ -337,14 +351,15 @@ def route_pieces(centreline) -> list[tuple[float, float]]:
 
 def stiff_route_difference(pieces, clearance_m, friction, weight_N_per_m, bending_stiffness_N_m2,
                            back_tension_N, lead_out_bending_lengths=10.0, nodes_per_bending_length=10.0,
-                           pad_decay_lengths=3.0, max_pad_m=6.0, progress=None) -> dict:
+                           pad_decay_lengths=3.0, max_pad_m=6.0, three_d=None, progress=None) -> dict:
     """Bending stiffness' change of the pulling force on a route, from the planar beam-in-conduit model:
     (T_EJ − T_flexible) / T_flexible, the model's own EJ → 0 limit as reference.
 
     Bends are grouped into windows (bends closer than two pads); each window is solved with straight
     pads before and after it (``pad_decay_lengths`` trough decay lengths √(T c / w), at least 10
     bending lengths, at most ``max_pad_m`` and what the route has), the far parts of the straights
-    adding μ w L in both chains (the rope's straight). A route ending in a bend gets a lead-out of
+    adding μ w L in both chains (the rope's straight). ``three_d`` (default: with gravity) lets the
+    nodes move in the whole normal plane (:func:`solve_planar_beam`). A route ending in a bend gets a lead-out of
     ``lead_out_bending_lengths`` where the stiff cable is pinned at the flexible cable's offset (as
     exucable's steady rig, :func:`exucable.model.layout.steady_lead_out_m`).
 
@@ -356,6 +371,7 @@ def stiff_route_difference(pieces, clearance_m, friction, weight_N_per_m, bendin
     """
     say = progress or (lambda line: None)
     mu, w, c, ej = friction, weight_N_per_m, clearance_m, bending_stiffness_N_m2
+    three_d = w > 0.0 if three_d is None else three_d
     n = len(pieces)
     windows, i = [], 0
     while i < n:
@@ -399,12 +415,15 @@ def stiff_route_difference(pieces, clearance_m, friction, weight_N_per_m, bendin
         trough_w = w if w > 0 else 1e-5 * t_flex * max(abs(k) for _, k in window)
         say(f"beam in conduit: window {wi + 1}/{len(windows)} (pieces {i + 1}-{j + 1}), "
             f"{sum(length for length, _ in window) / h:.0f} nodes")
-        flex = solve_planar_beam(window, c, mu, w, min(ej, t_flex * h * h), t_flex, h, trough_weight_N_per_m=trough_w)
+        flex = solve_planar_beam(window, c, mu, w, min(ej, t_flex * h * h), t_flex, h, trough_weight_N_per_m=trough_w,
+                                 three_d=three_d)
         # the leading end: pinned where the flexible cable is (exucable's rig) at the route's end or
         # without gravity (nothing else centres it); free on a straight with gravity
-        head = float(flex.offset_m[-1]) if j + 1 >= n or w == 0.0 else None
-        stiff = solve_planar_beam(window, c, mu, w, ej, t_stiff, h, head_offset_m=head, trough_weight_N_per_m=trough_w)
-        outer = -math.copysign(1.0, sum(k for _, k in pieces[i:j + 1])) * stiff.offset_m
+        head = flex.offset_m[-1].copy() if j + 1 >= n or w == 0.0 else None
+        stiff = solve_planar_beam(window, c, mu, w, ej, t_stiff, h, head_offset_m=head, trough_weight_N_per_m=trough_w,
+                                  three_d=three_d)
+        lateral = stiff.offset_m[:, 0] if three_d else stiff.offset_m
+        outer = -math.copysign(1.0, sum(k for _, k in pieces[i:j + 1])) * lateral
         out_windows.append({"pieces": (i + 1, j + 1), "flexible_in_N": t_flex, "stiff_in_N": t_stiff,
                             "flexible_out_N": flex.pull_force_N, "stiff_out_N": stiff.pull_force_N,
                             "nodes": int(stiff.station_m.size), "max_outer_offset_over_c": float(np.max(outer) / c)})
@@ -414,3 +433,155 @@ def stiff_route_difference(pieces, clearance_m, friction, weight_N_per_m, bendin
             t_flex += mu * w * (length - used[k])
             t_stiff += mu * w * (length - used[k])
     return {"stiff_N": t_stiff, "flexible_N": t_flex, "difference": t_stiff / t_flex - 1.0, "windows": out_windows}
+
+
+class _Chain3D(_Chain):
+    """The same chain with the third dimension: each node moves in its normal plane (the bend plane's
+    normal n and the vertical), the wall is the round conduit |d| = c (a stiff penalty), the weight a
+    body force; the cable may lift off the floor in free spans (the rope with clearance's) and bridge
+    the trough with its stiffness. Bending energy (EJ/h) Σ (1 − t_{i−1}·t_i) (= EJ φ²/(2h) at small φ).
+    Offsets are (N, 2) arrays: along n and up."""
+
+    def pos(self, d):
+        x = np.zeros((self.N, 3))
+        x[:, :2] = self.C + d[:, :1] * self.n
+        x[:, 2] = d[:, 1]
+        return x
+
+    def _normal_frames(self):
+        n3 = np.zeros((self.N, 3))
+        n3[:, :2] = self.n
+        up = np.zeros((self.N, 3))
+        up[:, 2] = 1.0
+        return n3, up
+
+    def wall_force(self, d):
+        """Wall force on each node in its normal plane, (N, 2) [N] (a penalty on |d| − c)."""
+        r = np.hypot(d[:, 0], d[:, 1])
+        p = np.maximum(r - self.c, 0.0)
+        delta = _SMOOTH_3D * self.c       # the penalty's force is smoothed (C¹) over this depth, for Newton
+        force = self.K * np.where(p < delta, p * p / (2.0 * delta), p - delta / 2.0)
+        return -(force / np.maximum(r, 1e-300))[:, None] * d
+
+    def wall_energy(self, d):
+        r = np.hypot(d[:, 0], d[:, 1])
+        p = np.maximum(r - self.c, 0.0)
+        delta = _SMOOTH_3D * self.c
+        return self.K * float(np.sum(np.where(p < delta, p ** 3 / (6.0 * delta),
+                                              p * p / 2.0 - delta * p / 2.0 + delta * delta / 6.0)))
+
+    def geometry3(self, d):
+        x = self.pos(d)
+        v = np.diff(x, axis=0)
+        length = np.linalg.norm(v, axis=1)
+        return x, v, length, v / length[:, None]
+
+    def energy(self, d, T, G):
+        x, _, length, t = self.geometry3(d)
+        cosines = np.einsum("ij,ij->i", t[:-1], t[1:])
+        return float(T @ length + self.EJ / self.h * np.sum(1.0 - cosines) + self.wall_energy(d)
+                     + self.w * float(self.hbar @ d[:, 1]) - np.sum(G * x))
+
+    def forces(self, d, T):
+        x, v, length, t = self.geometry3(d)
+        tension = np.zeros_like(x)
+        tension[:-1] += T[:, None] * t
+        tension[1:] -= T[:, None] * t
+        cosines = np.einsum("ij,ij->i", t[:-1], t[1:])[:, None]
+        a = self.EJ / self.h
+        dE_dv = np.zeros_like(v)
+        dE_dv[:-1] -= a * (t[1:] - cosines * t[:-1]) / length[:-1, None]
+        dE_dv[1:] -= a * (t[:-1] - cosines * t[1:]) / length[1:, None]
+        bending = np.zeros_like(x)
+        bending[1:] -= dE_dv
+        bending[:-1] += dE_dv
+        n3, up = self._normal_frames()
+        wf = self.wall_force(d)
+        wall = wf[:, :1] * n3 + wf[:, 1:] * up
+        wall[:, 2] -= self.w * self.hbar      # the weight, with the wall's force
+        return tension, bending, wall, t
+
+    def lateral_residual(self, d, T, G):
+        tension, bending, wall, _ = self.forces(d, T)
+        total = tension + bending + wall + G
+        n3, up = self._normal_frames()
+        return np.stack([np.einsum("ij,ij->i", total, n3), total[:, 2]], 1)
+
+    def solve_shape(self, d, T, G, maxit=300):
+        free = np.ones((self.N, 2), bool)
+        if self.head is not None:
+            free[-1] = False
+            d[-1] = self.head
+        idx = np.flatnonzero(free)
+        m = idx.size
+        flat = d.reshape(-1)
+        for it in range(maxit):
+            r = self.lateral_residual(flat.reshape(-1, 2), T, G).reshape(-1)[idx]
+            nr = float(np.max(np.abs(r)))
+            if nr < _SHAPE_TOL_3D * self.Tref:
+                return flat.reshape(-1, 2), it
+            eps = 1e-7 * self.c
+            band = 5
+            ab = np.zeros((2 * band + 1, m))
+            for colour in range(2 * band + 1):
+                cols = np.arange(colour, m, 2 * band + 1)
+                trial = flat.copy()
+                trial[idx[cols]] += eps
+                dr = (self.lateral_residual(trial.reshape(-1, 2), T, G).reshape(-1)[idx] - r) / eps
+                for off in range(-band, band + 1):
+                    rows = cols + off
+                    ok = (rows >= 0) & (rows < m)
+                    ab[band + off, cols[ok]] = dr[rows[ok]]
+            step = solve_banded((band, band), ab, -r)
+            E0 = self.energy(flat.reshape(-1, 2), T, G)
+            slope = -float(r @ step)
+            if slope > 0.0:
+                step = r / np.max(np.abs(ab[band]))
+                slope = -float(r @ step)
+            lam = 1.0
+            while True:
+                trial = flat.copy()
+                trial[idx] += lam * step
+                if self.energy(trial.reshape(-1, 2), T, G) <= E0 + 1e-4 * lam * slope + 1e-12 * abs(E0) or lam < 1e-9:
+                    break
+                lam *= 0.5
+            if (lam < 1e-9 or np.max(np.abs(trial - flat)) < 1e-9 * self.c) and nr < _SHAPE_STALL_3D * self.Tref:
+                return flat.reshape(-1, 2), it   # stalled on the penalty's kinks, at a residual far below what matters
+            flat = trial
+        if nr < _SHAPE_STALL_3D * self.Tref:
+            return flat.reshape(-1, 2), maxit
+        raise BeamConduitError(f"shape Newton did not converge in {maxit} iterations at EJ = {self.EJ:.4g} N m^2 "
+                               f"(normal-plane residual {nr:.3g} N)")
+
+    def march(self, d, T):
+        _, bending, wall, t = self.forces(d, T)
+        contact = np.hypot(*self.wall_force(d).T)
+        new_T = np.empty_like(T)
+        friction_force = np.zeros((self.N, 3))
+        prev_T, prev_t = self.Tb, np.array([self.e[0, 0], self.e[0, 1], 0.0])
+        for i in range(self.N - 1):
+            tau = prev_t + t[i]
+            tau /= np.linalg.norm(tau)
+            friction_force[i] = -self.mu * contact[i] * tau
+            new_T[i] = (prev_T * (prev_t @ tau) - (bending[i] + wall[i]) @ tau + self.mu * contact[i]) / (t[i] @ tau)
+            prev_T, prev_t = new_T[i], t[i]
+        friction_force[-1] = -self.mu * contact[-1] * t[-1]
+        return new_T, friction_force, prev_T + self.mu * contact[-1], contact
+
+    def solve(self, d, soften=False, max_passes=200):
+        T = np.full(self.N - 1, self.Tb)
+        G = np.zeros((self.N, 3))
+        if soften:
+            K = self.K
+            for f in (1e-3, 1e-2, 1e-1):
+                self.K = K * f
+                d, _ = self.solve_shape(d, T, G)
+            self.K = K
+        old = None
+        for p in range(max_passes):
+            d, _ = self.solve_shape(d, T, G)
+            T, G, pull, contact = self.march(d, T)
+            if old is not None and abs(pull - old) < _TOL_PULL_3D * pull:
+                return PlanarBeamSolution(pull, self.sig, d, T, contact, p + 1)
+            old = pull
+        raise BeamConduitError(f"shape/tension passes did not converge in {max_passes} at EJ = {self.EJ:.4g} N m^2")

@@ -45,3 +45,31 @@ def test_invalid_input_names_the_field():
     with pytest.raises(ValueError, match="bending_stiffness_N_m2"):
         solve_planar_beam(ROUTE, C, MU, 0.0, 0.0, T, 0.01)
     assert issubclass(BeamConduitError, RuntimeError)
+
+
+def test_flexible_limit_in_3d_is_the_rope_with_clearance():
+    """With gravity on a horizontal bend the 3D chain at λ = h is the rope with clearance (an independent
+    solver: a string, its free spans lifting off the floor near the bend's ends): 2e-4 (h = 1 cm; 2e-5 at
+    5 mm), while the free spans themselves move the pull by ~1 % from the capstan with μ w L."""
+    from exucable.geometry import Bend, Straight, centreline_from_path
+    from exucable.rope_clearance import solve_rope_with_clearance
+    from exucable.beam_conduit import route_pieces
+
+    w, h = 0.21 * 9.80665, 0.01
+    centre = centreline_from_path([0.0, 0.0, 0.0], (1.0, 0.0, 0.0), [Straight(1.0), Bend(90.0, R), Straight(1.0)])
+    pieces = route_pieces(centre)
+    assert pieces == [(1.0, 0.0), pytest.approx((R * math.pi / 2, 1.0 / R)), (1.0, 0.0)]
+    rope = solve_rope_with_clearance(centre, C, MU, w, T, node_spacing_m=0.005).pull_force_N
+    beam = solve_planar_beam(pieces, C, MU, w, T * h * h, T, h, three_d=True).pull_force_N
+    assert beam == pytest.approx(rope, rel=2e-4)
+
+
+def test_span_pressing_the_opposite_wall_costs_friction():
+    """λ/R = 0.4 (EJ 4 N m², lift-off 1.37 × 2c): stiff_bend's single-contact elastica is invalid; the
+    cable touches the exit straight's outer wall (three-point bending) and the pull lies well above
+    that model's −3.5 % (the opposite wall's friction), still below the capstan."""
+    got = stiff_route_difference([(1.0, 0.0), (R * math.pi / 2, 1.0 / R), (1.0, 0.0)], C, MU, 0.0, 4.0, T)
+    assert got["windows"][0]["max_outer_offset_over_c"] == pytest.approx(1.0, abs=1e-3)
+    single = stiff_bend(T, MU, math.pi / 2, R - C, 4.0)
+    assert not single.fits(C)
+    assert single.vs_rope + 0.01 < got["difference"] < 0.0
