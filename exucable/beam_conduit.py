@@ -230,9 +230,11 @@ class _Chain:
                 if self.energy(trial, T, G) <= E0 + 1e-4 * lam * slope + 1e-12 * abs(E0) or lam < 1e-9:
                     break
                 lam *= 0.5
-            if np.max(np.abs(trial - d)) < 1e-12 * self.c and nr < 1e-5 * self.Tref:
-                return trial, it   # stagnated at round-off
+            if (lam < 1e-9 or np.max(np.abs(trial - d)) < 1e-12 * self.c) and nr < _SHAPE_STALL_3D * self.Tref:
+                return d, it   # stalled on the penalty's kink, at a residual far below what matters
             d = trial
+        if nr < _SHAPE_STALL_3D * self.Tref:
+            return d, maxit
         raise BeamConduitError(f"shape Newton did not converge in {maxit} iterations at EJ = {self.EJ:.4g} N m^2 "
                                f"(lateral residual {nr:.3g} N)")
 
