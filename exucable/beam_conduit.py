@@ -1,33 +1,35 @@
-"""A stiff cable in the bend plane of its conduit, touching either wall: three-point bending
-(issue #10 items 6–7). numpy and scipy only; no Exudyn.
+"""A stiff cable in its conduit, touching either wall: three-point bending (issue #10 items 6–7).
+numpy and scipy only; no Exudyn.
 
 :mod:`exucable.stiff_bend` lands the free span of a stiff cable on the bend's inner wall and
 assumes the span's straight then fits in the conduit, i.e. its offset λ²/(2ρ) from the rope's line
 (λ = √(EJ/T)) stays within the 2c across it. Beyond that the span also presses the straight's
 opposite wall — the three-point bending of Iordanescu & Tamowski's PULLFLEX (IEEE Trans. Power
-Delivery 11(2), 1996) — with friction of its own. This module solves that case without assuming
-where the cable touches: an independent planar steady beam-in-conduit model, discretised
-differently from exucable's ANCF elements.
+Delivery 11(2), 1996) — with friction of its own; and with gravity the span's straight, pushed
+towards the outer wall, climbs the round conduit's floor, which pushes back. This module solves
+both without assuming where the cable touches: an independent steady beam-in-conduit model,
+discretised differently from exucable's ANCF elements.
 
 **Model.** Steady sliding seen in space (as :mod:`exucable.rope_clearance`): the cable's shape is
 fixed and its material runs through it. Nodes ``i`` sit at fixed centreline arc lengths σ_i (spacing
-h) of a planar route (straights and arcs of signed curvature κ₀), each at a lateral offset d_i
-along the centreline's left normal, x_i = C(σ_i) + d_i n_i. Segment j has tension T_j and unit
-direction t_j; node i turns the cable by φ_i, with bending energy EJ φ_i²/(2h) (a discrete
-elastica, curvature φ_i/h). The conduit acts on node i across the bend plane with
+h) of a horizontal route (straights and arcs of signed curvature κ₀). Segment j has tension T_j and
+unit direction t_j; bending costs EJ φ_i²/(2h) at node i (φ_i its turning angle; a discrete
+elastica of curvature φ_i/h). Two variants:
 
-- the walls at |d| = c: a stiff penalty (penetration ~1e-4 c here), unilateral;
-- gravity's trough, for a horizontal route in a round conduit: a cable at offset d has climbed
-  c − √(c² − d²) up the wall, so its weight w [N/m] pushes it back with w d/√(c² − d²) per length
-  (its potential), and presses the wall with √(f² + w²) per length where f is the lateral force;
-  on a bend this is the rope's √((T/ρ)² + w²) (exucable/rope.py), on a straight μ w;
-- Coulomb friction μ √(f² + w²) against the sliding direction (the bisector of t_{i−1} and t_i;
-  Eq. 19 of Yang et al. 2013 per unit length).
+- *3D* (default with gravity, ``three_d``): node i moves in its normal plane, offset d_i (along the
+  bend plane's normal n and up) inside the round conduit |d| ≤ c (a stiff penalty, smoothed over
+  1e-4 c so Newton does not chatter); its weight w h is a body force, so the cable rests on the
+  floor, climbs the wall where the bend pulls it, lifts off in free spans (the rope with
+  clearance's) and bridges the floor with its stiffness. Bending energy (EJ/h) Σ (1 − t_{i−1}·t_i).
+- *planar* (without gravity): node i moves along n only, walls at d = ±c; a weight, if given, acts
+  as the trough's potential w (c − √(c² − d²)) and presses the floor with √(f² + w²) (kept for
+  comparison: it overstates the gravity part, not bridging the floor).
 
-Two sub-problems alternate (as in :mod:`exucable.rope_clearance`) until the pulling force
-changes by < 1e-9: (1) the *shape*: with tensions and friction frozen, the offsets minimise
-Σ T_j ℓ_j + Σ EJ φ_i²/(2h) + wall and trough potentials − friction · x — damped Newton on the
-lateral balance, its banded Jacobian by finite differences in five colours, an energy line search;
+Coulomb friction μ |contact| acts against the sliding direction (the bisector of t_{i−1} and t_i;
+Eq. 19 of Yang et al. 2013). Two sub-problems alternate until the pulling force settles (as in
+:mod:`exucable.rope_clearance`): (1) the *shape*: with tensions and friction frozen, the offsets
+minimise Σ T_j ℓ_j + bending + wall and weight potentials − friction · x — damped Newton on the
+normal-plane balance, its banded Jacobian by finite differences in colours, an energy line search;
 (2) the *tensions*: march from the trailing end solving each node's balance along the sliding
 direction for the next segment's tension (bending and wall forces included).
 
@@ -35,15 +37,13 @@ The trailing end is free (back tension along the entry straight); the leading en
 too (a long exit straight) or pinned where exucable's steady rig holds it (its rope-with-clearance
 position, 10 bending lengths past the last bend: :func:`exucable.model.layout.steady_lead_out_m`).
 Stiff cables are reached by continuation in EJ from λ ≈ h (where the rope's path, on the inner
-wall of each bend, is a good start).
+wall of each bend and the floor, is a good start).
 
-Limits (``tests/test_beam_conduit.py``): EJ → 0 gives the capstan on a bend without gravity;
-small λ/ρ with the span inside the conduit gives :func:`exucable.stiff_bend.stiff_bend`. What it
-leaves out: the third dimension (the cable's climb up the wall is only the trough's potential;
-no vertical bending; no free spans across the clearance under gravity, which the rope with
-clearance has — so its EJ → 0 limit is not the rope with clearance on a horizontal bend with
-gravity, and only its *ratio* to that limit is used as the prediction of exucable − rope with
-clearance), torsion, and the cable's extension.
+Limits (``tests/test_beam_conduit.py``): λ = h gives the capstan on a bend without gravity (1e-4)
+and, in 3D with gravity, the rope with clearance (:mod:`exucable.rope_clearance`, 2e-4); small λ/ρ
+with the span inside the conduit gives :func:`exucable.stiff_bend.stiff_bend` (within 10 % of its
+−0.24 %). What it leaves out: torsion, the cable's extension, and dynamics; the prediction used is
+the *ratio* of the stiff cable's pull to the model's own λ = h limit.
 """
 
 from __future__ import annotations

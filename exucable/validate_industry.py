@@ -154,7 +154,7 @@ class IndustryRow:
     liftoff_over_2c: float       # max over bends of λ²/(2R) / 2c, λ = √(EJ/T_out)
     stiff_estimate: float = float("nan")   # exucable/stiff_bend.py along the route, vs the rope
     stiff_estimate_fits: bool = False      # every bend within that model's validity (offset ≤ 2c)
-    beam_estimate: float = float("nan")    # exucable/beam_conduit.py (both walls, weight's trough), vs its EJ → 0
+    beam_estimate: float = float("nan")    # exucable/beam_conduit.py (3D chain, both walls), vs its EJ → 0
     run_rope_N: float | None = None            # both references for the run's extent of cable (a dynamic
     run_rope_clearance_N: float | None = None  # run's window has pulled some out; steady: = the route's)
     values_N: list = field(default_factory=list)        # exucable per mesh level (default first)
@@ -255,8 +255,8 @@ class IndustryRow:
                          f"{self.flexibility:.3g} ({regime}); the stiff-bend model (exucable/stiff_bend.py, bend "
                          f"by bend, no free spans) predicts {100 * self.stiff_estimate:+.2f} % vs the rope"
                          + ("" if self.stiff_estimate_fits else " but is outside its validity (offset > 2c)")
-                         + (f"; the planar beam-in-conduit model (exucable/beam_conduit.py: both walls, the weight's "
-                            f"trough) predicts {100 * self.beam_estimate:+.2f} % vs its flexible limit"
+                         + (f"; the beam-in-conduit model (exucable/beam_conduit.py: both walls, the weight, free "
+                            f"spans) predicts {100 * self.beam_estimate:+.2f} % vs its flexible limit"
                             if np.isfinite(self.beam_estimate) else ""))
         return "; ".join(parts)
 
@@ -325,8 +325,8 @@ def _stiff_estimate(scenario, plan_sections) -> tuple[float, bool]:
 
 def _beam_estimate(scenario) -> float:
     """Bending stiffness' change of the pulling force from :func:`exucable.beam_conduit.stiff_route_difference`
-    (the stiff cable may press both walls: PULLFLEX's three-point bending; the weight's friction and
-    trough on the floor), relative to that model's EJ → 0 limit; NaN for a route it does not model
+    (the stiff cable may press both walls: PULLFLEX's three-point bending; its weight on the round
+    conduit's floor, free spans), relative to that model's EJ → 0 limit; NaN for a route it does not model
     (a bend out of the horizontal plane, no weight or no clearance)."""
     from .beam_conduit import BeamConduitError, route_pieces, stiff_route_difference
     conduit = scenario.build_conduit()
