@@ -302,7 +302,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
     scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
                   model.back_tension_N, 1.0)
     tolerance_N = float(tolerance) * scale_N
-    settings = static_settings(absolute_tolerance_N=EXACT_NEWTON_SHARE * tolerance_N)
+    settings = static_settings(tolerance=NEWTON_TOLERANCE, absolute_tolerance_N=EXACT_NEWTON_SHARE * tolerance_N)
     inexact = static_settings(tolerance=INEXACT_NEWTON_TOLERANCE, absolute_tolerance_N=1e-3 * tolerance_N)
     c0 = initial_spring_rate(model)
     t_wall = time.perf_counter()
