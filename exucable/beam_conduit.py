@@ -130,6 +130,9 @@ class PlanarBeamSolution:
 
 
 class _Chain:
+    space_dim = 2          # node positions' dimension (the frozen friction forces' shape)
+    pull_tol = _TOL_PULL
+
     def __init__(self, pieces, clearance_m, friction, weight_N_per_m, bending_stiffness_N_m2, back_tension_N,
                  spacing_m, head_offset_m=None, trough_weight_N_per_m=None, tension_scale_N=None):
         self.sig, self.C, self.e, self.n, self.kap = _centreline(pieces, spacing_m)
@@ -256,7 +259,7 @@ class _Chain:
 
     def solve(self, d, soften=False, max_passes=200):
         T = np.full(self.N - 1, self.Tb)
-        G = np.zeros((self.N, 2))
+        G = np.zeros((self.N, self.space_dim))
         if soften:       # from a rough start: a soft wall first
             K = self.K
             for f in (1e-3, 1e-2, 1e-1):
@@ -267,7 +270,7 @@ class _Chain:
         for p in range(max_passes):
             d, _ = self.solve_shape(d, T, G)
             T, G, pull, contact = self.march(d, T)
-            if old is not None and abs(pull - old) < _TOL_PULL * pull:
+            if old is not None and abs(pull - old) < self.pull_tol * pull:
                 return PlanarBeamSolution(pull, self.sig, d, T, contact, p + 1)
             old = pull
         raise BeamConduitError(f"shape/tension passes did not converge in {max_passes} at EJ = {self.EJ:.4g} N m^2")
@@ -444,6 +447,9 @@ class _Chain3D(_Chain):
     the trough with its stiffness. Bending energy (EJ/h) Σ (1 − t_{i−1}·t_i) (= EJ φ²/(2h) at small φ).
     Offsets are (N, 2) arrays: along n and up."""
 
+    space_dim = 3
+    pull_tol = _TOL_PULL_3D
+
     def pos(self, d):
         x = np.zeros((self.N, 3))
         x[:, :2] = self.C + d[:, :1] * self.n
@@ -569,21 +575,3 @@ class _Chain3D(_Chain):
             prev_T, prev_t = new_T[i], t[i]
         friction_force[-1] = -self.mu * contact[-1] * t[-1]
         return new_T, friction_force, prev_T + self.mu * contact[-1], contact
-
-    def solve(self, d, soften=False, max_passes=200):
-        T = np.full(self.N - 1, self.Tb)
-        G = np.zeros((self.N, 3))
-        if soften:
-            K = self.K
-            for f in (1e-3, 1e-2, 1e-1):
-                self.K = K * f
-                d, _ = self.solve_shape(d, T, G)
-            self.K = K
-        old = None
-        for p in range(max_passes):
-            d, _ = self.solve_shape(d, T, G)
-            T, G, pull, contact = self.march(d, T)
-            if old is not None and abs(pull - old) < _TOL_PULL_3D * pull:
-                return PlanarBeamSolution(pull, self.sig, d, T, contact, p + 1)
-            old = pull
-        raise BeamConduitError(f"shape/tension passes did not converge in {max_passes} at EJ = {self.EJ:.4g} N m^2")
