@@ -174,7 +174,7 @@ def _upper_bands(quad) -> np.ndarray:
 
 def solve_duct_beam(path, clearance_m: float, friction: float, weight_N_per_m: float, back_tension_N: float,
                     bending_stiffness_N_m2: float, node_spacing_m: float = 0.005, head_offset_m=None,
-                    rtol: float = 1e-10) -> DuctBeamSolution:
+                    rtol: float = 1e-9) -> DuctBeamSolution:
     """Steady pull of the linearised stiff cable through a planar route (module docstring).
 
     Parameters
