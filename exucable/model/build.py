@@ -399,15 +399,17 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
 
 
 def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
-                check_points_per_element: int | None = None) -> Model:
+                check_points_per_element: int | None = None, start: InitialLayout | None = None) -> Model:
     """Build and assemble the Exudyn system of ``scenario`` in a SystemContainer of its own.
 
     A thin wrapper of :func:`add_cable_in_conduit` with the scenario's rig and loads. The mesh is
     :func:`exucable.model.layout.plan_cable_mesh`'s: the rule of :mod:`exucable.mesh` or the
     scenario's override, with the element length divided by ``refine`` and the check points per
-    element overridden by ``check_points_per_element`` (``exucable converge``).
+    element overridden by ``check_points_per_element`` (``exucable converge``). ``start`` replaces
+    the start state (:func:`exucable.solve.steady_start`: the steady solve's state).
     """
-    start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)
+    if start is None:
+        start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
     h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start)
