@@ -10,7 +10,7 @@ per route: the dynamic status, when it became steady, the pulling force and its 
 and the wall times (the dynamic one includes its steady start). Scatter and agreement target:
 0.2 % (issue 10 item 3, issue 11). Read ``reference/README.md``, "Why the force wandered".
 
-Run: ``nice .venv/bin/python benchmarks/industry_dynamic.py [ROUTE ...] [--end-time 3] [--start steady|rope]``
+Run: ``nice .venv/bin/python benchmarks/industry_dynamic.py [ROUTE ...] [--end-time 3] [--start steady|rope] [--window S]``
 (default routes: commscope_conquest_500ft_bend90 commscope_conquest_run_a_h
 gera_wire_pulling_example machinecalcs_two_bends).
 """
@@ -35,6 +35,7 @@ def main() -> None:
     ap.add_argument("routes", nargs="*", default=ROUTES)
     ap.add_argument("--end-time", type=float, default=3.0, help="solver.end_time [s]")
     ap.add_argument("--start", choices=("steady", "rope"), default="steady", help="solver.start")
+    ap.add_argument("--window", type=float, default=None, help="solver.steady_window [s] (default: the scenario's)")
     args = ap.parse_args()
     print("| route | dynamic | steady from [s] | pulling force [N] | scatter [%] | steady - dynamic [%] "
           "| wall dynamic / steady [s] |")
@@ -43,6 +44,8 @@ def main() -> None:
         for name in args.routes:
             sc = load_scenario(HERE / f"{name}.toml").replace(**{
                 "solver.end_time": args.end_time, "solver.steady_stop": True, "solver.start": args.start})
+            if args.window is not None:
+                sc = sc.replace(**{"solver.steady_window": args.window})
             t0 = time.perf_counter()
             dyn = run_scenario(sc, Path(tmp) / f"{name}_dyn", quiet=True, plots=False).summary
             wall_dyn = time.perf_counter() - t0
