@@ -1,7 +1,7 @@
 """The industry routes in dynamic mode: how steady the pulling force gets, and against steady mode.
 
 For each route in ``scenarios/industry/`` named on the command line: the dynamic run with
-``solver.end_time`` (default 3 s), ``solver.steady_stop`` and ``solver.start`` (default
+``solver.end_time`` (default 3 s), ``solver.steady_stop`` and ``solver.start_from`` (default
 ``"steady"``; ``--start rope`` is the run before issue 10 item 3's fix), then steady mode laid out
 as far as the dynamic run had pulled (``solver.steady_lead_out`` = its
 ``reference_pulled_out_m``), so both modes are compared in the same state. Prints one table row
@@ -34,7 +34,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("routes", nargs="*", default=ROUTES)
     ap.add_argument("--end-time", type=float, default=3.0, help="solver.end_time [s]")
-    ap.add_argument("--start", choices=("steady", "rope"), default="steady", help="solver.start")
+    ap.add_argument("--start", choices=("steady", "rope"), default="steady", help="solver.start_from")
     ap.add_argument("--window", type=float, default=None, help="solver.steady_window [s] (default: the scenario's)")
     args = ap.parse_args()
     print("| route | dynamic | steady from [s] | pulling force [N] | scatter [%] | steady - dynamic [%] "
@@ -43,7 +43,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.routes:
             sc = load_scenario(HERE / f"{name}.toml").replace(**{
-                "solver.end_time": args.end_time, "solver.steady_stop": True, "solver.start": args.start})
+                "solver.end_time": args.end_time, "solver.steady_stop": True, "solver.start_from": args.start})
             if args.window is not None:
                 sc = sc.replace(**{"solver.steady_window": args.window})
             t0 = time.perf_counter()

@@ -570,9 +570,9 @@ class SolverSpec(_Spec):
     mode : {"dynamic", "steady"}
         ``"dynamic"``: integrate the paper's dynamics in time; ``"steady"``: solve the steady
         sliding state in one static solve (:mod:`exucable.solve_steady`).
-    start : {"rope", "steady"}
+    start_from : {"rope", "steady"}
         Dynamic mode: start from the rope's tension (``"rope"``) or from the steady solve's state
-        (``"steady"``, :func:`exucable.solve.steady_start`).
+        (``"steady"``, :func:`exucable.solve_start.steady_start`).
     steady_lead_out_m : float or None
         Steady mode: cable laid out past the conduit's exit at the start [m] (None: the rule of
         :func:`exucable.model.layout.steady_lead_out_m`, 10 bending lengths past the last bend).
@@ -595,7 +595,7 @@ class SolverSpec(_Spec):
     pretension: bool = _default("solver.pretension")
     mode: str = _default("solver.mode")
     steady_lead_out_m: float | None = _default("solver.steady_lead_out")
-    start: str = _default("solver.start")
+    start_from: str = _default("solver.start_from")
 
     def _check(self) -> None:
         if self.mode == "steady" and not self.pretension:

@@ -276,7 +276,7 @@ FIELDS: tuple[Field, ...] = (
            "needs `solver.pretension = true`; on a route ending in a bend the start is laid out past the exit so that "
            "the rig sits 10 bending lengths √(EJ/T) beyond the bend, and `reference_pulled_out_m` says how far); "
            "the `solver` time keys are then unused"),
-    F("solver.start", "start", "choice", "", "rope", choices=("rope", "steady"), ours=True,
+    F("solver.start_from", "start_from", "choice", "", "rope", choices=("rope", "steady"), ours=True,
       rule="dynamic mode, velocity-controlled pull: `\"rope\"` starts from the rope's tension on the rope-with-"
            "clearance path (`solver.pretension`); `\"steady\"` first solves the steady state (as `solver.mode = "
            "\"steady\"`, laid out by the same rule or `solver.steady_lead_out`) and starts the dynamic run in it, "
@@ -285,7 +285,7 @@ FIELDS: tuple[Field, ...] = (
            "solve fails"),
     F("solver.steady_lead_out", "steady_lead_out_m", "float", "m", None, ge=0.0, ours=True,
       default_doc="the rule in `solver.mode`",
-      rule="≥ 0; steady mode and `solver.start = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "
+      rule="≥ 0; steady mode and `solver.start_from = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "
            "reaches after pulling that far: `exucable validate` sets it to the dynamic run's "
            "`reference_pulled_out_m` to compare both modes in the same state)"),
     # ---- output

@@ -1,4 +1,4 @@
-"""solver.start = "steady": the dynamic run starts in the steady solve's state (issue 10 item 3).
+"""solver.start_from = "steady": the dynamic run starts in the steady solve's state (issue 10 item 3).
 
 A short Gera-like route (the wander's worst case: a stiff cable, EJ = 103 N m², in a 0.6 m bend at
 the exit, gravity): from the rope start the pulling force falls for the whole run as the rig pulls
@@ -21,7 +21,7 @@ def _scenario(start):
                        cable=xc.Cable(radius=0.01905, mass_per_length=2.2322, youngs_modulus=1e9),
                        contact=xc.Contact(friction=0.3), pull=xc.Pull(speed=0.3048, back_tension=500.0),
                        gravity=xc.Gravity(g=9.80665),
-                       solver=xc.Solver(end_time=0.4, step=1e-2, start=start))
+                       solver=xc.Solver(end_time=0.4, step=1e-2, start_from=start))
 
 
 def test_steady_start_is_steady_and_agrees_with_steady_mode():

@@ -406,7 +406,7 @@ def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
     :func:`exucable.model.layout.plan_cable_mesh`'s: the rule of :mod:`exucable.mesh` or the
     scenario's override, with the element length divided by ``refine`` and the check points per
     element overridden by ``check_points_per_element`` (``exucable converge``). ``start`` replaces
-    the start state (:func:`exucable.solve.steady_start`: the steady solve's state).
+    the start state (:func:`exucable.solve_start.steady_start`: the steady solve's state).
     """
     if start is None:
         start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)

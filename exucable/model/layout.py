@@ -492,7 +492,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
 
     rope = rope_for(L_cable)
     lead_out = 0.0
-    if sc.solver.pretension and (sc.solver.mode == "steady" or (sc.solver.start == "steady" and sc.pull.force_N is None)):
+    if sc.solver.pretension and (sc.solver.mode == "steady" or (sc.solver.start_from == "steady" and sc.pull.force_N is None)):
         lead_out = (steady_lead_out_m(centre, c.bending_stiffness_N_m2, rope.pull_force_N)
                     if sc.solver.steady_lead_out_m is None else float(sc.solver.steady_lead_out_m))
         if lead_out >= L_cable:
