@@ -557,6 +557,9 @@ class SolverSpec(_Spec):
         Duration of the start-up damper that settles the pre-tensioned start [s] (0: none).
     startup_damping_1_per_s : float
         Its initial rate c0 [1/s] (mass-proportional).
+    exit_span_damping_1_per_s : float
+        Rate [1/s] of the damper toward the steady flow on the cable past the conduit's exit
+        (:class:`exucable.model.startup.ExitSpanDamper`); 0: none.
     output_interval_s : float
         Interval between stored output states [s] (default max(step, end_time/1000)).
     steady_stop : bool
@@ -588,6 +591,7 @@ class SolverSpec(_Spec):
     newton_tolerance: float = _default("solver.newton_tolerance")
     startup_time_s: float = _default("solver.startup_time")
     startup_damping_1_per_s: float = _default("solver.startup_damping")
+    exit_span_damping_1_per_s: float = _default("solver.exit_span_damping")
     output_interval_s: float = _default("solver.output_interval")
     steady_stop: bool = _default("solver.steady_stop")
     steady_window_s: float = _default("solver.steady_window")

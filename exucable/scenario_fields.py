@@ -261,6 +261,11 @@ FIELDS: tuple[Field, ...] = (
            "start and fades out over this time; the steady state is looked for after it"),
     F("solver.startup_damping", "startup_damping_1_per_s", "float", "1/s", 200.0, ge=0.0, ours=True,
       rule="≥ 0: its initial rate"),
+    F("solver.exit_span_damping", "exit_span_damping_1_per_s", "float", "1/s", 0.0, ge=0.0, ours=True,
+      rule="≥ 0: velocity-controlled dynamic runs: a mass-proportional damper toward the steady flow V·r'/|r'| on the "
+           "cable past the conduit's exit (the span hanging from the mouth to the rig, which nothing else damps; it "
+           "exerts no force on a steadily sliding cable); 0 switches it off. The industry scenarios use 10 "
+           "(reference/README.md, \"Why the force wandered\")"),
     F("solver.output_interval", "output_interval_s", "float", "s", None, gt=0.0, ours=True, derived=True,
       default_doc="max(step, end_time/1000)", rule="> 0"),
     F("solver.steady_stop", "steady_stop", "bool", "", False, ours=True,

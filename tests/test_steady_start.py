@@ -47,3 +47,28 @@ def test_rope_start_wanders_on_the_same_route():
     t, f = res.history.time_s, res.history.pull_force_N
     late = f[t >= 0.1]
     assert (late.max() - late.min()) / np.mean(late) > 1e-2
+
+
+def test_exit_span_damper_is_zero_on_the_steady_flow_and_damps_departures():
+    """solver.exit_span_damping: no force inside the conduit, none on a cable sliding along its own
+    path at the rig speed past the exit, -c·m·δv on a departure δv from that flow."""
+    from exucable.model.startup import ExitSpanDamper
+
+    # three nodes: one inside (behind the exit at x = 0), one half a ramp past it, one a full ramp past
+    pos = np.array([[-1.0, 0.0, 0.0], [0.25, 0.0, 0.0], [2.0, 0.0, -0.1]])
+    slope = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.995, 0.0, -0.0998]])
+    ref = np.hstack([pos, slope]).reshape(-1)
+    mass = np.array([0.5, 1.0, 2.0])
+    d = ExitSpanDamper(mass, ref, rate_1_per_s=10.0, speed_m_per_s=0.3, exit_point_m=[0, 0, 0],
+                       exit_tangent=[1, 0, 0], ramp_length_m=0.5)
+    q = np.zeros(18)
+    flow = np.zeros((3, 6))
+    flow[:, :3] = 0.3 * slope / np.linalg.norm(slope, axis=1)[:, None]
+    assert np.allclose(d.force(1.0, q, flow.reshape(-1)), 0.0)
+    moved = flow.copy()
+    moved[:, 2] += 0.01                                  # every node 1 cm/s upwards
+    f = d.force(1.0, q, moved.reshape(-1)).reshape(3, 6)
+    assert f[0, 2] == 0.0                                # inside: none
+    assert np.isclose(f[1, 2], -10.0 * 0.5 * 1.0 * 0.01)  # half-way up the ramp (smoothstep(1/2) = 1/2)
+    assert np.isclose(f[2, 2], -10.0 * 2.0 * 0.01)       # fully on
+    assert np.allclose(f[:, 3:], 0.0)                    # slopes are not damped
