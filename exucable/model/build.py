@@ -382,15 +382,13 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
                                surface=ct.surface, centreline=centre, **extra)
         h.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, h.kernel)
         sp = sc.solver
+        Le = layout.element_length_m
+        lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2  # [kg]
         if sp.pretension and sp.startup_time_s > 0.0 and not steady:
-            Le = layout.element_length_m
-            lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
             h.startup_damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
             add_startup_damper(mbs, cable.nodes, h.startup_damper)
         if sp.exit_span_damping_1_per_s > 0.0 and leading == "rig" and not steady:
             from .startup import ExitSpanDamper, add_exit_span_damper
-            Le = layout.element_length_m
-            lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
             h.exit_span_damper = ExitSpanDamper(lumped, layout.coordinates, sp.exit_span_damping_1_per_s, speed,
                                                 np.asarray(centre.point(centre.length_m), dtype=float).reshape(3),
                                                 t_exit, float(np.mean(Le)), ramp_time)
