@@ -6,7 +6,7 @@ with unilateral round walls, the weight, Coulomb friction; not Exudyn, not ANCF)
 (λ/10 and λ/20), beside nothing of exucable's own: reference/README.md sets these predictions beside the
 measured exucable − rope with clearance (`exucable validate --suite industry`, `bending_stiffness_study.py`).
 
-    nice .venv/bin/python benchmarks/beam_conduit_study.py                 # ~3 min on 2 loaded cores
+    nice .venv/bin/python benchmarks/beam_conduit_study.py                 # minutes per route on a loaded machine
     nice .venv/bin/python benchmarks/beam_conduit_study.py --ej-scale 0.1  # a cable 10x less stiff
     nice .venv/bin/python benchmarks/beam_conduit_study.py --only gera --levels 1
 
