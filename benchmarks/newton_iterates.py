@@ -16,19 +16,15 @@ Linear convergence shows as a penetration error shrinking by a constant factor p
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import exucable.model.coupling as coupling  # noqa: E402
 import exucable.solve as solve  # noqa: E402
-from exucable.model.build import build_model  # noqa: E402
-from exucable.scenario import load_scenario  # noqa: E402
+from contact_flips import record_force_calls  # noqa: E402
 
 
 def main(argv=None) -> int:
@@ -40,19 +36,7 @@ def main(argv=None) -> int:
     ap.add_argument("--no-hold", action="store_true", help="damping onset g(δ) of every iterate (solve.HOLD_ONSET)")
     args = ap.parse_args(argv)
     solve.HOLD_ONSET = not args.no_hold
-    sc = load_scenario(args.scenario)
-    sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, end_time_s=args.t_to, steady_stop=False))
-    calls = []
-    force = coupling.ContactCoupling._force
-
-    def recording_force(self, mbs, t, item, q, q_t):
-        if t >= args.t_from:
-            calls.append((t, np.array(q) + self.q_ref, np.array(q_t)))
-        return force(self, mbs, t, item, q, q_t)
-
-    coupling.ContactCoupling._force = recording_force
-    model = build_model(sc)
-    solve.simulate(model)
+    model, calls = record_force_calls(args.scenario, args.t_from, args.t_to)
     impl = model.coupling.kernel._impl
     n_k = impl.nh.shape[0]
     steps = {}

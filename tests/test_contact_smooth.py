@@ -171,10 +171,9 @@ def test_open_ends_do_not_hide_contact_behind_the_start_plane(backend):
 ONSET = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.2, damping_onset_m=5e-4)
 
 
-def test_damping_onset_jacobians_and_backends_agree():
-    """With a damping onset (f_n = K δ^e + C min(δ/δ_d, 1) δ̇; penetrations 3e-4 m inside the
-    5e-4 m ramp) both backends agree (1e-11) and the Jacobians match central differences (same
-    steps and 1e-6 bound as above)."""
+def onset_case():
+    """Two elements in a bend, 3e-4 m into the wall (inside ONSET's 5e-4 m ramp), sliding with
+    noise: (q, q_t, kernels by backend, the generator for more noise)."""
     cond = conduit("bend", segments_per_bend=10)
     rng = np.random.default_rng(7)
     s_nodes = np.linspace(0.35, 0.65, 3)
@@ -182,6 +181,14 @@ def test_damping_onset_jacobians_and_backends_agree():
     L = np.diff(s_nodes)
     ks = {b: ContactKernel(cond.segments, L, R_CABLE, ONSET, 6, backend=b, surface="smooth",
                            centreline=cond.centreline) for b in ("numpy", "numba")}
+    return q, q_t, ks, rng
+
+
+def test_damping_onset_jacobians_and_backends_agree():
+    """With a damping onset (f_n = K δ^e + C min(δ/δ_d, 1) δ̇; penetrations 3e-4 m inside the
+    5e-4 m ramp) both backends agree (1e-11) and the Jacobians match central differences (same
+    steps and 1e-6 bound as above)."""
+    q, q_t, ks, rng = onset_case()
     a, b = (ks[x].evaluate(q, q_t, jacobian=True) for x in ("numpy", "numba"))
     assert np.abs(a.generalized_force - b.generalized_force).max() <= 1e-11 * np.abs(a.generalized_force).max()
     assert np.abs(a.jac_q_blocks - b.jac_q_blocks).max() <= 1e-10 * np.abs(a.jac_q_blocks).max()
@@ -199,13 +206,7 @@ def test_held_damping_onset():
     same state the force is the same (1e-12); held at other values both backends agree and the
     Jacobians are those of f_n = K δ^e + C g δ̇ with g fixed (central differences, 1e-6), which
     differ from the live onset's by its ∂g/∂δ term."""
-    cond = conduit("bend", segments_per_bend=10)
-    rng = np.random.default_rng(7)
-    s_nodes = np.linspace(0.35, 0.65, 3)
-    q, q_t = cable_on_offset_curve(cond, s_nodes, towards_centre(cond), GAP + 3e-4, rng=rng, noise=0.02)
-    L = np.diff(s_nodes)
-    ks = {b: ContactKernel(cond.segments, L, R_CABLE, ONSET, 6, backend=b, surface="smooth",
-                           centreline=cond.centreline) for b in ("numpy", "numba")}
+    q, q_t, ks, rng = onset_case()
     for k in ks.values():
         live = k.evaluate(q, q_t, jacobian=True)
         assert live.penetration_m.shape == (2, 6) and np.all(live.penetration_m > 0.0)
