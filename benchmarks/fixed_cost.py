@@ -9,6 +9,7 @@ running a cached numba kernel pays), ``--repeat`` times each; medians of wall ti
 
     nice .venv/bin/python benchmarks/fixed_cost.py             # ~30 s
     nice .venv/bin/python benchmarks/fixed_cost.py --repeat 9
+    nice .venv/bin/python benchmarks/fixed_cost.py --before /path/to/main-tree   # before/after
 
 Target: ``exucable run --no-plots`` within 0.6 s of ``import exudyn``.
 """
@@ -42,12 +43,12 @@ def trivial_scenario(directory: Path) -> Path:
     return path
 
 
-def timed(cmd, out_dir: Path | None = None) -> float:
+def timed(cmd, out_dir: Path | None = None, env: dict | None = None) -> tuple[float, float]:
     """Whole-process wall time and CPU time [s] of ``cmd``. A run of 1 ms cannot be steady: ``exucable run``
     then exits 1 with status ``not_steady`` (the trust flags), which is accepted here, checked in
     ``out_dir/summary.json``; any other failure raises."""
     c0, t0 = os.times(), time.perf_counter()
-    out = subprocess.run(cmd, capture_output=True, text=True)
+    out = subprocess.run(cmd, capture_output=True, text=True, env=env)
     dt, c1 = time.perf_counter() - t0, os.times()
     if out.returncode != 0:
         summary = out_dir / "summary.json" if out_dir is not None else None
@@ -71,6 +72,9 @@ def top_imports(cmd, n=8):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--before", type=Path, default=None,
+                    help="another exucable source tree (e.g. `git archive main` unpacked) to run interleaved "
+                         "with this one, through PYTHONPATH; warm its numba cache first")
     args = ap.parse_args(argv)
     exe = Path(sys.executable).with_name("exucable")
     with tempfile.TemporaryDirectory() as tmp:
@@ -85,12 +89,19 @@ def main(argv=None) -> int:
             "exucable run (figures)": [str(exe), "run", str(sc), "-o", str(tmp / "b"), "-q"],
         }
         outs = {"exucable run --no-plots": tmp / "a", "exucable run (figures)": tmp / "b"}
+        envs = {}
+        if args.before is not None:
+            before = f"exucable run --no-plots ({args.before.name})"
+            cases[before] = [str(exe), "run", str(sc), "-o", str(tmp / "c"), "-q", "--no-plots"]
+            outs[before] = tmp / "c"
+            envs[before] = dict(os.environ, PYTHONPATH=str(args.before.resolve()))
+            timed(cases[before], outs[before], envs[before])
         timed(cases["exucable run --no-plots"], outs["exucable run --no-plots"])  # warm the disk and kernel caches
         times = {k: [] for k in cases}
         load0 = os.getloadavg()[0]
         for _ in range(args.repeat):
             for k, cmd in cases.items():
-                times[k].append(timed(cmd, outs.get(k)))
+                times[k].append(timed(cmd, outs.get(k), envs.get(k)))
         med = {k: statistics.median(w for w, _ in v) for k, v in times.items()}
         cpu = {k: statistics.median(c for _, c in v) for k, v in times.items()}
         floor, cpu_floor = med["python -c 'import exudyn'"], cpu["python -c 'import exudyn'"]
