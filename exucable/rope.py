@@ -134,7 +134,7 @@ class RopeSolution:
     max_sidewall_pressure_N_per_m: float
     direction: str = "forward"
     slack: bool = False
-    # (s_lo, s_hi, T(s)) in cable coordinates; T from solve_ivp's dense output or a constant 0 (slack).
+    # (s_lo, s_hi, T(s)) in cable coordinates; T from a closed form, solve_ivp's dense output or a constant 0 (slack).
     _branches: tuple = field(default=(), repr=False)
 
     @property
