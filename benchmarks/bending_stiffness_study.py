@@ -143,20 +143,42 @@ def print_row(r: dict) -> None:
           f"{1e3 * r['entry_edge_m']:.0f} ({1e3 * r['model_entry_edge_m']:.0f}) | {r['wall_s']:.0f} |", flush=True)
 
 
-def readme_table(rows) -> str:
-    """One line per case: both meshes' values side by side (reference/README.md)."""
-    out = ["| case | gravity | c [mm] | EJ [N m²] | λ_in/R | lift-off/2c | meshes | exucable − rope with clearance | "
-           "estimate | entry P [N] (model) | exit P [N] (model) | entry place [mm into the bend] (model) |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+def by_case(rows) -> list[list[dict]]:
+    """The rows grouped per case (case, gravity, clearance, EJ) in the sweep's order, each group by mesh
+    (the study's mesh first, then the refined one)."""
     keys = []
     for r in rows:
         k = (r["case"], r["gravity"], r["clearance_m"], r["EJ_N_m2"])
         if k not in keys:
             keys.append(k)
-    for k in keys:
-        rs = sorted((r for r in rows if (r["case"], r["gravity"], r["clearance_m"], r["EJ_N_m2"]) == k),
-                    key=lambda r: r["refine"])
+    return [sorted((r for r in rows if (r["case"], r["gravity"], r["clearance_m"], r["EJ_N_m2"]) == k),
+                   key=lambda r: r["refine"]) for k in keys]
+
+
+def mesh_table(rows) -> str:
+    """Issue 10's mesh check of every case: the study's mesh against the refined one (pulling force of
+    each, their difference, bound 0.2 %) and the wall time of each solve."""
+    out = ["| case | gravity | c [mm] | EJ [N m²] | meshes (elements × check points) | pulling force per mesh [N] | "
+           "study mesh vs refined | wall per mesh [s] |", "|---|---|---|---|---|---|---|---|"]
+    for rs in by_case(rows):
+        r0, r1 = rs[0], rs[-1]
+        meshes = " / ".join(f"{r['elements']}×{r['check_points_per_element']}" for r in rs)
+        forces = " / ".join(f"{r['pull_force_N']:.3f}" for r in rs)
+        walls = " / ".join(f"{r['wall_s']:.1f}" for r in rs)
+        diff = "–" if len(rs) < 2 else f"{100 * (r0['pull_force_N'] / r1['pull_force_N'] - 1):+.4f} %"
+        out.append(f"| {r0['case']} | {'yes' if r0['gravity'] else 'no'} | {r0['clearance_m'] * 1e3:g} | "
+                   f"{r0['EJ_N_m2']:g} | {meshes} | {forces} | {diff} | {walls} |")
+    return "\n".join(out)
+
+
+def readme_table(rows) -> str:
+    """One line per case: both meshes' values side by side (reference/README.md)."""
+    out = ["| case | gravity | c [mm] | EJ [N m²] | λ_in/R | lift-off/2c | meshes | exucable − rope with clearance | "
+           "estimate | entry P [N] (model) | exit P [N] (model) | entry place [mm into the bend] (model) |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for rs in by_case(rows):
         r0 = rs[0]
+        k = (r0["case"], r0["gravity"], r0["clearance_m"], r0["EJ_N_m2"])
         both = lambda f: " / ".join(f(r) for r in rs)  # noqa: E731
         est = f"{r0['model_pct']:+.3f} %" + ("" if r0["model_fits"] else " (invalid: lift-off > 2c)")
         out.append(f"| {k[0]} | {'yes' if k[1] else 'no'} | {k[2] * 1e3:g} | {k[3]:g} | {r0['lambda_in_over_R']:.3g} | "
@@ -222,12 +244,14 @@ def main(argv=None) -> int:
     p.add_argument("--json", help="write the rows to this JSON file (rewritten after each row)")
     p.add_argument("--from-json", help="print (and plot) the rows of this JSON file instead of running")
     p.add_argument("--figure", help="plot the rows to this PNG")
+    p.add_argument("--mesh-report", action="store_true",
+                   help="with --from-json: the mesh check of every case (pulling force and wall time per mesh)")
     a = p.parse_args(argv)
     if a.mass is not None and a.case:
         CASES[a.case]["mass_kg_per_m"] = a.mass
     if a.from_json:
         rows = json.loads(Path(a.from_json).read_text())
-        print(readme_table(rows))
+        print(mesh_table(rows) if a.mesh_report else readme_table(rows))
     else:
         if a.case:
             c = a.clearance if a.clearance is not None else next(x[2] for x in SWEEP if x[0] == a.case)

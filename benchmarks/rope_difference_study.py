@@ -239,7 +239,13 @@ def main(argv=None) -> int:
                    "(exucable converge's extrapolation); write the rows to this JSON file")
     p.add_argument("--clearance-limit", action="store_true",
                    help="only the rope with clearance against the centreline rope as c → 0 (seconds)")
+    p.add_argument("--mesh-report", help="reprint the mesh check written by --mesh-check to this JSON file")
     a = p.parse_args(argv)
+    if a.mesh_report:
+        print(MESH_HEADER)
+        for row in json.loads(Path(a.mesh_report).read_text()):
+            print(mesh_row_text(row))
+        return 0
     limit = clearance_limit()
     print("| case (gravity) | c [m] | c/R | rope with clearance vs rope | free-span estimate |\n|---|---|---|---|---|")
     for r in limit:
@@ -274,6 +280,23 @@ def main(argv=None) -> int:
     return 0
 
 
+MESH_HEADER = ("| case | gravity | c [mm] | EJ [N m²] | elements × check points | pulling force per level [N] | "
+               "extrapolated [N] | study mesh vs extrapolated | observed order | wall per level [s] |\n"
+               "|---|---|---|---|---|---|---|---|---|---|")
+
+
+def mesh_row_text(row: dict) -> str:
+    """One case of the mesh check as a table row (wall times to 0.1 s: most solves take about a second)."""
+    ext = "n/a" if row["extrapolated_N"] is None else f"{row['extrapolated_N']:.3f} ± {row['error_N']:.2g}"
+    dv = row["default_vs_extrapolated"]
+    dv = f"{100 * dv:+.3f} %" if dv is not None else f"{100 * row['default_vs_finest']:+.3f} % (vs finest)"
+    # no order where the three values are not monotone (the finest is then the estimate)
+    order = "–" if row["order"] is None or math.isnan(row["order"]) else f"{row['order']:.2g}"
+    return (f"| {row['case']} | {'yes' if row['gravity'] else 'no'} | {row['clearance_m'] * 1e3:g} | {row['EJ_N_m2']:g} | "
+            f"{' / '.join(row['meshes'])} | {' / '.join(f'{v:.3f}' for v in row['values_N'])} | {ext} | {dv} | {order} | "
+            f"{' / '.join(f'{w:.1f}' for w in row['wall_s'])} |")
+
+
 def mesh_check(path: str, element_length_m: float, check_spacing_m: float) -> list[dict]:
     """The study's mesh against two refinements (halving the element length and the check-point
     spacing), each case solved in steady mode (no start-up, no scatter: the mesh alone)."""
@@ -282,9 +305,7 @@ def mesh_check(path: str, element_length_m: float, check_spacing_m: float) -> li
     from exucable.commands.converge import converge
     from exucable.scenario import parse_scenario
 
-    print("| case | gravity | c [mm] | EJ [N m²] | elements × check points | pulling force per level [N] | "
-          "extrapolated [N] | study mesh vs extrapolated | observed order | wall per level [s] |\n"
-          "|---|---|---|---|---|---|---|---|---|---|", flush=True)
+    print(MESH_HEADER, flush=True)
     rows = []
     for case, grav, c, ej in SWEEP:
         data = scenario_dict(case, c, ej, grav, element_length_m, check_spacing_m, 1.0)
@@ -300,13 +321,7 @@ def mesh_check(path: str, element_length_m: float, check_spacing_m: float) -> li
                "default_vs_extrapolated": rep.get("default_vs_extrapolated"),
                "default_vs_finest": lv[0]["value_N"] / lv[-1]["value_N"] - 1.0}
         rows.append(row)
-        ext = "n/a" if row["extrapolated_N"] is None else f"{row['extrapolated_N']:.3f} ± {row['error_N']:.2g}"
-        dv = row["default_vs_extrapolated"]
-        dv = f"{100 * dv:+.3f} %" if dv is not None else f"{100 * row['default_vs_finest']:+.3f} % (vs finest)"
-        order = "n/a" if row["order"] is None else f"{row['order']:.2g}"
-        print(f"| {case} | {'yes' if grav else 'no'} | {c * 1e3:g} | {ej:g} | {' / '.join(row['meshes'])} | "
-              f"{' / '.join(f'{v:.3f}' for v in row['values_N'])} | {ext} | {dv} | {order} | "
-              f"{' / '.join(f'{w:.0f}' for w in row['wall_s'])} |", flush=True)
+        print(mesh_row_text(row), flush=True)
         tmp_json = Path(path + ".tmp")
         tmp_json.write_text(json.dumps(rows, indent=1))
         tmp_json.replace(path)

@@ -183,6 +183,43 @@ def test_one_iteration_steps_reach_the_exact_step_answer(monkeypatch):
     assert abs(F_one / F_tight - 1) < 1e-8
 
 
+def test_exact_steps_stop_above_the_round_off_floor(monkeypatch):
+    """What stalled the fine industry meshes (Gera 2032, MachineCalcs 4064 elements): the residual has a
+    round-off floor that grows with the mesh (2e-5 N at Gera's 2032 elements), the exact pseudo-time
+    steps' Newton tolerance was below it (1e-3 × the stop tolerance, and 1e-8 of the initial residual),
+    every exact step failed and the solve was reported as "continuation stalled at load scale 0".
+
+    Reproduced on Example 2 (coarse, 20 elements, floor measured 1.8e-10 N): the relative Newton
+    tolerance made unreachable (1e-30) and the stop tolerance tightened to 5e-10 × 205 N = 1.0e-7 N.
+    With the former share (1e-3: Newton to 1e-10 N, below the floor) the solve stalls and says where,
+    why and which keys to change; with EXACT_NEWTON_SHARE (1e-8 N) it converges to the default solve's
+    pulling force (within 1e-6). (The exact-step continuation: the one-iteration steps tried before
+    it are switched off.)"""
+    from dataclasses import replace
+
+    import exucable.solve_steady as ss
+    from exucable.model.build import build_model
+
+    sc = fast("paper_ex2_bend90")
+    sc = replace(sc, solver=replace(sc.solver, mode="steady"))
+    monkeypatch.setattr(ss, "MAX_ONE_ITERATION_STEPS", 0)
+    default = ss.solve_steady(build_model(sc))
+    assert default.status == "ok", default.message
+    monkeypatch.setattr(ss, "NEWTON_TOLERANCE", 1e-30)
+    monkeypatch.setattr(ss, "MIN_CONTINUATION_STEP", 0.5)   # one continuation stage is enough to show it
+    tight = 5e-10
+    out = ss.solve_steady(build_model(sc), tolerance=tight)
+    assert out.status == "ok", out.message
+    assert out.history.pull_force_N[-1] == pytest.approx(default.history.pull_force_N[-1], rel=1e-6)
+
+    monkeypatch.setattr(ss, "EXACT_NEWTON_SHARE", 1e-3)
+    stalled = ss.solve_steady(build_model(sc), tolerance=tight)
+    assert stalled.status == "failed"
+    for part in ("continuation stalled at load scale", "round-off floor", "Newton residual stayed at",
+                 "`cable.element_length`", '`solver.mode = "dynamic"`'):
+        assert part in stalled.message, (part, stalled.message)
+
+
 def test_steady_mode_refuses_a_start_without_pretension():
     with pytest.raises(ExucableError, match="solver.pretension"):
         make_scenario(solver={"end_time": 0.2, "step": 0.01, "mode": "steady", "pretension": False})
