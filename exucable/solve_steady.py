@@ -38,8 +38,8 @@ there, so no step need be solved exactly to know how far the state is from equil
 whose residual grows more than ``REJECT_GROWTH``-fold is undone and retried with c × 4; an accepted
 step divides c by ``RATE_FALL`` (by ``RATE_FALL_AFTER_REJECT`` right after a rejection), so the
 steps become plain Newton steps near the solution. The solve stops once that residual is below the
-tolerance: Example 4 in 17 Newton iterations instead of 36, and its pulling force 20× closer to
-the one at 1/1000 of the stop tolerance. Where it does not converge within its budget, the
+tolerance: Example 4 in 17 Newton iterations instead of 36, its pulling force 1e-9 (not 7e-7) from
+the one at 1/1000 of the stop tolerance (reference/README.md, "Speed"). Where it does not converge within its budget, the
 exact-step continuation above runs from the start.
 Where that does not converge either, the loads themselves are ramped (friction, gravity and end forces
 scaled by λ) with the increment halved on failure.
@@ -316,7 +316,9 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
     solution's largest tension (default :data:`STATIC_TOLERANCE`; a tighter one shows how
     converged the pulling force is, ``benchmarks/steady_scale.py --tolerance-check``).
 
-    Pseudo-transient continuation from the pre-tensioned start at the full loads; if that fails,
+    Pseudo-transient continuation from the pre-tensioned start at the full loads, first with one
+    Newton iteration per pseudo-time step steered by the true residual, then (if that does not
+    converge) with the inexact/exact steps; if that fails too,
     continuation in the load scale λ (friction, gravity, end forces) from the start, each stage
     solved the same way, the increment doubled after a success and halved after a failure. The
     history has one row per converged pseudo-time step; its ``time_s`` column holds the step's
