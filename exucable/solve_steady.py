@@ -366,6 +366,14 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
         counters["jacobian"] += int(solver.it.newtonJacobiCount)
         return ok, message, float(solver.conv.residual)
 
+    def step(c: float, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
+        """One pseudo-time step at spring rate ``c`` [1/s²] from the stored state (see one_solve)."""
+        store.restore_as_initial()
+        spring.anchor_at(_cable_part(model, store.saved[0]))
+        spring.rate = c
+        counters["steps"] += 1
+        return one_solve(exact)
+
     def record(lam: float, residual: float) -> None:
         """One history row (and the progress bar) for an accepted pseudo-time step."""
         total[0] += 1
@@ -401,11 +409,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
                 return False, (f"one-iteration pseudo-time steps: the residual did not halve in "
                                f"{MAX_ONE_ITERATION_STALL} steps (smallest {best:.3g} N)")
             stalled += 1
-            store.restore_as_initial()
-            spring.anchor_at(_cable_part(model, store.saved[0]))
-            spring.rate = c
-            ok, message, _ = one_solve(one_iteration)
-            counters["steps"] += 1
+            ok, message, _ = step(c, one_iteration)
             residual = true_residual() if ok else np.inf
             if residual > REJECT_GROWTH * previous or not ok:
                 c *= 4.0
@@ -442,11 +446,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
                                f"{MAX_PSEUDO_STEPS} pseudo-time steps (smallest {best:.3g} N, stop at "
                                f"{tolerance_N:.3g} N)")
             stalled += 1
-            store.restore_as_initial()
-            spring.anchor_at(_cable_part(model, store.saved[0]))
-            spring.rate = c
-            ok, message, leftover = one_solve(exact)
-            counters["steps"] += 1
+            ok, message, leftover = step(c, exact)
             if not ok:
                 stuck.record(exact, leftover)
                 c *= 4.0
