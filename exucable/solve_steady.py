@@ -366,7 +366,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
         counters["jacobian"] += int(solver.it.newtonJacobiCount)
         return ok, message, float(solver.conv.residual)
 
-    def step(c: float, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
+    def pseudo_step(c: float, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
         """One pseudo-time step at spring rate ``c`` [1/s²] from the stored state (see one_solve)."""
         store.restore_as_initial()
         spring.anchor_at(_cable_part(model, store.saved[0]))
@@ -409,7 +409,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
                 return False, (f"one-iteration pseudo-time steps: the residual did not halve in "
                                f"{MAX_ONE_ITERATION_STALL} steps (smallest {best:.3g} N)")
             stalled += 1
-            ok, message, _ = step(c, one_iteration)
+            ok, message, _ = pseudo_step(c, one_iteration)
             residual = true_residual() if ok else np.inf
             if residual > REJECT_GROWTH * previous or not ok:
                 c *= 4.0
@@ -446,7 +446,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
                                f"{MAX_PSEUDO_STEPS} pseudo-time steps (smallest {best:.3g} N, stop at "
                                f"{tolerance_N:.3g} N)")
             stalled += 1
-            ok, message, leftover = step(c, exact)
+            ok, message, leftover = pseudo_step(c, exact)
             if not ok:
                 stuck.record(exact, leftover)
                 c *= 4.0
