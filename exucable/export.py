@@ -140,6 +140,11 @@ def problem_description(model) -> dict:
             "law": "-c(t) m_k (v_k - v_k,initial) on node positions, m_k = lumped mass, "
                    "c(t) = rate (1 - smoothstep(t / duration))",
         },
+        "exit_span_damper": None if getattr(model, "exit_span_damper", None) is None else {
+            "rate_1_per_s": model.exit_span_damper.rate, "ramp_length_m": model.exit_span_damper.ramp_length,
+            "law": "-rate w_k m_k (v_k - V r'_k/|r'_k|) on node positions, m_k = lumped mass, V = rig speed, "
+                   "w_k = smoothstep(((r_k - exit point) . exit_tangent) / ramp_length_m), clipped to [0, 1]",
+        },
         "solver": {
             "method": "Exudyn MainSolverImplicitSecondOrder (generalized-alpha), adaptive step, full Newton",
             "end_time_s": sp.end_time_s,

@@ -157,7 +157,12 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                                         "plan several cables per duct with `exucable plan`")
     _refuse_pulling_the_cable_out(sc)
     t_start = time.perf_counter()
-    model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element)
+    from .solve_start import steady_start
+    first = None
+    if sc.solver.start_from == "steady" and sc.solver.mode == "dynamic" and sc.pull.force_N is None and sc.solver.pretension:
+        first = steady_start(sc, refine=refine, check_points_per_element=check_points_per_element)
+    model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element,
+                        start=first.layout if first is not None else None)
     build_s = time.perf_counter() - t_start
     sp = sc.solver
     recorder = None
@@ -242,6 +247,14 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "scenario": sc.to_dict(),
         "versions": versions(),
     }
+    if first is not None:
+        summary["start"] = {"kind": "steady" if first.layout is not None else "rope",
+                            "steady_pull_force_N": first.pull_force_N if first.layout is not None else None,
+                            "lead_out_m": getattr(model.start, "lead_out_m", 0.0),
+                            "steady_solve_message": first.message, "steady_solve_wall_time_s": first.wall_time_s}
+        if first.layout is None:
+            summary["warnings"].append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
+                                       "started from the rope instead")
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
     summary["status"], summary["flags"] = _assess(model, out, st, h, summary["pull_force_N"])
@@ -304,7 +317,8 @@ def window_references(scenario, model, window_time_s) -> dict:
     if sc.pull.force_N is not None or len(window_time_s) == 0:
         return {}
     t_mean = float(np.mean(window_time_s))
-    return extent_references(sc, model, ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s))
+    lead_out = getattr(model.start, "lead_out_m", 0.0)   # a steady start's lead-out (solver.start_from)
+    return extent_references(sc, model, lead_out + ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s))
 
 
 def extent_references(scenario, model, pulled_out_m: float) -> dict:

@@ -557,6 +557,9 @@ class SolverSpec(_Spec):
         Duration of the start-up damper that settles the pre-tensioned start [s] (0: none).
     startup_damping_1_per_s : float
         Its initial rate c0 [1/s] (mass-proportional).
+    exit_span_damping_1_per_s : float
+        Rate [1/s] of the damper toward the steady flow on the cable past the conduit's exit
+        (:class:`exucable.model.startup.ExitSpanDamper`); 0: none.
     output_interval_s : float
         Interval between stored output states [s] (default max(step, end_time/1000)).
     steady_stop : bool
@@ -570,6 +573,9 @@ class SolverSpec(_Spec):
     mode : {"dynamic", "steady"}
         ``"dynamic"``: integrate the paper's dynamics in time; ``"steady"``: solve the steady
         sliding state in one static solve (:mod:`exucable.solve_steady`).
+    start_from : {"rope", "steady"}
+        Dynamic mode: start from the rope's tension (``"rope"``) or from the steady solve's state
+        (``"steady"``, :func:`exucable.solve_start.steady_start`).
     steady_lead_out_m : float or None
         Steady mode: cable laid out past the conduit's exit at the start [m] (None: the rule of
         :func:`exucable.model.layout.steady_lead_out_m`, 10 bending lengths past the last bend).
@@ -585,6 +591,7 @@ class SolverSpec(_Spec):
     newton_tolerance: float = _default("solver.newton_tolerance")
     startup_time_s: float = _default("solver.startup_time")
     startup_damping_1_per_s: float = _default("solver.startup_damping")
+    exit_span_damping_1_per_s: float = _default("solver.exit_span_damping")
     output_interval_s: float = _default("solver.output_interval")
     steady_stop: bool = _default("solver.steady_stop")
     steady_window_s: float = _default("solver.steady_window")
@@ -592,6 +599,7 @@ class SolverSpec(_Spec):
     pretension: bool = _default("solver.pretension")
     mode: str = _default("solver.mode")
     steady_lead_out_m: float | None = _default("solver.steady_lead_out")
+    start_from: str = _default("solver.start_from")
 
     def _check(self) -> None:
         if self.mode == "steady" and not self.pretension:

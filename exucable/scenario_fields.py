@@ -261,6 +261,11 @@ FIELDS: tuple[Field, ...] = (
            "start and fades out over this time; the steady state is looked for after it"),
     F("solver.startup_damping", "startup_damping_1_per_s", "float", "1/s", 200.0, ge=0.0, ours=True,
       rule="≥ 0: its initial rate"),
+    F("solver.exit_span_damping", "exit_span_damping_1_per_s", "float", "1/s", 0.0, ge=0.0, ours=True,
+      rule="≥ 0: velocity-controlled dynamic runs: a mass-proportional damper toward the steady flow V·r'/|r'| on the "
+           "cable past the conduit's exit (the span hanging from the mouth to the rig, which nothing else damps; it "
+           "exerts no force on a steadily sliding cable); 0 switches it off. The industry scenarios use 10 "
+           "(reference/README.md, \"Why the force wandered\")"),
     F("solver.output_interval", "output_interval_s", "float", "s", None, gt=0.0, ours=True, derived=True,
       default_doc="max(step, end_time/1000)", rule="> 0"),
     F("solver.steady_stop", "steady_stop", "bool", "", False, ours=True,
@@ -276,9 +281,16 @@ FIELDS: tuple[Field, ...] = (
            "needs `solver.pretension = true`; on a route ending in a bend the start is laid out past the exit so that "
            "the rig sits 10 bending lengths √(EJ/T) beyond the bend, and `reference_pulled_out_m` says how far); "
            "the `solver` time keys are then unused"),
+    F("solver.start_from", "start_from", "choice", "", "rope", choices=("rope", "steady"), ours=True,
+      rule="dynamic mode, velocity-controlled pull: `\"rope\"` starts from the rope's tension on the rope-with-"
+           "clearance path (`solver.pretension`); `\"steady\"` first solves the steady state (as `solver.mode = "
+           "\"steady\"`, laid out by the same rule or `solver.steady_lead_out`) and starts the dynamic run in it, "
+           "sliding: no start misfit to ring in the axial mode, no bending boundary layer at the rig to pull out of "
+           "(reference/README.md, \"Why the force wandered\"); falls back to `\"rope\"` with a warning if that "
+           "solve fails"),
     F("solver.steady_lead_out", "steady_lead_out_m", "float", "m", None, ge=0.0, ours=True,
       default_doc="the rule in `solver.mode`",
-      rule="≥ 0; steady mode only: cable laid out past the conduit's exit at the start (the state a dynamic pull "
+      rule="≥ 0; steady mode and `solver.start_from = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "
            "reaches after pulling that far: `exucable validate` sets it to the dynamic run's "
            "`reference_pulled_out_m` to compare both modes in the same state)"),
     # ---- output

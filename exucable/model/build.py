@@ -90,6 +90,8 @@ class CableInConduit:
     coupling, kernel
         The contact coupling (an ObjectGenericODE2 over the cable nodes) and its kernel.
     startup_damper : StartupDamper or None
+    exit_span_damper : ExitSpanDamper or None
+        The damper on the span past the exit (``solver.exit_span_damping``).
     guide : Guide or None
         The force-controlled pull's sheave.
     recorder : Recorder
@@ -116,6 +118,7 @@ class CableInConduit:
     coupling: ContactCoupling | None = None
     kernel: ContactKernel | None = None
     startup_damper: StartupDamper | None = None
+    exit_span_damper: object = None   # ExitSpanDamper (solver.exit_span_damping) or None
     guide: Guide | None = None
     recorder: Recorder | None = None
     # how fast the flexible reference's pulling force moves as the cable leaves its conduit [N/s]
@@ -379,11 +382,17 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
                                surface=ct.surface, centreline=centre, **extra)
         h.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, h.kernel)
         sp = sc.solver
+        Le = layout.element_length_m
+        lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2  # [kg]
         if sp.pretension and sp.startup_time_s > 0.0 and not steady:
-            Le = layout.element_length_m
-            lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
             h.startup_damper = StartupDamper(lumped, layout.velocities, sp.startup_damping_1_per_s, sp.startup_time_s)
             add_startup_damper(mbs, cable.nodes, h.startup_damper)
+        if sp.exit_span_damping_1_per_s > 0.0 and leading == "rig" and not steady:
+            from .startup import ExitSpanDamper, add_exit_span_damper
+            h.exit_span_damper = ExitSpanDamper(lumped, layout.coordinates, sp.exit_span_damping_1_per_s, speed,
+                                                np.asarray(centre.point(centre.length_m), dtype=float).reshape(3),
+                                                t_exit, float(np.mean(Le)), ramp_time)
+            add_exit_span_damper(mbs, cable.nodes, h.exit_span_damper)
         if leading == "force":
             # the sheave of a force-controlled pull: lateral stiffness of the contact law's order at
             # its working point (1e6 N/m), damped near-critically for the end node's mass
@@ -399,15 +408,17 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
 
 
 def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
-                check_points_per_element: int | None = None) -> Model:
+                check_points_per_element: int | None = None, start: InitialLayout | None = None) -> Model:
     """Build and assemble the Exudyn system of ``scenario`` in a SystemContainer of its own.
 
     A thin wrapper of :func:`add_cable_in_conduit` with the scenario's rig and loads. The mesh is
     :func:`exucable.model.layout.plan_cable_mesh`'s: the rule of :mod:`exucable.mesh` or the
     scenario's override, with the element length divided by ``refine`` and the check points per
-    element overridden by ``check_points_per_element`` (``exucable converge``).
+    element overridden by ``check_points_per_element`` (``exucable converge``). ``start`` replaces
+    the start state (:func:`exucable.solve_start.steady_start`: the steady solve's state).
     """
-    start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)
+    if start is None:
+        start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
     h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start)

@@ -24,7 +24,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["CableLayout", "InitialLayout", "initial_layout", "lay_cable", "steady_lead_out_m", "contact_offsets", "extended_point", "extended_tangent"]
+__all__ = ["CableLayout", "InitialLayout", "initial_layout", "lay_cable", "sliding_layout", "steady_lead_out_m", "contact_offsets", "extended_point", "extended_tangent"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -271,23 +271,28 @@ def lay_cable(
         if excess.max() < 1e-7 * max(1.0, want.max()) or clearance_m is None:
             break
         target = target - (excess / np.maximum(d, 1e-300))[:, None] * lat
-    pos = coef[0::2]
-    slope = coef[1::2]
-    # the fitted shape is fixed in space while the material slides along it at speed V:
-    # velocity V·r'/|r'|, slope rate d(r')/dt = V·r''/|r'| (r'' averaged over the node's elements)
+    del ss_in
+    return sliding_layout(np.diff(x_nodes), x_nodes, s_nodes, coef[0::2], coef[1::2], speed_m_per_s)
+
+
+def sliding_layout(element_length_m, node_x_m, node_s_m, position_m, slope, speed_m_per_s: float) -> CableLayout:
+    """A :class:`CableLayout` whose shape is fixed in space while the material slides along it at
+    speed V [m/s] (the steady pull's flow): velocity V·r'/|r'|, slope rate d(r')/dt = V·r''/|r'|
+    (r'' of the cubic Hermite shape, averaged over the elements meeting at a node)."""
+    Le = np.asarray(element_length_m, dtype=float)
+    pos, slope = np.asarray(position_m, dtype=float), np.asarray(slope, dtype=float)
+    coef = np.empty((2 * len(pos), 3))
+    coef[0::2], coef[1::2] = pos, slope
     r2 = _second_derivative_at_nodes(coef, Le)
     mag = np.linalg.norm(slope, axis=1)[:, None]
-    vel = speed_m_per_s * slope / mag
-    srate = speed_m_per_s * r2 / mag
-    del ss_in
     return CableLayout(
-        element_length_m=np.diff(x_nodes),
-        node_x_m=x_nodes,
-        node_s_m=s_nodes,
+        element_length_m=Le,
+        node_x_m=np.asarray(node_x_m, dtype=float),
+        node_s_m=np.asarray(node_s_m, dtype=float),
         position_m=pos,
         slope=slope,
-        velocity_m_per_s=vel,
-        slope_rate_1_per_s=srate,
+        velocity_m_per_s=speed_m_per_s * slope / mag,
+        slope_rate_1_per_s=speed_m_per_s * r2 / mag,
     )
 
 
@@ -487,7 +492,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
 
     rope = rope_for(L_cable)
     lead_out = 0.0
-    if sc.solver.mode == "steady" and sc.solver.pretension:
+    if sc.solver.pretension and (sc.solver.mode == "steady" or (sc.solver.start_from == "steady" and sc.pull.force_N is None)):
         lead_out = (steady_lead_out_m(centre, c.bending_stiffness_N_m2, rope.pull_force_N)
                     if sc.solver.steady_lead_out_m is None else float(sc.solver.steady_lead_out_m))
         if lead_out >= L_cable:

@@ -11,7 +11,7 @@ import exudyn as exu
 
 from .generic import add_user_force_object
 
-__all__ = ["StartupDamper", "add_startup_damper"]
+__all__ = ["ExitSpanDamper", "StartupDamper", "add_exit_span_damper", "add_startup_damper"]
 
 
 class StartupDamper:
@@ -95,4 +95,81 @@ def add_startup_damper(mbs, nodes, damper: StartupDamper) -> int:
     if n != 6 * len(nodes):
         raise ValueError("the damper and the cable disagree on the number of nodes")
     damper.object = add_user_force_object(mbs, nodes, n, damper._force, damper._jacobian)
+    return damper.object
+
+
+class ExitSpanDamper:
+    """A light viscous damper on the cable past the conduit's exit, toward the steady flow.
+
+    Past the exit the cable hangs under gravity from the conduit's mouth to the rig, which moves
+    away along the exit tangent; nothing but the material damping (ζ < 1 %) damps that span, and
+    its swing (Gera: period 0.8 s, ±0.36 % of the pulling force) outlasts any run
+    (reference/README.md, "Why the force wandered"). Force on each node past the exit:
+    -c·w_k·m_k·(v_k − V·r'_k/|r'_k|), m_k the lumped mass, r'_k the current slope, V the rig's
+    speed: zero on a cable that slides steadily along its own path. w_k ramps from 0 at the exit
+    to 1 one element past it (C¹), so nodes enter the damper smoothly. ``solver.exit_span_damping``
+    sets c [1/s]; 0 (the default) switches it off.
+    """
+
+    def __init__(self, lumped_mass_kg, reference_coordinates, rate_1_per_s: float, speed_m_per_s: float,
+                 exit_point_m, exit_tangent, ramp_length_m: float, ramp_time_s: float = 0.0):
+        self.mk = np.asarray(lumped_mass_kg, dtype=float)
+        self.q_ref = np.asarray(reference_coordinates, dtype=float).reshape(-1)
+        self.rate = float(rate_1_per_s)
+        self.speed = float(speed_m_per_s)
+        self.exit_point = np.asarray(exit_point_m, dtype=float)
+        self.exit_tangent = np.asarray(exit_tangent, dtype=float)
+        self.ramp_length = float(ramp_length_m)
+        self.ramp_time = float(ramp_time_s)
+        self.object: int | None = None
+
+    def _parts(self, t, q):
+        from .rig import smooth_ramp
+        x = (self.q_ref + np.asarray(q, dtype=float)).reshape(-1, 6)
+        d = (x[:, :3] - self.exit_point) @ self.exit_tangent
+        tau = np.clip(d / self.ramp_length, 0.0, 1.0)
+        w = tau * tau * (3.0 - 2.0 * tau)
+        slope = x[:, 3:]
+        mag = np.linalg.norm(slope, axis=1)[:, None]
+        return self.rate * w * self.mk, self.speed * smooth_ramp(t, self.ramp_time), slope, mag
+
+    def force(self, t, q, v) -> np.ndarray:
+        """Generalized force [N] on the cable coordinates."""
+        c, speed, slope, mag = self._parts(t, q)
+        out = np.zeros((len(c), 6))
+        out[:, :3] = -c[:, None] * (np.asarray(v, dtype=float).reshape(-1, 6)[:, :3] - speed * slope / mag)
+        return out.reshape(-1)
+
+    def _force(self, mbs, t, item, q, q_t):
+        return self.force(t, q, q_t)
+
+    def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
+        # ∂Q/∂q̇ (diagonal) and ∂Q/∂r' of the flow reference; the weight's slow change with position is left out
+        c, speed, slope, mag = self._parts(t, q)
+        n = 6 * len(c)
+        on = np.flatnonzero(c)
+        rows, cols, vals = [], [], []
+        for k in on:
+            for i in range(3):
+                rows.append(6 * k + i), cols.append(6 * k + i), vals.append(f_v * c[k])
+            u = slope[k] / mag[k]
+            block = -f_q * c[k] * speed / mag[k, 0] * (np.eye(3) - np.outer(u, u))
+            for i in range(3):
+                for j in range(3):
+                    if block[i, j] != 0.0:
+                        rows.append(6 * k + i), cols.append(6 * k + 3 + j), vals.append(block[i, j])
+        m = exu.MatrixContainer()
+        if vals:
+            m.SetWithSparseMatrix(np.column_stack([rows, cols, vals]).astype(float), n, n, False)
+        else:
+            m.Initialize(n, n, False)
+        return m
+
+
+def add_exit_span_damper(mbs, nodes, damper: ExitSpanDamper) -> int:
+    """Add ``damper`` to ``mbs`` as one mass-free ``ObjectGenericODE2`` on the cable ``nodes``;
+    returns the Exudyn object index (also stored as ``damper.object``)."""
+    if len(damper.mk) != len(nodes):
+        raise ValueError("the damper and the cable disagree on the number of nodes")
+    damper.object = add_user_force_object(mbs, nodes, 6 * len(nodes), damper._force, damper._jacobian)
     return damper.object
