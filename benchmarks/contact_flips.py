@@ -33,25 +33,35 @@ from exucable.model.build import build_model  # noqa: E402
 from exucable.scenario import load_scenario  # noqa: E402
 
 
+def record_force_calls(scenario_path, t_from: float, t_to: float):
+    """Run the scenario to ``t_to`` [s]; return (model, [(t, absolute q, q̇) of every contact
+    force call at t >= ``t_from``])."""
+    sc = load_scenario(scenario_path)
+    sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, end_time_s=t_to, steady_stop=False))
+    calls = []
+    force = coupling.ContactCoupling._force
+
+    def recording_force(self, mbs, t, item, q, q_t):
+        if t >= t_from:
+            calls.append((t, np.array(q) + self.q_ref, np.array(q_t)))
+        return force(self, mbs, t, item, q, q_t)
+
+    coupling.ContactCoupling._force = recording_force
+    try:
+        model = build_model(sc)
+        solve.simulate(model)
+    finally:
+        coupling.ContactCoupling._force = force
+    return model, calls
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scenario")
     ap.add_argument("--from", dest="t_from", type=float, default=0.0022, help="first time recorded [s]")
     ap.add_argument("--to", dest="t_to", type=float, default=0.0045, help="end time of the run [s]")
     args = ap.parse_args(argv)
-    sc = load_scenario(args.scenario)
-    sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, end_time_s=args.t_to, steady_stop=False))
-    calls = []
-    force = coupling.ContactCoupling._force
-
-    def recording_force(self, mbs, t, item, q, q_t):
-        if t >= args.t_from:
-            calls.append((t, np.array(q) + self.q_ref, np.array(q_t)))
-        return force(self, mbs, t, item, q, q_t)
-
-    coupling.ContactCoupling._force = recording_force
-    model = build_model(sc)
-    solve.simulate(model)
+    model, calls = record_force_calls(args.scenario, args.t_from, args.t_to)
     impl = model.coupling.kernel._impl
     onset = impl.law.damping_onset_m
 

@@ -1,12 +1,15 @@
 """Fixed cost of ``exucable run`` (issue 15, part 3), measured in one run.
 
 A trivial scenario (the fast Example 2 over one 1 ms step) is run as a whole process, with and
-without figures, interleaved with ``python -c "import exudyn"`` (the floor: interpreter + Exudyn),
-``--repeat`` times each; medians are compared. Then one ``-X importtime`` run says which imports
-the rest is made of.
+without figures, interleaved with ``python -c "import exudyn"`` (the floor: interpreter + Exudyn)
+and with the numba floor (Exudyn, numba and numba's CPU target initialised, which any process
+running a cached numba kernel pays), ``--repeat`` times each; medians of wall time and of CPU time
+(user + system, less disturbed by the other jobs on a shared machine) are compared. Then one
+``-X importtime`` run says which imports the rest is made of.
 
     nice .venv/bin/python benchmarks/fixed_cost.py             # ~30 s
     nice .venv/bin/python benchmarks/fixed_cost.py --repeat 9
+    nice .venv/bin/python benchmarks/fixed_cost.py --before /path/to/main-tree   # before/after
 
 Target: ``exucable run --no-plots`` within 0.6 s of ``import exudyn``.
 """
@@ -25,6 +28,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+FLOOR_CASE = "numba floor: import exudyn, numba + target init"
+NUMBA_FLOOR = "import exudyn, numba; from numba.core.registry import cpu_target; cpu_target.target_context.refresh()"
 
 
 def trivial_scenario(directory: Path) -> Path:
@@ -38,19 +43,19 @@ def trivial_scenario(directory: Path) -> Path:
     return path
 
 
-def timed(cmd, out_dir: Path | None = None) -> float:
-    """Whole-process wall time [s] of ``cmd``. A run of 1 ms cannot be steady: ``exucable run``
+def timed(cmd, out_dir: Path | None = None, env: dict | None = None) -> tuple[float, float]:
+    """Whole-process wall time and CPU time [s] of ``cmd``. A run of 1 ms cannot be steady: ``exucable run``
     then exits 1 with status ``not_steady`` (the trust flags), which is accepted here, checked in
     ``out_dir/summary.json``; any other failure raises."""
-    t0 = time.perf_counter()
-    out = subprocess.run(cmd, capture_output=True, text=True)
-    dt = time.perf_counter() - t0
+    c0, t0 = os.times(), time.perf_counter()
+    out = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    dt, c1 = time.perf_counter() - t0, os.times()
     if out.returncode != 0:
         summary = out_dir / "summary.json" if out_dir is not None else None
         status = json.loads(summary.read_text()).get("status") if summary and summary.exists() else None
         if status != "not_steady":
             raise RuntimeError(f"{' '.join(map(str, cmd))} failed (status {status}):\n{out.stderr[-2000:]}")
-    return dt
+    return dt, (c1.children_user - c0.children_user) + (c1.children_system - c0.children_system)
 
 
 def top_imports(cmd, n=8):
@@ -67,6 +72,9 @@ def top_imports(cmd, n=8):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--before", type=Path, default=None,
+                    help="another exucable source tree (e.g. `git archive main` unpacked) to run interleaved "
+                         "with this one, through PYTHONPATH; warm its numba cache first")
     args = ap.parse_args(argv)
     exe = Path(sys.executable).with_name("exucable")
     with tempfile.TemporaryDirectory() as tmp:
@@ -74,25 +82,39 @@ def main(argv=None) -> int:
         sc = trivial_scenario(tmp)
         cases = {
             "python -c 'import exudyn'": [sys.executable, "-c", "import exudyn"],
+            # what any run of a numba kernel pays before its first cached function: numba's import and
+            # its CPU target's registries (numba.np.linalg, which imports scipy.linalg for BLAS, ...)
+            FLOOR_CASE: [sys.executable, "-c", NUMBA_FLOOR],
             "exucable run --no-plots": [str(exe), "run", str(sc), "-o", str(tmp / "a"), "-q", "--no-plots"],
             "exucable run (figures)": [str(exe), "run", str(sc), "-o", str(tmp / "b"), "-q"],
         }
         outs = {"exucable run --no-plots": tmp / "a", "exucable run (figures)": tmp / "b"}
+        envs = {}
+        if args.before is not None:
+            before = f"exucable run --no-plots ({args.before.name})"
+            cases[before] = [str(exe), "run", str(sc), "-o", str(tmp / "c"), "-q", "--no-plots"]
+            outs[before] = tmp / "c"
+            envs[before] = dict(os.environ, PYTHONPATH=str(args.before.resolve()))
+            timed(cases[before], outs[before], envs[before])
         timed(cases["exucable run --no-plots"], outs["exucable run --no-plots"])  # warm the disk and kernel caches
         times = {k: [] for k in cases}
         load0 = os.getloadavg()[0]
         for _ in range(args.repeat):
             for k, cmd in cases.items():
-                times[k].append(timed(cmd, outs.get(k)))
-        med = {k: statistics.median(v) for k, v in times.items()}
-        floor = med["python -c 'import exudyn'"]
+                times[k].append(timed(cmd, outs.get(k), envs.get(k)))
+        med = {k: statistics.median(w for w, _ in v) for k, v in times.items()}
+        cpu = {k: statistics.median(c for _, c in v) for k, v in times.items()}
+        floor, cpu_floor = med["python -c 'import exudyn'"], cpu["python -c 'import exudyn'"]
         print(f"# Fixed cost of exucable run — load average {load0:.1f} -> {os.getloadavg()[0]:.1f} "
               f"on {os.cpu_count()} cores, median of {args.repeat} interleaved runs\n")
-        print("| command | median [s] | above import exudyn [s] | all runs [s] |\n|---|---|---|---|")
+        print("| command | wall, median [s] | above import exudyn [s] | CPU, median [s] | CPU above import exudyn [s] "
+              "| all runs, wall [s] |\n|---|---|---|---|---|---|")
         for k, v in times.items():
-            print(f"| {k} | {med[k]:.3f} | {med[k] - floor:+.3f} | {', '.join(f'{x:.2f}' for x in v)} |")
+            print(f"| {k} | {med[k]:.3f} | {med[k] - floor:+.3f} | {cpu[k]:.2f} | {cpu[k] - cpu_floor:+.2f} | "
+                  f"{', '.join(f'{w:.2f}' for w, _ in v)} |")
         print(f"\ntarget: exucable run --no-plots within 0.6 s of import exudyn: "
-              f"{med['exucable run --no-plots'] - floor:.2f} s")
+              f"{med['exucable run --no-plots'] - floor:.2f} s wall, {cpu['exucable run --no-plots'] - cpu_floor:.2f} s CPU; "
+              f"the numba floor alone: {med[FLOOR_CASE] - floor:.2f} s wall, {cpu[FLOOR_CASE] - cpu_floor:.2f} s CPU")
         print("\nslowest top-level imports of `exucable run --no-plots` (-X importtime, cumulative):\n")
         for seconds, name in top_imports(["-m", "exucable", *cases["exucable run --no-plots"][1:]]):
             print(f"- {name}: {seconds:.3f} s")

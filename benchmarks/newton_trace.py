@@ -60,6 +60,8 @@ def settings(sp):
         setattr(obj, last, value)
     return s
 solve.solver_settings = settings
+for name, value in {solve_attrs!r}.items():
+    setattr(solve, name, value)
 t0 = time.perf_counter()
 model = build_model(sc)
 out = solve.simulate(model)
@@ -81,7 +83,7 @@ def _value(text: str):
     return {"True": True, "False": False}.get(text, text)
 
 
-def trace(path, overrides=None, exudyn=None, end_time=None, steady_stop=None):
+def trace(path, overrides=None, exudyn=None, end_time=None, steady_stop=None, solve_attrs=None):
     """Run ``path`` in a child process with Exudyn's verbose Newton output; return (result, attempts).
 
     Each attempt is a dict with ``t`` [s], ``h`` [s], ``residuals`` (initial first), ``accepted``,
@@ -94,7 +96,8 @@ def trace(path, overrides=None, exudyn=None, end_time=None, steady_stop=None):
     if steady_stop is not None:
         ov["solver.steady_stop"] = steady_stop
     code = _CHILD.format(root=str(ROOT), path=str(path), overrides=ov, parent=str(path.parent),
-                         stem=path.stem, exudyn=dict(exudyn or {}))
+                         stem=path.stem, exudyn=dict(exudyn or {}),
+                         solve_attrs=dict(solve_attrs or {}))
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, bufsize=1 << 16)
     attempts, cur, result = [], None, None
     for line in proc.stdout:
@@ -170,15 +173,18 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="dotted scenario key")
     ap.add_argument("--exudyn", action="append", default=[], metavar="KEY=VALUE",
                     help="dotted attribute of SimulationSettings.timeIntegration")
+    ap.add_argument("--solve", action="append", default=[], metavar="NAME=VALUE",
+                    help="module setting of exucable.solve (e.g. PREDICTOR=zero)")
     ap.add_argument("--json", default=None, help="write the parsed attempts here")
     args = ap.parse_args(argv)
     ov = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}
     ex = {k: _value(v) for k, v in (s.split("=", 1) for s in args.exudyn)}
+    sv = {k: _value(v) for k, v in (s.split("=", 1) for s in args.solve)}
     dump = {}
     for path in args.scenario:
-        result, attempts = trace(path, ov, ex, args.end_time)
+        result, attempts = trace(path, ov, ex, args.end_time, solve_attrs=sv)
         s = summarize(result, attempts)
-        label = f"{Path(path).parent.name}/{Path(path).name} {' '.join(args.set + args.exudyn)}".strip()
+        label = f"{Path(path).parent.name}/{Path(path).name} {' '.join(args.set + args.exudyn + args.solve)}".strip()
         print_summary(label, s)
         dump[label] = {"summary": s, "attempts": attempts}
     if args.json:

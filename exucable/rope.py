@@ -23,14 +23,18 @@ The centreline only needs the interface of :mod:`exucable.geometry`'s ``Centreli
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from exucable.errors import ModelError
+
+# scipy.integrate and scipy.optimize are imported where needed: a route of straights and
+# gravity-free or horizontal bends is integrated in closed form (_closed_form), and importing them
+# (with the scipy.spatial, scipy.sparse and scipy.special they pull in) is a third of a second of an
+# `exucable run` of such a route (issue 15, fixed cost).
 
 __all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "sidewall_pressure_N_per_m"]
 
@@ -130,7 +134,7 @@ class RopeSolution:
     max_sidewall_pressure_N_per_m: float
     direction: str = "forward"
     slack: bool = False
-    # (s_lo, s_hi, T(s)) in cable coordinates; T from solve_ivp's dense output or a constant 0 (slack).
+    # (s_lo, s_hi, T(s)) in cable coordinates; T from a closed form, solve_ivp's dense output or a constant 0 (slack).
     _branches: tuple = field(default=(), repr=False)
 
     @property
@@ -195,7 +199,63 @@ def _end_of_slack(g0: Callable[[float], float], s_lo: float, s_hi: float) -> flo
     if idx.size == 0:
         return s_hi
     i = idx[0] + 1  # values[i - 1] <= 0 < values[i]
+    from scipy.optimize import brentq
+
     return float(brentq(g0, grid[i - 1], grid[i], xtol=1e-14 * max(1.0, abs(s_hi)), rtol=1e-15))
+
+
+# A piece counts as straight, horizontal or of constant curvature if these hold to this relative tolerance
+# at _SHAPE_PROBES points inside it (rounding of the geometry's own evaluation is ~1e-16).
+_SHAPE_TOLERANCE = 1e-12
+_SHAPE_PROBES = 5
+
+
+def _closed_form(curve, s_min: float, s_max: float, mu: float, w: float):
+    """The rope ODE's exact solution on one piece, where it has one; else None.
+
+    Returns ``advance(s, T, s_to) -> (s_end, T_end, fn)``: the tension from ``T`` [N] at ``s`` on to
+    ``s_to``, or to where it reaches zero first (``s_end``), ``fn`` the vectorised T(s) on [s, s_end].
+    Three cases of dT/ds = μ|T κn − w g⊥| + w t_z (module docstring), exact where DOP853 is accurate to
+    its tolerance (1e-11):
+
+    - straight (κ = 0): the rate is the constant c = μ w |g⊥| + w t_z, T = T₀ + c (s − s₀) (paper Eq. 25);
+    - no weight, |κ| constant (bend, helix): T = T₀ exp(μ|κ|(s − s₀)), the capstan law (paper Eq. 26);
+    - a horizontal bend with weight (t and κn ⟂ e_z, |κ| constant): dT/ds = μ √(κ²T² + w²), so
+      asinh(κT/w) grows linearly: T = (w/κ) sinh(μκ(s − s₀) + asinh(κT₀/w)).
+    """
+    probes = np.linspace(s_min, s_max, _SHAPE_PROBES)
+    t = _as_rows(curve.tangent(probes), _SHAPE_PROBES)
+    kn = _as_rows(curve.curvature_vector(probes), _SHAPE_PROBES)
+    kappa = np.linalg.norm(kn, axis=1)
+    if np.all(kappa == 0.0) and np.all(np.abs(t - t[0]) <= _SHAPE_TOLERANCE):
+        load, tz = _transverse_load(curve, probes[:1], np.zeros(1), w)
+        rate = mu * float(np.linalg.norm(load[0])) + w * float(tz[0])
+
+        def advance(s, T, s_to):
+            if rate < 0.0 and T < -rate * (s_to - s):     # downhill: T reaches zero inside (the ODE's event)
+                s_end, T_end = s + T / -rate, 0.0
+            else:
+                s_end, T_end = s_to, max(T + rate * (s_to - s), 0.0)
+            return s_end, T_end, lambda x: np.maximum(T + rate * (np.asarray(x, dtype=float) - s), 0.0)
+
+        return advance
+    k = float(kappa[0])
+    if k == 0.0 or np.any(np.abs(kappa - k) > _SHAPE_TOLERANCE * k):
+        return None
+    if w == 0.0:
+        def advance(s, T, s_to):
+            return s_to, T * math.exp(mu * k * (s_to - s)), \
+                lambda x: T * np.exp(mu * k * (np.asarray(x, dtype=float) - s))
+
+        return advance
+    if np.all(np.abs(t[:, 2]) <= _SHAPE_TOLERANCE) and np.all(np.abs(kn[:, 2]) <= _SHAPE_TOLERANCE * k):
+        def advance(s, T, s_to):
+            a = math.asinh(k * T / w)
+            return s_to, (w / k) * math.sinh(mu * k * (s_to - s) + a), \
+                lambda x: (w / k) * np.sinh(mu * k * (np.asarray(x, dtype=float) - s) + a)
+
+        return advance
+    return None
 
 
 def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, trailing_N: float, dense: bool,
@@ -229,6 +289,7 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
 
         hits_zero.terminal = True
         hits_zero.direction = -1.0
+        exact = _closed_form(curve, s_min, s_max, mu, w)
 
         s = lo
         for _ in range(10_000):  # guard: every pass advances s (a slack stretch or an ODE run)
@@ -246,6 +307,14 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
                 s, tension = s_next, 0.0
                 if s >= hi:
                     break
+            if exact is not None:
+                s_end, tension, fn = exact(s, tension, hi)
+                if dense:
+                    branches.append((s, s_end, plo, phi, fn, np.array([s, s_end])))
+                s = s_end
+                continue
+            from scipy.integrate import solve_ivp
+
             sol = solve_ivp(rate, (s, hi), [tension], method="DOP853", rtol=_RTOL, atol=_ATOL_N,
                             dense_output=dense, events=hits_zero)
             if sol.status < 0:
@@ -299,7 +368,8 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
     """Tension along a rope pulled steadily through a conduit, given the trailing (back) tension.
 
     Integrates ``dT/ds = μ|T κn − w(e_z − (e_z·t)t)| + w(e_z·t)`` piece by piece (restarting at every piece
-    boundary, where κ jumps) with scipy's DOP853 at rtol 1e-11.
+    boundary, where κ jumps) in closed form where it has one (straights; bends without weight or
+    horizontal ones, see ``_closed_form``), elsewhere with scipy's DOP853 at rtol 1e-11.
 
     If the ODE would drive the tension negative (a downhill stretch steeper than the friction angle,
     tan θ > μ), the tension is clamped at 0: the cable runs slack there, and the tension rises again from 0
@@ -450,5 +520,7 @@ def solve_rope_for_pull_force(centreline, friction: float, pull_force_N: float,
             f_hi = pull_of(hi)
         else:  # pragma: no cover - the pull force grows at least linearly in the back tension
             raise ModelError("pull_force_N", "could not bracket the trailing tension")
+        from scipy.optimize import brentq
+
         trailing = float(brentq(lambda x: pull_of(x) - target, 0.0, hi, xtol=1e-15 * max(1.0, hi), rtol=1e-14))
     return solve_rope(centreline, mu, w, trailing, direction, length)

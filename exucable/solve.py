@@ -20,6 +20,9 @@ from .model.recorder import History, Recorder, earliest_steady_s, expected_drift
 
 # the first step is solver.step / START_STEP_DIVISOR (see simulate)
 START_STEP_DIVISOR = 128
+# hold each check point's contact damping onset at the step's start value within a step
+# (ContactLaw's notes; Newton iterations Ex. 4 381 -> 288). False: g(δ) of every iterate.
+HOLD_ONSET = True
 
 __all__ = ["History", "SolveOutcome", "simulate", "solver_settings", "steady_quantity", "expected_drift_N_per_s",
            "earliest_steady_s",
@@ -146,6 +149,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
         if not lifted[0] and t > 0.0:
             solver.it.maxStepSize = sp.end_time_s / max_steps
             lifted[0] = True
+        if HOLD_ONSET and model.coupling is not None:
+            model.coupling.start_step(mbs, t)
         if snapshots is not None:
             snapshots.step(t, model.pull_force_N(t))
         go_on = recorder(mbs, t)
@@ -154,6 +159,8 @@ def simulate(model, progress: Progress | None = None, steady_stop: bool | None =
         return go_on
 
     mbs.SetPostStepUserFunction(post_step)
+    if HOLD_ONSET and model.coupling is not None:
+        model.coupling.start_step(mbs, mbs.systemData.GetTime())
     t0 = time.perf_counter()
     status, message = "ok", ""
     try:

@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 __all__ = ["AxisGauge", "cable_sample_points", "PullForceEstimate", "pull_force_uncertainty", "assess",
            "PENETRATION_LIMIT", "DYNAMIC_LIMIT", "TRUSTED_STATUSES"]
@@ -68,12 +67,14 @@ class AxisGauge:
         self.s = np.linspace(0.0, L, n)
         self.c = np.asarray(centreline.point(self.s), dtype=float).reshape(n, 3)
         self.t = np.asarray(centreline.tangent(self.s), dtype=float).reshape(n, 3)
-        self.tree = cKDTree(self.c)
+        from .contact.nearest import NearestSample   # numba: loaded when a run has a contact kernel
+
+        self.nearest = NearestSample(self.c)
         self.length_m = L
 
     def __call__(self, points_m) -> tuple[np.ndarray, np.ndarray]:
         p = np.asarray(points_m, dtype=float).reshape(-1, 3)
-        _, i = self.tree.query(p)
+        i = self.nearest(p)
         rel = p - self.c[i]
         along = np.einsum("ij,ij->i", rel, self.t[i])
         d = np.linalg.norm(rel - along[:, None] * self.t[i], axis=1)

@@ -112,5 +112,7 @@ def test_one_kernel_pass_per_newton_iteration():
     assert a.status == b.status == "ok"
     assert a.history.pull_force_N == b.history.pull_force_N       # bit for bit
     assert cb.jacobian_calls > 0 and cb.reused_evaluations == cb.jacobian_calls
-    assert ca.kernel_evaluations == ca.force_calls + ca.jacobian_calls
-    assert cb.kernel_evaluations == cb.force_calls
+    assert ca.kernel_evaluations == ca.force_calls + ca.jacobian_calls + ca.onset_evaluations
+    assert cb.kernel_evaluations == cb.force_calls + cb.onset_evaluations
+    # the held damping onset is read off the converged state's own pass: one pass more, at t = 0
+    assert ca.onset_evaluations == cb.onset_evaluations == 1

@@ -171,10 +171,9 @@ def test_open_ends_do_not_hide_contact_behind_the_start_plane(backend):
 ONSET = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.2, damping_onset_m=5e-4)
 
 
-def test_damping_onset_jacobians_and_backends_agree():
-    """With a damping onset (f_n = K δ^e + C min(δ/δ_d, 1) δ̇; penetrations 3e-4 m inside the
-    5e-4 m ramp) both backends agree (1e-11) and the Jacobians match central differences (same
-    steps and 1e-6 bound as above)."""
+def onset_case():
+    """Two elements in a bend, 3e-4 m into the wall (inside ONSET's 5e-4 m ramp), sliding with
+    noise: (q, q_t, kernels by backend, the generator for more noise)."""
     cond = conduit("bend", segments_per_bend=10)
     rng = np.random.default_rng(7)
     s_nodes = np.linspace(0.35, 0.65, 3)
@@ -182,6 +181,14 @@ def test_damping_onset_jacobians_and_backends_agree():
     L = np.diff(s_nodes)
     ks = {b: ContactKernel(cond.segments, L, R_CABLE, ONSET, 6, backend=b, surface="smooth",
                            centreline=cond.centreline) for b in ("numpy", "numba")}
+    return q, q_t, ks, rng
+
+
+def test_damping_onset_jacobians_and_backends_agree():
+    """With a damping onset (f_n = K δ^e + C min(δ/δ_d, 1) δ̇; penetrations 3e-4 m inside the
+    5e-4 m ramp) both backends agree (1e-11) and the Jacobians match central differences (same
+    steps and 1e-6 bound as above)."""
+    q, q_t, ks, rng = onset_case()
     a, b = (ks[x].evaluate(q, q_t, jacobian=True) for x in ("numpy", "numba"))
     assert np.abs(a.generalized_force - b.generalized_force).max() <= 1e-11 * np.abs(a.generalized_force).max()
     assert np.abs(a.jac_q_blocks - b.jac_q_blocks).max() <= 1e-10 * np.abs(a.jac_q_blocks).max()
@@ -192,6 +199,47 @@ def test_damping_onset_jacobians_and_backends_agree():
     # and the force is continuous at first touch: the damping term vanishes with δ
     st = k.points(q, q_t)
     assert np.all(st.penetration_m < ONSET.damping_onset_m)
+
+
+def test_held_damping_onset():
+    """The dynamic solve holds the onset g within a step (ContactLaw's notes). Held at g(δ) of the
+    same state the force is the same (1e-12); held at other values both backends agree and the
+    Jacobians are those of f_n = K δ^e + C g δ̇ with g fixed (central differences, 1e-6), which
+    differ from the live onset's by its ∂g/∂δ term."""
+    q, q_t, ks, rng = onset_case()
+    for k in ks.values():
+        live = k.evaluate(q, q_t, jacobian=True)
+        assert live.penetration_m.shape == (2, 6) and np.all(live.penetration_m > 0.0)
+        np.testing.assert_allclose(live.penetration_m.reshape(-1), k.points(q, q_t).penetration_m, rtol=1e-12)
+        g = k.damping_onset(live.penetration_m)
+        np.testing.assert_allclose(g, live.penetration_m / ONSET.damping_onset_m, rtol=1e-12)
+        same = k.evaluate(q, q_t, jacobian=True, held_onset=g)
+        np.testing.assert_allclose(same.generalized_force, live.generalized_force, rtol=0,
+                                   atol=1e-12 * np.abs(live.generalized_force).max())
+        assert np.abs(same.jac_q_blocks - live.jac_q_blocks).max() > 1e-3 * np.abs(live.jac_q_blocks).max()
+    held = rng.uniform(0.2, 1.0, size=(2, 6))
+    a, b = (ks[x].evaluate(q, q_t, jacobian=True, held_onset=held) for x in ("numpy", "numba"))
+    assert np.abs(a.generalized_force - b.generalized_force).max() <= 1e-11 * np.abs(a.generalized_force).max()
+    assert np.abs(a.jac_q_blocks - b.jac_q_blocks).max() <= 1e-10 * np.abs(a.jac_q_blocks).max()
+    assert np.abs(a.jac_qt_blocks - b.jac_qt_blocks).max() <= 1e-10 * np.abs(a.jac_qt_blocks).max()
+
+    class Held:  # the numpy kernel with the onset held, for the differences
+        def evaluate(self, q, q_t, jacobian=False):
+            return ks["numpy"].evaluate(q, q_t, jacobian, held_onset=held)
+
+    jq_fd, jqt_fd = fd_jacobians(Held(), q, q_t)
+    assert np.abs(assemble_blocks_dense(a.jac_q_blocks) - jq_fd).max() < 1e-6 * np.abs(jq_fd).max()
+    assert np.abs(assemble_blocks_dense(a.jac_qt_blocks) - jqt_fd).max() < 1e-6 * np.abs(jqt_fd).max()
+    with pytest.raises(ValueError, match="held_onset has shape"):
+        ks["numba"].evaluate(q, q_t, held_onset=np.ones(12))
+
+
+def test_damping_onset_values():
+    """g(δ) = min(δ/δ_d, 1) in contact, 0 out of it; 1 for the paper's law (δ_d = 0)."""
+    from exucable.contact.law import damping_onset
+    d = np.array([-1e-4, 0.0, 1e-4, 5e-4, 2e-3])
+    np.testing.assert_allclose(damping_onset(ONSET, d), [0.0, 0.0, 0.2, 1.0, 1.0])
+    np.testing.assert_array_equal(damping_onset(LAW, d), np.ones(5))
 
 
 @pytest.mark.parametrize("surface", ["segments", "smooth"])

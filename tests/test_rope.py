@@ -262,3 +262,50 @@ def test_solution_fields_and_errors():
         args = {"friction": 0.2, **kwargs}
         with pytest.raises(ModelError):
             solve_rope(route, **args)
+
+
+# ---------------------------------------------------------------- closed-form pieces against the ODE
+@pytest.mark.parametrize("items, start_dir, w, back", [
+    ([Straight(2.0), Bend(90.0, 0.5, turn="left"), Straight(3.0)], [1, 0, 0], W, 2.0),        # horizontal bend + weight
+    ([Straight(10.0), Bend(90.0, 0.5, turn="left"), Straight(5.0)], heading(-8.0), W, 2.0),   # tilted bend (ODE)
+    ([Straight(3.0), Bend(30.0, 1.0, turn="up"), Straight(4.0)], heading(-40.0), W, 0.1),     # T hits 0, slack, recovers
+    ([Straight(1.0), Bend(90.0, 0.5, turn="left"), Helix(2.0, 1.0, 0.05)], [1, 0, 0], 0.0, 150.0),  # no weight
+    (SPATIAL, [1, 0, 0], W, 5.0),
+])
+def test_closed_form_pieces_agree_with_the_ode(monkeypatch, items, start_dir, w, back):
+    """Pieces solved in closed form (straights; bends and helices without weight; horizontal bends with
+    weight) give the tension the DOP853 integration gives (rtol 1e-11) to 1e-9: the closed forms are the
+    ODE's exact solutions, so only the integrator's own error remains."""
+    import exucable.rope as rope
+
+    route = centreline_from_path([0, 0, 0], start_dir, items)
+    for direction in ("forward", "reverse"):
+        exact = solve_rope(route, 0.3, w, back, direction=direction, n_output=201)
+        with monkeypatch.context() as m:
+            m.setattr(rope, "_closed_form", lambda *args: None)
+            ode = solve_rope(route, 0.3, w, back, direction=direction, n_output=201)
+        scale = max(ode.max_tension_N, 1e-12)
+        np.testing.assert_allclose(exact.tension_N, ode.tension_N, rtol=1e-9, atol=1e-9 * scale)
+        s = np.linspace(0.0, ode.cable_length_m, 57)
+        np.testing.assert_allclose(exact.tension_at(s), ode.tension_at(s), rtol=1e-9, atol=1e-9 * scale)
+        assert exact.pull_force_N == pytest.approx(ode.pull_force_N, rel=1e-9)
+        assert exact.max_tension_N == pytest.approx(ode.max_tension_N, rel=1e-9)
+        assert exact.max_sidewall_pressure_N_per_m == pytest.approx(ode.max_sidewall_pressure_N_per_m, rel=1e-9)
+        assert exact.slack == ode.slack
+
+
+def test_closed_form_covers_straights_and_horizontal_or_weightless_bends_only():
+    import exucable.rope as rope
+
+    route = centreline_from_path([0, 0, 0], heading(10.0), [Straight(1.0), Bend(90.0, 0.5, turn="left"),
+                                                          Bend(45.0, 1.0, turn="up"), Helix(2.0, 1.0, 0.05)])
+    kinds = []
+    for piece in route.pieces:
+        lo, hi = rope._inside(piece.s_start_m, piece.s_start_m + piece.length_m)
+        kinds.append((rope._closed_form(route, lo, hi, 0.3, W) is not None,
+                      rope._closed_form(route, lo, hi, 0.3, 0.0) is not None))
+    # the bend after a 10 deg incline is tilted: only without weight; the vertical bend and the helix likewise
+    assert kinds == [(True, True), (False, True), (False, True), (False, True)]
+    flat = centreline_from_path([0, 0, 0], [1, 0, 0], [Straight(1.0), Bend(90.0, 0.5, turn="right")])
+    piece = flat.pieces[1]
+    assert rope._closed_form(flat, *rope._inside(piece.s_start_m, piece.s_start_m + piece.length_m), 0.3, W)

@@ -265,7 +265,7 @@ def test_defaults_filled():
     assert (p.direction, p.back_tension_N, p.force_N, p.ramp_time_s) == ("forward", 0.0, None, 0.0)
     v = s.solver
     assert v.min_step_s == 1.0e-8
-    assert v.spectral_radius == 0.5 and v.newton_max_iterations == 12 and v.newton_tolerance == 1e-5
+    assert v.spectral_radius == 0.5 and v.newton_max_iterations == 8 and v.newton_tolerance == 1e-5
     assert v.output_interval_s == max(1.0e-2, 1.0 / 1000)
     assert v.steady_stop is False and v.steady_window_s == 0.2 and v.steady_tolerance == 1.0e-3
     assert v.pretension is True

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["check_points", "hermite_unit", "hermite", "RULES"]
+__all__ = ["check_points", "gauss_legendre", "hermite_unit", "hermite", "RULES"]
 
 RULES = ("gauss", "uniform")
 
@@ -42,15 +42,43 @@ def check_points(n: int, rule: str = "gauss") -> tuple[np.ndarray, np.ndarray]:
     if n < 1:
         raise ValueError(f"check points per element must be >= 1, got {n}")
     if rule == "gauss":
-        # scipy's Golub-Welsch on the banded Jacobi matrix, O(n²): numpy's leggauss takes a dense
-        # eigensolve, O(n³), 0.2-0.7 s at the paper's 800 points per element (Example 4)
-        from scipy.special import roots_legendre
-
-        x, w = roots_legendre(n)
+        x, w = gauss_legendre(n)
         return 0.5 * (x + 1.0), 0.5 * w
     if rule == "uniform":
         return (np.arange(n) + 0.5) / n, np.full(n, 1.0 / n)
     raise ValueError(f"check point rule must be one of {RULES}, got {rule!r}")
+
+
+def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes on [-1, 1], ascending, and their weights (summing to 2), ``n >= 1``.
+
+    Golub-Welsch as in scipy's ``roots_legendre`` (to rounding, ~1e-15): the nodes are the
+    eigenvalues of the symmetric tridiagonal Jacobi matrix of the Legendre recurrence, off-diagonal
+    k/√(4k² − 1) (O(n²); numpy's ``leggauss`` takes a dense eigensolve, O(n³), 0.2-0.7 s at the
+    paper's 800 points per element), polished by one Newton step on P_n; the weights are
+    2 / ((1 − x²) P_n'(x)²) (Abramowitz & Stegun 25.4.29). Here rather than ``scipy.special``,
+    whose import is a tenth of a second of ``exucable run``'s fixed cost (issue 15); scipy.linalg is
+    loaded anyway (numba's BLAS).
+    """
+    from scipy.linalg import eigvalsh_tridiagonal
+
+    k = np.arange(1.0, n)
+    x = eigvalsh_tridiagonal(np.zeros(n), k / np.sqrt(4.0 * k * k - 1.0))
+
+    def legendre_and_derivative(x):
+        p_prev, p = np.ones_like(x), x.copy()
+        for j in range(2, n + 1):               # Bonnet: j P_j = (2j − 1) x P_{j−1} − (j − 1) P_{j−2}
+            p_prev, p = p, ((2 * j - 1) * x * p - (j - 1) * p_prev) / j
+        if n == 1:
+            p_prev, p = np.ones_like(x), x
+        return p, n * (p_prev - x * p) / (1.0 - x * x)
+
+    p, dp = legendre_and_derivative(x)
+    x = x - p / dp
+    _, dp = legendre_and_derivative(x)
+    w = 2.0 / ((1.0 - x * x) * dp * dp)
+    x, w = 0.5 * (x - x[::-1]), 0.5 * (w + w[::-1])    # exactly symmetric, like scipy's
+    return x, w * (2.0 / w.sum())
 
 
 def hermite_unit(xi) -> np.ndarray:

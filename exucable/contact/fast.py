@@ -382,15 +382,20 @@ def _points_kernel(q, qt, length, n1, n2, n3, n4, r1, r2, r3, r4, steady_speed, 
 def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, off, cand,
                     gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
                     inv_href, jacobian, force, jq, jqt, tab, sel, acc, open_first, open_last,
-                    smooth, seg_piece, pieces, seg_phi, n_newton, inv_onset):
-    """Generalized contact force and its 12×12 Jacobian blocks; returns (n_in_contact, max δ)."""
+                    smooth, seg_piece, pieces, seg_phi, n_newton, inv_onset, held_ramp, hold, delta_out):
+    """Generalized contact force and its 12×12 Jacobian blocks; returns (n_in_contact, max δ).
+
+    ``delta_out[e, k]`` receives every point's penetration δ [m] (0 out of contact). With ``hold``
+    the damping onset is ``held_ramp[e, k]`` instead of g(δ) (see :class:`FastKernel`)."""
     n_k = n1.shape[0]
     n_contact = 0
     max_d2 = -1.0
     for e in range(length.shape[0]):
         c0 = off[e]
         c1 = off[e + 1]
+        d_out = delta_out[e]
         if c0 == c1:
+            d_out[:] = 0.0
             continue
         le = length[e]
         b = 6 * e
@@ -398,12 +403,17 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         _closest_points(tab, seg, cand, c0, c1, sel, open_first, open_last, smooth, seg_piece, pieces,
                         seg_phi, n_newton)
         n_touch, max_d2 = _normals(tab, n_k, gap, max_d2)
+        d_out[:] = tab[_DELTA, :n_k]
         if n_touch == 0:
             continue
         n_contact += n_touch
         _positions(qt, b, le, n1, n2, n3, n4, tab[_VX], tab[_VY], tab[_VZ])  # Eq. 8
-        _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
-                      exponent_mode, inv_onset)
+        if hold:
+            _held_ramp(tab, n_k, held_ramp[e])
+        else:
+            _onset_ramp(tab, n_k, inv_onset)
+        _normal_force_with_ramp(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
+                                exponent_mode)
         _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
         _add_generalized_force(tab, n1, n2, n3, n4, le, b, force)
         if not jacobian:
@@ -457,7 +467,42 @@ def _normals(tab, n_k, gap, max_d2):
 @njit(inline="always", **_JIT)
 def _normal_force(tab, omega, n_k, weight_scale, stiffness, damping, exponent, exponent_mode,
                   inv_onset):
-    """v_n, v_τ (Eqs. 16-17) and the weighted normal force w·max(0, K δ^e + C δ̇) (Eq. 18)."""
+    """v_n, v_τ (Eqs. 16-17) and the weighted normal force w·max(0, K δ^e + C g(δ) δ̇) (Eq. 18)."""
+    _onset_ramp(tab, n_k, inv_onset)
+    _normal_force_with_ramp(tab, omega, n_k, weight_scale, stiffness, damping, exponent, exponent_mode)
+
+
+@njit(inline="always", **_JIT)
+def _onset_ramp(tab, n_k, inv_onset):
+    """Damping onset g(δ) = min(δ/δ_d, 1) and dg/dδ of every point ((1, 0) for δ_d = 0)."""
+    delta = tab[_DELTA]
+    rr = tab[_RAMP]
+    drr = tab[_DRAMP]
+    if inv_onset > 0.0:
+        for k in range(n_k):
+            x = delta[k] * inv_onset
+            below = x < 1.0
+            rr[k] = x if below else 1.0
+            drr[k] = inv_onset if below else 0.0
+    else:
+        for k in range(n_k):
+            rr[k] = 1.0
+            drr[k] = 0.0
+
+
+@njit(inline="always", **_JIT)
+def _held_ramp(tab, n_k, ramp):
+    """Damping onset held at given values g [-] (the step's start, see ContactCoupling): dg/dδ = 0."""
+    rr = tab[_RAMP]
+    drr = tab[_DRAMP]
+    for k in range(n_k):
+        rr[k] = ramp[k]
+        drr[k] = 0.0
+
+
+@njit(inline="always", **_JIT)
+def _normal_force_with_ramp(tab, omega, n_k, weight_scale, stiffness, damping, exponent, exponent_mode):
+    """:func:`_normal_force` with the onset rows _RAMP, _DRAMP already filled."""
     nx = tab[_NX]
     ny = tab[_NY]
     nz = tab[_NZ]
@@ -490,17 +535,6 @@ def _normal_force(tab, omega, n_k, weight_scale, stiffness, damping, exponent, e
             fr[k] = delta[k] ** exponent
             ddr[k] = exponent * delta[k] ** (exponent - 1.0)
     rr = tab[_RAMP]
-    drr = tab[_DRAMP]
-    if inv_onset > 0.0:  # damping onset g = min(δ/δ_d, 1)
-        for k in range(n_k):
-            x = delta[k] * inv_onset
-            below = x < 1.0
-            rr[k] = x if below else 1.0
-            drr[k] = inv_onset if below else 0.0
-    else:
-        for k in range(n_k):
-            rr[k] = 1.0
-            drr[k] = 0.0
     for k in range(n_k):
         vn = nx[k] * vx[k] + ny[k] * vy[k] + nz[k] * vz[k]  # Eq. 16, = δ̇
         raw = stiffness * fr[k] + damping * rr[k] * vn  # Eq. 18 (with the damping onset)
@@ -843,6 +877,7 @@ class FastKernel:
         self._tab = np.empty((_ROWS, n_k))
         self._acc = np.empty((10, 18))
         self._empty_blocks = np.empty((0, 12, 12))
+        self._no_onset = np.empty((self.n_el, n_k))
 
     def candidates(self, q):
         """CSR candidate segment lists (offsets, indices) for coordinates ``q``."""
@@ -860,8 +895,10 @@ class FastKernel:
                        self.open_first, self.open_last)
         return nearest
 
-    def evaluate(self, q, q_t, jacobian):
-        """Return (Q, ∂Q/∂q blocks or None, ∂Q/∂q̇ blocks or None, n_in_contact, max δ [m])."""
+    def evaluate(self, q, q_t, jacobian, held_onset=None):
+        """Return (Q, ∂Q/∂q blocks or None, ∂Q/∂q̇ blocks or None, n_in_contact, max δ [m],
+        δ [m] per point (n_el, n_k), 0 out of contact); ``held_onset``: the damping onset g per
+        point, shape (n_el, n_k), instead of g(δ) (see ContactKernel.evaluate)."""
         q = np.ascontiguousarray(q, dtype=float)
         q_t = np.ascontiguousarray(q_t, dtype=float)
         off, cand = self.candidates(q)
@@ -872,15 +909,18 @@ class FastKernel:
         else:
             jq = jqt = self._empty_blocks
         n1, n2, n3, n4 = self._n
+        penetration = np.empty((self.n_el, self.nh.shape[0]))
+        hold = held_onset is not None
+        onset = np.ascontiguousarray(held_onset, dtype=float) if hold else self._no_onset
         n_contact, max_pen = _contact_kernel(
             q, q_t, self.length, n1, n2, n3, n4, self.pair_t, _PAIRS, self.omega, self.seg, off,
             cand, self.gap, *self._law_arguments(),
             self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc,
             self.open_first, self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
-            NEWTON_ITERATIONS, self._inverse_onset())
+            NEWTON_ITERATIONS, self._inverse_onset(), onset, hold, penetration)
         if not jacobian:
             jq = jqt = None
-        return force, jq, jqt, int(n_contact), float(max_pen)
+        return force, jq, jqt, int(n_contact), float(max_pen), penetration
 
     def _law_arguments(self):
         """The law's numbers as both kernels take them: K, C, e, e's mode, μ_k, μ_s - μ_k, 1/v_s², ε²."""

@@ -1,8 +1,11 @@
 """Where the compiled contact kernel is cached, and what happens when it cannot be.
 
 Numba compiles the kernel once (tens of seconds for :mod:`.fast`) and, with ``cache=True``, keeps
-the machine code on disk so that later processes only load it (a tenth of a second). Numba looks
-for a writable cache directory in this order (``numba.core.caching``):
+the machine code on disk so that later processes only load it (a tenth of a second). The same holds
+for the broad phase (:mod:`.broadphase`), the steady-mode kernel (:mod:`.steady`) and the trust
+gauge's nearest-sample search (:mod:`.nearest`). Nothing here sets ``NUMBA_*`` options: a process
+that imports exucable keeps numba's configuration as the user set it. Numba looks for a writable
+cache directory in this order (``numba.core.caching``):
 
 1. ``$NUMBA_CACHE_DIR`` if set;
 2. ``__pycache__`` next to the source (``exucable/contact/__pycache__``: an editable install);

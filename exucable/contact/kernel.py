@@ -34,7 +34,7 @@ import numpy as np
 from ..geometry.segments import Segments
 from ..scenario_fields import default_of
 from .checkpoints import check_points, hermite_unit
-from .law import ContactLaw
+from .law import ContactLaw, damping_onset
 from .reference import ReferenceKernel
 from .smooth import SmoothWall, refine_closest_points
 
@@ -68,6 +68,8 @@ class ContactResult:
     max_penetration_m : float
         Largest δ over all check points that found a candidate segment [m] (-inf if none); a
         value approaching the cable radius means the cable is leaving the conduit.
+    penetration_m : ndarray, shape (n_el, n_check_points), or None
+        Every check point's penetration δ [m], 0 out of contact (None from the steady kernel).
     """
 
     generalized_force: np.ndarray
@@ -75,6 +77,7 @@ class ContactResult:
     jac_qt_blocks: np.ndarray | None
     n_in_contact: int
     max_penetration_m: float = -np.inf
+    penetration_m: np.ndarray | None = None
 
 
 @dataclass
@@ -297,7 +300,7 @@ class ContactKernel:
         return off.copy(), idx.copy()
 
     # -- evaluation ----------------------------------------------------------------------------
-    def evaluate(self, q, q_t, jacobian: bool = False) -> ContactResult:
+    def evaluate(self, q, q_t, jacobian: bool = False, held_onset=None) -> ContactResult:
         """Generalized contact force on the cable and optionally its Jacobian blocks.
 
         Parameters
@@ -308,6 +311,11 @@ class ContactKernel:
             Their time derivatives [m/s, 1/s].
         jacobian : bool
             Also return ∂Q/∂q and ∂Q/∂q̇ as element blocks.
+        held_onset : array_like, shape (n_elements, n_check_points), optional
+            The damping onset g [-] of every check point, held at these values instead of
+            g(δ) of this state: f_n = max(0, K δ^e + C g δ̇), with no ∂g/∂δ term in the Jacobian.
+            The dynamic solve passes g(δ) of the step's start (:meth:`damping_onset`), which
+            makes the law linear in δ̇ within a step (see :class:`~exucable.contact.law.ContactLaw`).
 
         Returns
         -------
@@ -315,7 +323,18 @@ class ContactKernel:
         """
         q = self._check(q, "q")
         q_t = self._check(q_t, "q_t")
-        return ContactResult(*self._impl.evaluate(q, q_t, jacobian))
+        if held_onset is None:
+            return ContactResult(*self._impl.evaluate(q, q_t, jacobian))
+        held = np.asarray(held_onset, dtype=float)
+        if held.shape != (self.n_elements, self.n_check_points):
+            raise ValueError(f"held_onset has shape {held.shape}, expected "
+                             f"{(self.n_elements, self.n_check_points)}")
+        return ContactResult(*self._impl.evaluate(q, q_t, jacobian, held))
+
+    def damping_onset(self, penetration_m) -> np.ndarray:
+        """The damping onset g(δ) [-] of penetrations δ [m] (e.g. ContactResult.penetration_m):
+        min(δ/δ_d, 1) in contact, 0 out of contact (1 everywhere for the paper's δ_d = 0)."""
+        return damping_onset(self.law, penetration_m)
 
     def points(self, q, q_t) -> CheckPointState:
         """Per check point state for post-processing, from the kernel's backend.

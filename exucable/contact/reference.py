@@ -56,11 +56,12 @@ def _nearest(p, cand, seg_start, seg_end, seg_axis, seg_length, open_first=-1, o
     return cand[j], t_clamped, residual, inside[rows, j]
 
 
-def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian):
+def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian, held_onset=None):
     """Force law on flat arrays of points (Eqs. 14-23) and its derivatives ∂F/∂P, ∂F/∂v.
 
     ``p_res`` = P - Pc (NaN rows for points without a segment); ``axis_inside`` = segment axis
-    where the projection is inside the segment, 0 where it is clamped to a vertex.
+    where the projection is inside the segment, 0 where it is clamped to a vertex;
+    ``held_onset`` (optional, one per point): the damping onset g, held, instead of g(δ).
     """
     m = p_res.shape[0]
     out = {
@@ -88,7 +89,10 @@ def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian):
     vt_ = v[touch]
     vn = np.sum(n * vt_, axis=1)  # Eq. 16
     dl = delta[touch]
-    ramp, dramp = damping_ramp(law, dl)
+    if held_onset is None:
+        ramp, dramp = damping_ramp(law, dl)
+    else:
+        ramp, dramp = held_onset[touch], np.zeros_like(dl)
     raw = law.stiffness * dl**law.exponent + law.damping * ramp * vn  # Eq. 18 (with the onset)
     act = raw > 0.0
     idx = touch[act]
@@ -174,7 +178,7 @@ class ReferenceKernel:
         v = S(ξ) q̇ (Eq. 8). A subclass may derive v from q instead (steady sliding)."""
         return shape, q_t
 
-    def _state(self, q, q_t, jacobian):
+    def _state(self, q, q_t, jacobian, held_onset=None):
         k = self.k
         n_el, n_k = k.n_elements, k.n_check_points
         shape = np.broadcast_to(k._nh, (n_el, n_k, 4)).copy()
@@ -210,15 +214,17 @@ class ReferenceKernel:
             phi = np.where(mask, phi, np.nan)
         w = (k.element_length_m[:, None] * k.omega[None, :]) / k.reference_spacing_m
         law = _point_law(residual.reshape(-1, 3), v.reshape(-1, 3), axis_inside.reshape(-1, 3),
-                         w.reshape(-1), k.law, k.gap_m, jacobian)
+                         w.reshape(-1), k.law, k.gap_m, jacobian,
+                         None if held_onset is None else np.asarray(held_onset, dtype=float).reshape(-1))
         return {"p": p.reshape(-1, 3), "v": v.reshape(-1, 3), "segment": segment.reshape(-1),
                 "t": t.reshape(-1), "shape": shape, "rate_shape": rate_shape, "law": law, "phi": phi,
                 "residual": residual.reshape(-1, 3)}
 
-    def evaluate(self, q, q_t, jacobian):
-        """Return (Q, ∂Q/∂q blocks or None, ∂Q/∂q̇ blocks or None, n_in_contact, max δ [m])."""
+    def evaluate(self, q, q_t, jacobian, held_onset=None):
+        """Return (Q, ∂Q/∂q blocks or None, ∂Q/∂q̇ blocks or None, n_in_contact, max δ [m],
+        δ [m] per point (n_el, n_k), 0 out of contact); ``held_onset`` as FastKernel.evaluate."""
         k = self.k
-        st = self._state(q, q_t, jacobian)
+        st = self._state(q, q_t, jacobian, held_onset)
         n_el, n_k = k.n_elements, k.n_check_points
         shape = st["shape"]
         law = st["law"]
@@ -244,4 +250,6 @@ class ReferenceKernel:
                 jqt = np.zeros_like(jq)
             else:
                 jqt = jv_blocks
-        return force, jq, jqt, n_contact, max_pen
+        with np.errstate(invalid="ignore"):
+            penetration = np.where(delta > 0.0, delta, 0.0).reshape(n_el, n_k)
+        return force, jq, jqt, n_contact, max_pen, penetration

@@ -37,6 +37,10 @@ class ContactCoupling:
         Number of user-function calls.
     kernel_evaluations, reused_evaluations : int
         Kernel passes made, and Jacobian calls served by the pass of the force call before.
+    onset_evaluations : int
+        Kernel passes made by :meth:`start_step` (its state was not the last pass's).
+    held_onset : ndarray or None
+        The damping onset g [-] per check point, held within the current step.
     jacobian_with_force : bool
         Compute the Jacobian blocks already in the force call (default; False: only when asked,
         two kernel passes per Newton iteration, for the benchmarks' comparison).
@@ -65,6 +69,32 @@ class ContactCoupling:
         self.jacobian_with_force = True
         self._last = None
         self.object = add_user_force_object(mbs, nodes, self.n, self._force, self._jacobian)
+        self._ltg = None
+        # the damping onset g per check point, held within a step at its value in the step's
+        # start state (ContactLaw's notes); None before the first start_step
+        self.held_onset = None
+        self.onset_evaluations = 0
+
+    def start_step(self, mbs, t):
+        """Hold every check point's damping onset g(δ) at its value in the current state: call it
+        once a step is accepted (and before the first), with t [s] the current time.
+
+        The state's penetrations are the last kernel pass's when that pass was at this state (it
+        is: Exudyn's last residual of a converged step is evaluated there), else one pass more.
+        """
+        if self._ltg is None:
+            self._ltg = np.asarray(mbs.systemData.GetObjectLTGODE2(self.object), dtype=np.int64)
+        sd = mbs.systemData
+        qa, va = self.absolute(np.asarray(sd.GetODE2Coordinates())[self._ltg],
+                               np.asarray(sd.GetODE2Coordinates_t())[self._ltg])
+        last = self._last
+        if last is not None and last[0] == t and np.array_equal(last[1], qa) and np.array_equal(last[2], va):
+            res = last[3]
+        else:
+            res = self._evaluate(t, qa, va, jacobian=False)
+            self.onset_evaluations += 1
+        self.held_onset = self.kernel.damping_onset(res.penetration_m)
+        self._last = None  # evaluated with the onset held before
 
     def absolute(self, q, q_t):
         """Absolute coordinates and rates from Exudyn's displacement coordinates."""
@@ -78,16 +108,16 @@ class ContactCoupling:
         last residual of a step computes blocks that go unused). The reuse is checked, not assumed:
         it needs the same t, q and q̇ bit for bit."""
         last = self._last
-        if (last is not None and last[0] == t and np.array_equal(last[1], q)
-                and np.array_equal(last[2], q_t)):
+        if (last is not None and (last[3].jac_q_blocks is not None or not jacobian) and last[0] == t
+                and np.array_equal(last[1], q) and np.array_equal(last[2], q_t)):
             self.reused_evaluations += 1
             return last[3]
         t0 = time.perf_counter()
-        res = self.kernel.evaluate(q, q_t, jacobian=jacobian)
+        res = self.kernel.evaluate(q, q_t, jacobian=jacobian, held_onset=self.held_onset)
         self.kernel_time_s += time.perf_counter() - t0
         self.kernel_evaluations += 1
         # copies: Exudyn may hand over views of vectors it later overwrites
-        self._last = (t, q.copy(), q_t.copy(), res) if jacobian else None
+        self._last = (t, q.copy(), q_t.copy(), res)
         return res
 
     def _force(self, mbs, t, item, q, q_t):

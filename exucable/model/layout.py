@@ -249,7 +249,7 @@ def lay_cable(
     xs = np.concatenate([[0.0], xs, [cable_length_m]])
     e_of = np.clip(np.searchsorted(x_nodes, xs, side="right") - 1, 0, n_elements - 1)
     xi_of = (xs - x_nodes[e_of]) / Le[e_of]
-    basis = _hermite_matrix(e_of, xi_of, Le, n_elements)
+    cols, vals = _hermite_rows(e_of, xi_of, Le)
     ss = np.interp(xs, x, s)
     target = np.stack([np.interp(ss, s, P[:, j]) for j in range(3)], axis=1)
     ss_in = np.clip(ss, 0.0, L)
@@ -257,13 +257,17 @@ def lay_cable(
     t_c = extended_tangent(centreline, ss)
     want = np.linalg.norm(target - C - np.sum((target - C) * t_c, axis=1)[:, None] * t_c, axis=1)
     inside = (ss > 0.0) & (ss < L)
-    from scipy.sparse.linalg import factorized
+    # scipy.linalg (loaded anyway: numba's BLAS) rather than scipy.sparse, whose import is part of
+    # `exucable run`'s fixed cost (issue 15)
+    from scipy.linalg import cho_solve_banded, cholesky_banded
 
-    solve_normal = factorized((basis.T @ basis).tocsc())   # banded normal matrix, factored once
+    n_unknowns = 2 * (n_elements + 1)
+    factor = cholesky_banded(_normal_matrix_banded(cols, vals, n_unknowns))   # factored once
     for _ in range(correction_iterations + 1):
-        rhs = basis.T @ target
-        coef = np.stack([solve_normal(rhs[:, j]) for j in range(3)], axis=1)  # (2(n+1), 3): r_k, r'_k rows
-        fitted = basis @ coef
+        rhs = np.zeros((n_unknowns, 3))
+        np.add.at(rhs, cols.ravel(), (vals[:, :, None] * target[:, None, :]).reshape(-1, 3))   # Bᵀ target
+        coef = cho_solve_banded((factor, False), rhs)   # (2(n+1), 3): r_k, r'_k rows
+        fitted = np.einsum("mk,mkj->mj", vals, coef[cols])                               # B coef
         rel = fitted - C
         lat = rel - np.sum(rel * t_c, axis=1)[:, None] * t_c
         d = np.linalg.norm(lat, axis=1)
@@ -296,20 +300,27 @@ def sliding_layout(element_length_m, node_x_m, node_s_m, position_m, slope, spee
     )
 
 
-def _hermite_matrix(e, xi, Le, n_elements):
-    """Rows of the Hermite basis (paper Eqs. 4-6) on the unknowns [r_0, r'_0, r_1, r'_1, ...]
-    (one coordinate direction), at element ``e`` and coordinate ``xi``."""
-    from scipy.sparse import csr_matrix
+def _hermite_rows(e, xi, Le):
+    """The Hermite basis (paper Eqs. 4-6) on the unknowns [r_0, r'_0, r_1, r'_1, ...] (one coordinate
+    direction) at element ``e`` and coordinate ``xi``: each row's four columns and values, shape (m, 4).
 
-    # sparse: four entries a row, so the fit's normal matrix is banded and a 1 km cable's start
-    # (thousands of elements) costs milliseconds, not the seconds-to-minutes of a dense O(n³) solve
-    m = len(xi)
+    Four entries a row, so the fit's normal matrix is banded (bandwidth 3) and a 1 km cable's start
+    (thousands of elements) costs milliseconds, not the seconds-to-minutes of a dense O(n³) solve."""
     L = Le[e]
-    rows = np.repeat(np.arange(m), 4)
-    cols = (2 * e[:, None] + np.arange(4)[None, :]).ravel()
+    cols = 2 * e[:, None] + np.arange(4)[None, :]
     vals = np.stack([1 - 3 * xi**2 + 2 * xi**3, L * (xi - 2 * xi**2 + xi**3),
-                     3 * xi**2 - 2 * xi**3, L * (-xi**2 + xi**3)], axis=1).ravel()
-    return csr_matrix((vals, (rows, cols)), shape=(m, 2 * (n_elements + 1)))
+                     3 * xi**2 - 2 * xi**3, L * (-xi**2 + xi**3)], axis=1)
+    return cols, vals
+
+
+def _normal_matrix_banded(cols, vals, n_unknowns):
+    """BᵀB of the rows of :func:`_hermite_rows` in LAPACK's upper banded storage (row 3 + i − j holds
+    entry (i, j), i ≤ j), as ``scipy.linalg.cholesky_banded`` takes it."""
+    ab = np.zeros((4, n_unknowns))
+    a, b = np.triu_indices(4)          # column pairs of a row with cols[a] <= cols[b]
+    np.add.at(ab, ((3 + cols[:, a] - cols[:, b]).ravel(), cols[:, b].ravel()),
+              (vals[:, a] * vals[:, b]).ravel())
+    return ab
 
 
 def _second_derivative_at_nodes(coef, Le):

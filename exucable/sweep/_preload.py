@@ -1,7 +1,8 @@
 """Imported once by the forkserver of the local pool, so that every case's process, forked
-from it, starts with numpy, scipy, Exudyn, the compiled contact kernel and matplotlib already
-loaded (about 1.7 s per case otherwise). Nothing here *uses* Exudyn: a process is forked only
-from this clean, import-only state, never from one that has run a model.
+from it, starts with numpy, scipy, Exudyn, the compiled contact kernel's modules, numba's
+initialised CPU target and matplotlib already loaded (about 1.7 s per case otherwise). Nothing
+here *uses* Exudyn: a process is forked only from this clean, import-only state, never from one
+that has run a model.
 """
 
 try:  # a failed import only costs start-up time in the workers; it must not kill the forkserver
@@ -12,5 +13,11 @@ try:  # a failed import only costs start-up time in the workers; it must not kil
     import exucable.plots.results  # noqa: F401
     import exucable.run  # noqa: F401
     import exucable.sweep.worker  # noqa: F401
+    import exucable.contact.nearest  # noqa: F401  (the axis gauge's search)
+    # numba's CPU target (its registries, numba.np.linalg and scipy.linalg for BLAS) is otherwise set
+    # up on the first compiled call of every case: about a fifth of a second each (issue 15)
+    from numba.core.registry import cpu_target
+
+    cpu_target.target_context.refresh()
 except Exception:  # pragma: no cover
     pass
