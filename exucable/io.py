@@ -60,16 +60,15 @@ def write_csv(path, columns, data: dict) -> Path:
     integer arrays (indices) as integers.
     """
     buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(columns)
-    # integer columns (node and element indices) stay integers
+    csv.writer(buf, lineterminator="\n").writerow(columns)
+    # integer columns (node and element indices) stay integers; tolist() gives Python ints and
+    # floats, whose str/repr are the forms above, formatted column by column (a per-row csv
+    # writer took ~10 µs a row: 0.03 s of a 0.3 s steady run's 6600 rows)
     arrays = [np.asarray(data[c]) for c in columns]
-    arrays = [a if np.issubdtype(a.dtype, np.integer) else a.astype(float) for a in arrays]
-    fmt = [(lambda v: str(int(v))) if np.issubdtype(a.dtype, np.integer) else (lambda v: repr(float(v)))
-           for a in arrays]
-    for row in zip(*arrays):
-        w.writerow([f(v) for f, v in zip(fmt, row)])
-    return atomic_write_text(path, buf.getvalue())
+    text = [list(map(str, a.astype(np.int64).tolist())) if np.issubdtype(a.dtype, np.integer)
+            else list(map(repr, a.astype(float).tolist())) for a in arrays]
+    body = "\n".join(map(",".join, zip(*text)))
+    return atomic_write_text(path, buf.getvalue() + body + ("\n" if body else ""))
 
 
 def read_csv(path) -> dict[str, np.ndarray]:

@@ -272,6 +272,7 @@ class ContactKernel:
                                     self.wall)
         else:
             self._impl = ReferenceKernel(self)
+        self._last_point_state = None   # (q, q_t, state) of the last per-point pass
 
     @property
     def n_elements(self) -> int:
@@ -341,7 +342,7 @@ class ContactKernel:
         Penetration, normal and the conduit arc length of Pc are derived here from each point's
         nearest segment and residual P - Pc, the same way for both backends.
         """
-        st = self._impl.point_state(self._check(q, "q"), self._check(q_t, "q_t"))
+        st = self._point_state(self._check(q, "q"), self._check(q_t, "q_t"))
         seg = st["segment"]
         p = st["position_m"]
         residual = st["residual_m"]
@@ -371,7 +372,23 @@ class ContactKernel:
         """Each check point's nearest conduit segment (-1: none within R: outside the conduit),
         element-major: :meth:`points`' ``segment`` without the profiles' post-processing."""
         q = self._check(q, "q")
-        return self._impl.point_state(q, np.zeros_like(q))["segment"]
+        last = self._last_point_state
+        if last is not None and np.array_equal(last[0], q):
+            return last[2]["segment"]      # the segments depend on q alone
+        return self._point_state(q, np.zeros_like(q))["segment"]
+
+    def _point_state(self, q, q_t) -> dict:
+        """The backend's per-point state, reused when asked again at the same state (the steady
+        solve's last check and the profiles after it ask at the same q; a backend that takes
+        the velocity from q, ``velocity_from_coordinates``, ignores q_t)."""
+        last = self._last_point_state
+        rates_matter = not getattr(self._impl, "velocity_from_coordinates", False)
+        if (last is not None and np.array_equal(last[0], q)
+                and (not rates_matter or np.array_equal(last[1], q_t))):
+            return last[2]
+        st = self._impl.point_state(q, q_t)
+        self._last_point_state = (q.copy(), q_t.copy(), st)
+        return st
 
     def _arc_length(self, p, seg, residual) -> np.ndarray:
         """Centreline arc length of each point's closest point Pc [m] (NaN without a segment):

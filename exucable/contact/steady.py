@@ -75,6 +75,7 @@ class SteadySlidingKernel(ContactKernel):
         law = replace(base, friction=scale * base.friction,
                       static_friction=None if base.static_friction is None else scale * base.static_friction)
         self.law = law
+        self._last_point_state = None      # its forces were of the former law
         if isinstance(self._impl, _SteadyFast):
             self._impl.fast.law = law
 
@@ -172,6 +173,8 @@ def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, pair_t, pai
 class _SteadyFast:
     """Compiled steady-sliding evaluation sharing a :class:`~exucable.contact.fast.FastKernel`'s
     tables, broad phase and work buffers."""
+
+    velocity_from_coordinates = True    # v = V ∂r/∂x: q_t is ignored
 
     def __init__(self, fast, dnh_unit, speed_m_per_s):
         self.fast = fast
