@@ -154,6 +154,7 @@ class IndustryRow:
     liftoff_over_2c: float       # max over bends of λ²/(2R) / 2c, λ = √(EJ/T_out)
     stiff_estimate: float = float("nan")   # exucable/stiff_bend.py along the route, vs the rope
     stiff_estimate_fits: bool = False      # every bend within that model's validity (offset ≤ 2c)
+    beam_estimate: float = float("nan")    # exucable/beam_conduit.py (3D chain, both walls), vs its EJ → 0
     run_rope_N: float | None = None            # both references for the run's extent of cable (a dynamic
     run_rope_clearance_N: float | None = None  # run's window has pulled some out; steady: = the route's)
     values_N: list = field(default_factory=list)        # exucable per mesh level (default first)
@@ -253,7 +254,10 @@ class IndustryRow:
             parts.append(f"exucable vs rope with clearance {100 * self.remainder:+.2f} % at √(EJ/T)/R = "
                          f"{self.flexibility:.3g} ({regime}); the stiff-bend model (exucable/stiff_bend.py, bend "
                          f"by bend, no free spans) predicts {100 * self.stiff_estimate:+.2f} % vs the rope"
-                         + ("" if self.stiff_estimate_fits else " but is outside its validity (offset > 2c)"))
+                         + ("" if self.stiff_estimate_fits else " but is outside its validity (offset > 2c)")
+                         + (f"; the beam-in-conduit model (exucable/beam_conduit.py: both walls, the weight, free "
+                            f"spans) predicts {100 * self.beam_estimate:+.2f} % vs its flexible limit"
+                            if np.isfinite(self.beam_estimate) else ""))
         return "; ".join(parts)
 
 
@@ -319,6 +323,29 @@ def _stiff_estimate(scenario, plan_sections) -> tuple[float, bool]:
     return (t - rope) / rope, fits
 
 
+def _beam_estimate(scenario) -> float:
+    """Bending stiffness' change of the pulling force from :func:`exucable.beam_conduit.stiff_route_difference`
+    (the stiff cable may press both walls: PULLFLEX's three-point bending; its weight on the round
+    conduit's floor, free spans), relative to that model's EJ → 0 limit; NaN for a route it does not model
+    (a bend out of the horizontal plane, no weight or no clearance)."""
+    from .beam_conduit import BeamConduitError, route_pieces, stiff_route_difference
+    conduit = scenario.build_conduit()
+    if scenario.pull.direction == "reverse":
+        conduit = conduit.reversed()
+    centre = conduit.centreline
+    c = scenario.conduit.inner_radius_m - scenario.cable.radius_m
+    g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
+    horizontal = all(abs(float(centre.tangent(s)[2])) < 1e-9 for s in np.linspace(0.0, centre.length_m, 257))
+    if not horizontal or c <= 0.0 or g <= 0.0:
+        return float("nan")
+    try:
+        return stiff_route_difference(route_pieces(centre), c, scenario.contact.friction,
+                                      scenario.cable.mass_per_length_kg_per_m * g, scenario.cable.bending_stiffness_N_m2,
+                                      max(scenario.pull.back_tension_N, 1e-3))["difference"]
+    except BeamConduitError:
+        return float("nan")
+
+
 def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: bool = True,
                       modes=("steady",), examples=None, progress: Callable[[str], None] | None = None,
                       scenario_dir=None, levels: int = 3) -> IndustryValidation:
@@ -377,6 +404,7 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
             row = IndustryRow(name, ex["source"], ex["kind"], mode, published_values(ex)["tension_N"][-1], bound,
                               plan["directions"][ex["direction"]]["pull_force_N"], *_flexibility(sc, sections))
             row.stiff_estimate, row.stiff_estimate_fits = _stiff_estimate(sc, sections)
+            row.beam_estimate = _beam_estimate(sc)
             k0 = None
             for level, refine in enumerate(refines):
                 say(f"validate industry: {name}, {mode}, mesh level {level} (element length / {refine:g}) ...")
@@ -420,7 +448,8 @@ def _g(x, fmt=".6g"):
 
 
 HEADER = ["example", "mode", "published [N]", "rope [N]", "rope w/ clearance [N] (run's extent)", "exucable [N]", "converged [N]",
-          "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "liftoff/2c", "stiff-bend est.", "pass"]
+          "mesh", "scatter", "vs published", "vs rope", "vs rope w/ clearance", "sqrt(EJ/T)/R", "liftoff/2c", "stiff-bend est.",
+          "beam-in-conduit est.", "pass"]
 
 
 def table_rows(iv: IndustryValidation):
@@ -432,7 +461,7 @@ def table_rows(iv: IndustryValidation):
                      _converged(r), _pct(r.mesh_difference),
                      "-" if sc is None else f"{100 * sc:.3f} %", _pct(r.rel(r.published_N), 2), _pct(r.rel(r.run_rope_N), 2),
                      _pct(r.remainder, 2), f"{r.flexibility:.3g}", f"{r.liftoff_over_2c:.2g}",
-                     _pct(r.stiff_estimate, 2) + ("" if r.stiff_estimate_fits else " (outside)"), "PASS" if r.passed else "FAIL"])
+                     _pct(r.stiff_estimate, 2) + ("" if r.stiff_estimate_fits else " (outside)"), _pct(r.beam_estimate, 2), "PASS" if r.passed else "FAIL"])
     return HEADER, rows
 
 
@@ -456,7 +485,8 @@ def write_industry_report(iv: IndustryValidation, out: Path, fast: bool) -> None
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(["example", "mode", "source", "published_N", "published_bound_N", "rope_pull_force_N",
                 "rope_clearance_pull_force_N", "pull_force_N", "level_pull_forces_N", "converged_pull_force_N", "converged_error_N", "mesh_difference",
-                "scatter", "elements", "flexibility_sqrt_EJ_over_T_per_R", "liftoff_over_2c", "status",
+                "scatter", "elements", "flexibility_sqrt_EJ_over_T_per_R", "liftoff_over_2c",
+                "stiff_bend_estimate", "beam_conduit_estimate", "status",
                 "wall_time_s", "passed"])
     for r in iv.rows:
         w.writerow([r.example, r.mode, r.source, repr(r.published_N), repr(r.published_bound_N), repr(r.rope_N),
@@ -466,7 +496,8 @@ def write_industry_report(iv: IndustryValidation, out: Path, fast: bool) -> None
                     "" if r.mesh_difference is None else repr(r.mesh_difference),
                     "" if not r.scatter or r.scatter[0] is None else repr(r.scatter[0]),
                     ";".join(str(n) for n in r.elements),
-                    repr(r.flexibility), repr(r.liftoff_over_2c), ";".join(r.statuses), ";".join(f"{t:.1f}" for t in r.wall_time_s), r.passed])
+                    repr(r.flexibility), repr(r.liftoff_over_2c),
+                    repr(r.stiff_estimate), repr(r.beam_estimate), ";".join(r.statuses), ";".join(f"{t:.1f}" for t in r.wall_time_s), r.passed])
     atomic_write_text(out / "industry.csv", buf.getvalue())
     header, rows = table_rows(iv)
     md = [f"# exucable industry validation ({'default mesh only' if fast else 'default and refined meshes'})", "",
