@@ -36,7 +36,7 @@ from ..scenario_fields import default_of
 from .checkpoints import check_points, hermite_unit
 from .law import ContactLaw, damping_onset
 from .reference import ReferenceKernel
-from .smooth import SmoothWall, refine_closest_points
+from .smooth import SmoothWall, closest_point_angles
 
 __all__ = [
     "ContactKernel",
@@ -406,7 +406,7 @@ class ContactKernel:
         if self.wall is not None:
             # beyond an open end the residual is zero: those points keep the segment's value
             refine = np.where(np.any(residual != 0.0, axis=1), seg, -1)
-            mask, _, _, phi = refine_closest_points(p, refine, t, self._seg_length, self.wall)
+            mask, phi = closest_point_angles(p, residual, refine, t, self._seg_length, self.wall)
             sm = mask & np.isfinite(phi)
             piece = self.wall.seg_piece[seg[sm]]
             s_conduit[sm] = self.wall.s_piece_start_m[piece] + phi[sm] * self.wall.piece_speed_m_per_rad[piece]
