@@ -89,10 +89,15 @@ def test_mode_difference_and_scatter_checks_without_runs():
     steady.values_N, steady.statuses = [100.0], ["ok"]
     dynamic.values_N, dynamic.statuses, dynamic.scatter = [99.0], ["steady"], [0.003]
     iv = IndustryValidation(rows=[steady, dynamic])
-    (ex, s, d, shift), = iv.mode_differences()
-    assert (s, d) == (100.0, 99.0) and shift == pytest.approx(-0.01)
+    (ex, s, d, shift, same), = iv.mode_differences()
+    assert (s, d) == (100.0, 99.0) and shift == pytest.approx(-0.01) and not same
     fails = iv.failures
     assert any("steady vs dynamic +1.010 %" in f for f in fails)
     assert any("steadiness level 0: scatter 0.300 %" in f for f in fails)
     dynamic.values_N, dynamic.scatter, dynamic.run_rope_clearance_N = [99.9], [0.001], 99.9
     assert iv.failures == []
+    # with steady mode solved in the dynamic run's own state, that value is the one compared
+    dynamic.same_state_steady_N = 99.5
+    (ex, s, d, shift, same), = iv.mode_differences()
+    assert (s, d, shift, same) == (99.5, 99.9, 0.0, True)
+    assert any("steady vs dynamic -0.400 %" in f for f in iv.failures)
