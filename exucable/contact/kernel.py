@@ -375,6 +375,11 @@ class ContactKernel:
         last = self._last_point_state
         if last is not None and np.array_equal(last[0], q):
             return last[2]["segment"]      # the segments depend on q alone
+        search = getattr(self._impl, "nearest_segments", None)
+        if search is not None:
+            # the compiled backend's contact search alone: the same segments as its point state
+            # (tests/test_contact_kernel.py) at a tenth of the cost (Ex. 4: 0.5 vs 7 ms)
+            return search(q).reshape(-1)
         return self._point_state(q, np.zeros_like(q))["segment"]
 
     def _point_state(self, q, q_t) -> dict:
