@@ -81,6 +81,20 @@ class SmoothWall:
         self.piece_speed_m_per_rad = speed
 
 
+def _on_curved_pieces(seg, t, seg_length, wall: SmoothWall):
+    """The points whose nearest segment (``seg``, -1: none) lies on a curved piece: their mask,
+    indices, piece rows and the chord's estimate of their helix angle [rad] (from the clamped
+    projection parameter ``t`` [m])."""
+    ok = seg >= 0
+    piece = np.where(ok, wall.seg_piece[np.maximum(seg, 0)], 0)
+    mask = ok & (wall.pieces[piece, _CURVED] == 1.0)
+    idx = np.nonzero(mask)[0]
+    s = seg[idx]
+    frac = t[idx] / seg_length[s]
+    estimate = wall.seg_phi[s, 0] + frac * (wall.seg_phi[s, 1] - wall.seg_phi[s, 0])
+    return mask, idx, wall.pieces[piece[idx]], estimate
+
+
 def refine_closest_points(p, seg, t, seg_length, wall: SmoothWall):
     """Exact closest points on the curved pieces (numpy reference; see the module docstring).
 
@@ -110,18 +124,11 @@ def refine_closest_points(p, seg, t, seg_length, wall: SmoothWall):
     residual = np.zeros((m, 3))
     axis_vec = np.zeros((m, 3))
     phi_out = np.zeros(m)
-    ok = seg >= 0
-    piece = np.where(ok, wall.seg_piece[np.maximum(seg, 0)], 0)
-    mask = ok & (wall.pieces[piece, _CURVED] == 1.0)
-    if not mask.any():
+    mask, idx, pc, phi = _on_curved_pieces(seg, t, seg_length, wall)
+    if not idx.size:
         return mask, residual, axis_vec, phi_out
-    idx = np.nonzero(mask)[0]
-    pc = wall.pieces[piece[idx]]
     c, e1, e2, k = pc[:, _C:_C + 3], pc[:, _E1:_E1 + 3], pc[:, _E2:_E2 + 3], pc[:, _K:_K + 3]
     a, h, Phi = pc[:, _A], pc[:, _H], pc[:, _PHI]
-    s = seg[idx]
-    frac = t[idx] / seg_length[s]
-    phi = wall.seg_phi[s, 0] + frac * (wall.seg_phi[s, 1] - wall.seg_phi[s, 0])
     x = p[idx] - c
     x1 = np.sum(x * e1, axis=1)
     x2 = np.sum(x * e2, axis=1)
@@ -160,34 +167,14 @@ def closest_point_angles(p, residual, seg, t, seg_length, wall: SmoothWall):
     tangent, whose polar angle runs past the end. The same φ as :func:`refine_closest_points`
     (there by Newton's method, to ~1e-12 rad), at a fraction of the cost.
 
-    Parameters
-    ----------
-    p, residual : ndarray (m, 3)
-        Check point positions P [m] and P − Pc on the smooth wall [m].
-    seg : ndarray (m,) int
-        Nearest segment of each point (``seg < 0``: none; points on straights are not touched).
-    t : ndarray (m,)
-        Clamped projection parameter on that segment [m].
-    seg_length : ndarray (n_seg,)
-        Segment lengths [m].
-
-    Returns
-    -------
-    mask : ndarray (m,) bool
-        Points on curved pieces.
-    phi : ndarray (m,)
-        Helix angle of Pc [rad] (0 outside ``mask``).
+    ``p``, ``seg``, ``t``, ``seg_length`` as for :func:`refine_closest_points`; ``residual``
+    (m, 3) is P − Pc on the smooth wall [m]. Returns ``mask`` (points on curved pieces) and
+    ``phi`` [rad] (0 outside ``mask``).
     """
-    ok = seg >= 0
-    piece = np.where(ok, wall.seg_piece[np.maximum(seg, 0)], 0)
-    mask = ok & (wall.pieces[piece, _CURVED] == 1.0)
     phi_out = np.zeros(p.shape[0])
-    if not mask.any():
+    mask, idx, pc, estimate = _on_curved_pieces(seg, t, seg_length, wall)
+    if not idx.size:
         return mask, phi_out
-    idx = np.nonzero(mask)[0]
-    pc = wall.pieces[piece[idx]]
-    s = seg[idx]
-    estimate = wall.seg_phi[s, 0] + t[idx] / seg_length[s] * (wall.seg_phi[s, 1] - wall.seg_phi[s, 0])
     x = p[idx] - residual[idx] - pc[:, _C:_C + 3]
     polar = np.arctan2(np.einsum("ij,ij->i", x, pc[:, _E2:_E2 + 3]),
                        np.einsum("ij,ij->i", x, pc[:, _E1:_E1 + 3]))
