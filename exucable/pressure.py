@@ -135,16 +135,14 @@ def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_pe
     near = np.flatnonzero((u >= -(H + bending_length_m + window_m / 2)) & (u <= inside))
     near = near[np.argsort(-u[near])]
     loaded = F[near] > 1e-12 * max(float(F[near].max()) if near.size else 0.0, 1e-300)
-    on, zeros = None, 0
-    for j in range(near.size):
-        if loaded[j]:
-            zeros = 0
-            continue
-        zeros += 1
-        if zeros == 3:                                # a real gap, not one grazing point
-            first_loaded = [near[i] for i in range(j - 2) if loaded[i]]
-            on = first_loaded[-1] if first_loaded else None
-            break
+    # the first gap: three unloaded points in a row (a real gap, not one grazing point); the cable
+    # lands at the last loaded point before it
+    unloaded = ~loaded
+    gaps = np.flatnonzero(unloaded[:-2] & unloaded[1:-1] & unloaded[2:])
+    on = None
+    if gaps.size:
+        before = np.flatnonzero(loaded[:gaps[0]])
+        on = int(near[before[-1]]) if before.size else None
     if on is None:                                    # no lift-off resolved: the excess over q across ±w/2
         a = window_m / 2
         sel = np.abs(s - s_end_m) <= a
@@ -231,7 +229,7 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
              for p in pieces if p.is_curved]
     for k, b in enumerate(bends, start=1):
         grid = np.linspace(b.s0 - a, b.s1 + a, 201)
-        p_w = windowed_load(s_m, force_N, window_m, grid)
+        p_w = _load_between(s_pts, cum, grid - a, grid + a) / window_m     # windowed_load, sorted once
         r_w = _rope_between(rs, rc, grid - a, grid + a) / window_m
         margin = a + 3.0 * bending_length_m
         body = (grid >= b.s0 + margin) & (grid <= b.s1 - margin)

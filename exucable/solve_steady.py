@@ -53,7 +53,7 @@ import numpy as np
 import exudyn as exu
 
 from .solve import History, Progress, SolveOutcome, quiet_sparse
-from .tension import tension_at, tension_profile
+from .tension import TensionStations, profile_stations_m
 
 __all__ = ["solve_steady", "static_settings", "STATIC_TOLERANCE"]
 
@@ -251,15 +251,24 @@ class _StateStore:
             sd.SetAECoordinates(list(lam), configuration=cfg)
 
 
-def steady_forces(model) -> tuple[float, float, float]:
+def force_stations(model) -> tuple[TensionStations, TensionStations]:
+    """:func:`steady_forces`' stations: two per element along the cable, and the trailing end."""
+    Le = model.layout.element_length_m
+    return TensionStations(Le, profile_stations_m(Le, 2)), TensionStations(Le, [0.0])
+
+
+def steady_forces(model, stations: tuple[TensionStations, TensionStations] | None = None
+                  ) -> tuple[float, float, float]:
     """Pulling force, trailing tension and maximum tension [N] of the current static state.
 
     The static solver's Lagrange multipliers carry the opposite sign of the dynamic solver's
     (checked: the leading end's reaction then equals its tension EA·ε, tests/test_steady.py).
+    ``stations``: :func:`force_stations` of the model, when asked at many states.
     """
     q, _ = model.coordinates()
     EA = model.axial_stiffness_N
-    _, N = tension_profile(q, model.layout.element_length_m, EA, points_per_element=2)
+    along, trailing = force_stations(model) if stations is None else stations
+    N = along.tension(q, EA)
     if model.lead_drive is not None:
         pull = -model.lead_drive.force_N(model.mbs)
     else:
@@ -267,7 +276,7 @@ def steady_forces(model) -> tuple[float, float, float]:
     if model.trail_drive is not None:
         trail = model.trail_drive.force_N(model.mbs)
     else:
-        trail = float(tension_at(q, model.layout.element_length_m, EA, [0.0])[0])
+        trail = float(trailing.tension(q, EA)[0])
     return float(pull), float(trail), float(np.max(N))
 
 
@@ -348,6 +357,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
     t_wall = time.perf_counter()
     total = [0]
 
+    stations = force_stations(model)
     one_iteration = static_settings(tolerance=1.0, max_iterations=1, absolute_tolerance_N=1e-3 * tolerance_N)
     last_solver = [None]
 
@@ -377,7 +387,7 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float = STA
     def record(lam: float, residual: float) -> None:
         """One history row (and the progress bar) for an accepted pseudo-time step."""
         total[0] += 1
-        pull, trail, tmax = steady_forces(model)
+        pull, trail, tmax = steady_forces(model, stations)
         history.time_s.append(float(total[0]))
         history.pull_force_N.append(pull)
         history.trailing_tension_N.append(trail)

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["axial_strain", "tension_at", "tension_profile", "SteadyState", "detect_steady_state",
-           "hermite_derivative_weights"]
+__all__ = ["axial_strain", "tension_at", "tension_profile", "profile_stations_m", "TensionStations", "SteadyState",
+           "detect_steady_state", "hermite_derivative_weights"]
 
 
 def hermite_derivative_weights(xi: np.ndarray, length_m: np.ndarray) -> np.ndarray:
@@ -36,6 +36,29 @@ def _locate(x_m, element_length_m):
     return e, xi
 
 
+class TensionStations:
+    """Fixed material stations ``x_m`` [m] on a cable of element lengths ``element_length_m`` [m]:
+    the elements and Hermite derivative weights found once, then the strain or tension of any
+    state (the steady solve's history asks at every pseudo-time step)."""
+
+    def __init__(self, element_length_m, x_m):
+        Le = np.asarray(element_length_m, dtype=float)
+        self.element, xi = _locate(x_m, Le)
+        self.weights = hermite_derivative_weights(xi, Le[self.element])
+
+    def strain(self, coordinates) -> np.ndarray:
+        """ε = |∂r/∂x| − 1 [-] at the stations (see :func:`axial_strain`)."""
+        q = np.asarray(coordinates, dtype=float).reshape(-1, 6)
+        e, w = self.element, self.weights
+        d = (w[:, 0, None] * q[e, :3] + w[:, 1, None] * q[e, 3:] + w[:, 2, None] * q[e + 1, :3]
+             + w[:, 3, None] * q[e + 1, 3:])
+        return np.linalg.norm(d, axis=1) - 1.0
+
+    def tension(self, coordinates, axial_stiffness_N) -> np.ndarray:
+        """N = EA·ε [N] at the stations (paper Eq. 24)."""
+        return axial_stiffness_N * self.strain(coordinates)
+
+
 def axial_strain(coordinates, element_length_m, x_m) -> np.ndarray:
     """Axial strain ε = |∂r/∂x| − 1 [-] at material stations ``x_m`` [m] from the trailing end.
 
@@ -48,13 +71,7 @@ def axial_strain(coordinates, element_length_m, x_m) -> np.ndarray:
     x_m : array_like (m,)
         Stations along the cable [m]; an element's end node belongs to the next element.
     """
-    q = np.asarray(coordinates, dtype=float).reshape(-1, 6)
-    Le = np.asarray(element_length_m, dtype=float)
-    e, xi = _locate(x_m, Le)
-    w = hermite_derivative_weights(xi, Le[e])
-    d = (w[:, 0, None] * q[e, :3] + w[:, 1, None] * q[e, 3:] + w[:, 2, None] * q[e + 1, :3]
-         + w[:, 3, None] * q[e + 1, 3:])
-    return np.linalg.norm(d, axis=1) - 1.0
+    return TensionStations(element_length_m, x_m).strain(coordinates)
 
 
 def tension_at(coordinates, element_length_m, axial_stiffness_N, x_m) -> np.ndarray:
@@ -62,15 +79,21 @@ def tension_at(coordinates, element_length_m, axial_stiffness_N, x_m) -> np.ndar
     return axial_stiffness_N * axial_strain(coordinates, element_length_m, x_m)
 
 
-def tension_profile(coordinates, element_length_m, axial_stiffness_N, points_per_element: int = 4):
-    """Tension along the whole cable: (x_m, tension_N) at ``points_per_element`` + 1 stations per
-    element including both ends (the end node of each element evaluated from its left element)."""
+def profile_stations_m(element_length_m, points_per_element: int = 4) -> np.ndarray:
+    """:func:`tension_profile`'s stations [m]: ``points_per_element`` + 1 per element including
+    both ends."""
     Le = np.asarray(element_length_m, dtype=float)
     x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
     xi = np.linspace(0.0, 1.0, points_per_element + 1)[:-1]
     x = (x_nodes[:-1, None] + xi[None, :] * Le[:, None]).ravel()
-    x = np.concatenate([x, [x_nodes[-1]]])
-    return x, tension_at(coordinates, Le, axial_stiffness_N, x)
+    return np.concatenate([x, [x_nodes[-1]]])
+
+
+def tension_profile(coordinates, element_length_m, axial_stiffness_N, points_per_element: int = 4):
+    """Tension along the whole cable: (x_m, tension_N) at ``points_per_element`` + 1 stations per
+    element including both ends (the end node of each element evaluated from its left element)."""
+    x = profile_stations_m(element_length_m, points_per_element)
+    return x, tension_at(coordinates, element_length_m, axial_stiffness_N, x)
 
 
 @dataclass(frozen=True)

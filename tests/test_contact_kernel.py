@@ -383,6 +383,28 @@ def test_conduit_ends_are_open(backend):
     assert open_k.evaluate(q, q_t).n_in_contact == inside.sum()
 
 
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_point_segments_are_the_point_states_segments(backend):
+    """point_segments (the compiled backend: its contact search alone) gives the nearest segment
+    of points(): on a bend, and across an open end where points beyond it have none (-1)."""
+    rng = np.random.default_rng(3)
+    route = bend_route()
+    q, q_t, L = random_cable(route, 4, rng)
+    route_end = straight_route(n_seg=3, length=1.2)
+    d = route_end.tangent(np.array([0.0]))[0]
+    p_end = route_end.centre(np.array([route_end.length]))[0]
+    # two elements: one across the exit, one wholly beyond it (no segment near: -1)
+    q_out = np.concatenate([p_end - 0.1 * d, d, p_end + 0.1 * d, d, p_end + 0.3 * d, d])
+    for segs, qq, n_el, length in ((route.segments, q, 4, L), (route_end.segments, q_out, 2, 0.2)):
+        fresh = ContactKernel(segs, length, R_CABLE, SLIDING, 40, n_elements=n_el,
+                              backend=backend)
+        seg = fresh.point_segments(qq)
+        state = ContactKernel(segs, length, R_CABLE, SLIDING, 40, n_elements=n_el,
+                              backend=backend).points(qq, np.zeros_like(qq)).segment
+        np.testing.assert_array_equal(seg, state)
+    assert (seg < 0).any() and (seg >= 0).any()
+
 # ---------------------------------------------------------------------------------------------
 # Jacobians against central finite differences
 # ---------------------------------------------------------------------------------------------

@@ -286,3 +286,28 @@ def test_profiles_of_both_backends_agree(kind, surface):
         a, b = getattr(fast, name), getattr(ref, name)
         assert np.array_equal(np.isnan(a), np.isnan(b)), name
         assert np.nanmax(np.abs(a - b)) <= 1e-10 * scale, name
+
+
+@pytest.mark.parametrize("kind", ["bend", "helix", "sbend"])
+def test_closest_point_angles_from_the_residual_match_newtons(kind):
+    """The profiles' arc length takes Pc's helix angle from the residual the kernel found (a polar
+    angle, no iteration): the same angle as refine_closest_points' Newton iteration (~1e-12 rad),
+    on the pieces and past their ends (clamped), for points anywhere in the conduit."""
+    from exucable.contact.smooth import SmoothWall, closest_point_angles, refine_closest_points
+
+    cond = conduit(kind, segments_per_bend=12)
+    seg = cond.segments
+    wall = SmoothWall(cond.centreline, seg)
+    rng = np.random.default_rng(7)
+    s = rng.uniform(0.0, cond.centreline.length_m, 400)
+    p = cond.centreline.point(s) + rng.uniform(-GAP, GAP, (s.size, 3))
+    d = p[:, None, :] - seg.start_m[None]
+    t_all = np.clip(np.einsum("ijk,jk->ij", d, seg.axis), 0.0, seg.length_m)
+    foot = seg.start_m[None] + t_all[..., None] * seg.axis[None]
+    nearest = np.argmin(np.sum((p[:, None, :] - foot) ** 2, axis=2), axis=1)
+    t = t_all[np.arange(s.size), nearest]
+    mask, residual, _, phi = refine_closest_points(p, nearest, t, seg.length_m, wall)
+    assert mask.sum() > 100
+    mask2, phi2 = closest_point_angles(p, residual, nearest, t, seg.length_m, wall)
+    np.testing.assert_array_equal(mask2, mask)
+    np.testing.assert_allclose(phi2[mask], phi[mask], rtol=0.0, atol=1e-11)

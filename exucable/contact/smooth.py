@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-__all__ = ["SmoothWall", "refine_closest_points", "NEWTON_ITERATIONS"]
+__all__ = ["SmoothWall", "refine_closest_points", "closest_point_angles", "NEWTON_ITERATIONS"]
 
 # Newton steps for a helix: the chord's estimate is within ~1e-3 rad (the sagitta's angle), and
 # the convergence is quadratic: 1e-6 after one step, 1e-12 after two. (Bends need none: closed form.)
@@ -81,6 +81,20 @@ class SmoothWall:
         self.piece_speed_m_per_rad = speed
 
 
+def _on_curved_pieces(seg, t, seg_length, wall: SmoothWall):
+    """The points whose nearest segment (``seg``, -1: none) lies on a curved piece: their mask,
+    indices, piece rows and the chord's estimate of their helix angle [rad] (from the clamped
+    projection parameter ``t`` [m])."""
+    ok = seg >= 0
+    piece = np.where(ok, wall.seg_piece[np.maximum(seg, 0)], 0)
+    mask = ok & (wall.pieces[piece, _CURVED] == 1.0)
+    idx = np.nonzero(mask)[0]
+    s = seg[idx]
+    frac = t[idx] / seg_length[s]
+    estimate = wall.seg_phi[s, 0] + frac * (wall.seg_phi[s, 1] - wall.seg_phi[s, 0])
+    return mask, idx, wall.pieces[piece[idx]], estimate
+
+
 def refine_closest_points(p, seg, t, seg_length, wall: SmoothWall):
     """Exact closest points on the curved pieces (numpy reference; see the module docstring).
 
@@ -110,18 +124,11 @@ def refine_closest_points(p, seg, t, seg_length, wall: SmoothWall):
     residual = np.zeros((m, 3))
     axis_vec = np.zeros((m, 3))
     phi_out = np.zeros(m)
-    ok = seg >= 0
-    piece = np.where(ok, wall.seg_piece[np.maximum(seg, 0)], 0)
-    mask = ok & (wall.pieces[piece, _CURVED] == 1.0)
-    if not mask.any():
+    mask, idx, pc, phi = _on_curved_pieces(seg, t, seg_length, wall)
+    if not idx.size:
         return mask, residual, axis_vec, phi_out
-    idx = np.nonzero(mask)[0]
-    pc = wall.pieces[piece[idx]]
     c, e1, e2, k = pc[:, _C:_C + 3], pc[:, _E1:_E1 + 3], pc[:, _E2:_E2 + 3], pc[:, _K:_K + 3]
     a, h, Phi = pc[:, _A], pc[:, _H], pc[:, _PHI]
-    s = seg[idx]
-    frac = t[idx] / seg_length[s]
-    phi = wall.seg_phi[s, 0] + frac * (wall.seg_phi[s, 1] - wall.seg_phi[s, 0])
     x = p[idx] - c
     x1 = np.sum(x * e1, axis=1)
     x2 = np.sum(x * e2, axis=1)
@@ -148,3 +155,29 @@ def refine_closest_points(p, seg, t, seg_length, wall: SmoothWall):
     axis_vec[idx] = np.sqrt(beta)[:, None] * T
     phi_out[idx] = phic
     return mask, residual, axis_vec, phi_out
+
+
+def closest_point_angles(p, residual, seg, t, seg_length, wall: SmoothWall):
+    """Helix angle φ of each point's closest point Pc = P − (P − Pc) on its curved piece, from
+    the residual a kernel already found (the profiles' arc length; no Newton iteration).
+
+    Pc lies on the helix C(φ) = c + a (cos φ e1 + sin φ e2) + h φ k, so its angle is the polar
+    angle of (Pc − c) in the (e1, e2) plane, unwrapped next to the chord's estimate (a helix may
+    coil more than one turn) and clamped to the piece, [0, Φ]: beyond an end Pc is on the end
+    tangent, whose polar angle runs past the end. The same φ as :func:`refine_closest_points`
+    (there by Newton's method, to ~1e-12 rad), at a fraction of the cost.
+
+    ``p``, ``seg``, ``t``, ``seg_length`` as for :func:`refine_closest_points`; ``residual``
+    (m, 3) is P − Pc on the smooth wall [m]. Returns ``mask`` (points on curved pieces) and
+    ``phi`` [rad] (0 outside ``mask``).
+    """
+    phi_out = np.zeros(p.shape[0])
+    mask, idx, pc, estimate = _on_curved_pieces(seg, t, seg_length, wall)
+    if not idx.size:
+        return mask, phi_out
+    x = p[idx] - residual[idx] - pc[:, _C:_C + 3]
+    polar = np.arctan2(np.einsum("ij,ij->i", x, pc[:, _E2:_E2 + 3]),
+                       np.einsum("ij,ij->i", x, pc[:, _E1:_E1 + 3]))
+    phi = estimate + ((polar - estimate + np.pi) % (2.0 * np.pi) - np.pi)
+    phi_out[idx] = np.clip(phi, 0.0, pc[:, _PHI])
+    return mask, phi_out

@@ -189,6 +189,10 @@ class _SteadyFast:
     def candidates(self, q):
         return self.fast.candidates(q)
 
+    def nearest_segments(self, q):
+        """Contact search only: nearest segment per check point, shape (n_el, n_k) (-1: none)."""
+        return self.fast.nearest_segments(q)
+
     def point_state(self, q, q_t):
         """Per check point state, compiled (tested against the numpy reference's); ``q_t`` is
         ignored: v = V ∂r/∂x."""
