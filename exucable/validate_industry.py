@@ -23,7 +23,8 @@ calculator vendor's page, each cited there and in its scenario file) one row per
   exucable from the rope"); exucable − rope with clearance is what the rope lacks, bending stiffness,
   measured by √(EJ/T)/R on the route's tightest bend. The study there found exucable within 0.1 % of
   the rope with clearance for √(EJ/T)/R ≤ 0.01 (:data:`FLEXIBLE_LIMIT`), which is checked where it
-  applies; beyond it no estimate exists yet and the difference is reported, not judged.
+  applies; beyond it the difference is reported beside two estimates, not judged: the stiff-bend model
+  (:mod:`exucable.stiff_bend`, bend by bend) and the beam in the conduit (:mod:`exucable.beam_conduit`).
 
 Writes ``industry.csv``, ``industry.md`` and ``industry.png`` (each atomically) into the output
 directory, each run's results in ``<out>/<mode>/<example>/level_<k>/``.
