@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from numba import njit
+from .jitcache import njit
 
 from .checkpoints import hermite_unit
 from .kernel import ContactKernel
