@@ -83,10 +83,9 @@ class Compiled:
                 return False
         for k, dtype, ndim in self.arrays:
             a = args[k]
-            if type(a) is not np.ndarray or a.dtype != dtype or a.ndim != ndim:
-                return False
-            flags = a.flags
-            if not (flags.c_contiguous and flags.writeable and flags.aligned):
+            # carray: C-contiguous, aligned and writeable; numpy's dtype objects of native float64
+            # and int64 are singletons (another object of equal dtype only costs the JIT path)
+            if type(a) is not np.ndarray or a.dtype is not dtype or a.ndim != ndim or not a.flags.carray:
                 return False
         return True
 
