@@ -2,16 +2,14 @@
 bit; a run that loads them imports no numba; a stale, missing, unloadable or unwritable module
 falls back to the JIT path.
 
-The module is built once per session if ``python3 dev.py`` (or ``exucable compile``) has not built
-it yet (about 20-40 s); without a C compiler the tests that need it are skipped.
+The module is built once per session (fixture ``aot_module`` in conftest.py) if ``python3 dev.py``
+(or ``exucable compile``) has not built it yet; without a C compiler the tests that need it are
+skipped. That a run with it imports no numba: tests/test_fixed_cost.py.
 """
 
 from __future__ import annotations
 
-import json
-import re
 import shutil
-import subprocess
 import sys
 import warnings
 from pathlib import Path
@@ -25,23 +23,9 @@ from exucable.contact.nearest import NearestSample
 from exucable.contact.steady import SteadySlidingKernel
 from exucable.geometry import Bend, Conduit, Straight, centreline_from_path
 
-ROOT = Path(__file__).resolve().parents[1]
 R_CABLE, R_CONDUIT = 0.0025, 0.0035
 LAW = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.3, static_friction=0.4,
                  stribeck_velocity_m_per_s=0.2, damping_onset_m=1e-4)
-
-
-@pytest.fixture(scope="session")
-def aot_module():
-    """The valid module for this checkout and machine (built here if missing)."""
-    path = aot.find()
-    if path is None:
-        try:
-            path, _ = aot_build.build()
-        except RuntimeError as exc:     # no C compiler, no writable directory
-            pytest.skip(f"cannot build the ahead-of-time kernels: {exc}")
-    aot.reset()
-    return path
 
 
 @pytest.fixture
@@ -140,22 +124,6 @@ def test_other_argument_types_go_to_the_jit_path(aot_module, mode):
     assert not compiled.accepts((points, frozen, start, centre, radius, out))
 
 
-def test_a_run_with_the_compiled_kernels_imports_no_numba(aot_module, tmp_path):
-    text = (ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml").read_text()
-    text = re.sub(r"(?m)^end_time = .*$", "end_time = 0.001", text)
-    text = re.sub(r"(?m)^step = .*$", "step = 1.0e-3", text)
-    scenario = tmp_path / "trivial.toml"
-    scenario.write_text(text)
-    code = (f"import sys, json\nfrom exucable.run import run_scenario\n"
-            f"run_scenario({str(scenario)!r}, {str(tmp_path / 'out')!r}, plots=False)\n"
-            "print(json.dumps(sorted(m for m in sys.modules if m.split('.')[0] in ('numba', 'llvmlite'))))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=600,
-                         env=_environment(EXUCABLE_KERNELS=None))
-    assert out.returncode == 0, out.stderr[-2000:]
-    assert json.loads(out.stdout.strip().splitlines()[-1]) == []
-    assert (tmp_path / "out" / "summary.json").exists()
-
-
 def test_the_key_follows_the_kernel_sources(tmp_path):
     copy = tmp_path / "contact"
     shutil.copytree(Path(aot.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
@@ -205,15 +173,3 @@ def test_without_a_writable_directory_compile_fails_clearly_and_runs_use_the_jit
         assert NearestSample(np.eye(3))(np.array([[0.9, 0.0, 0.1]]))[0] == 0
     finally:
         aot.reset()
-
-
-def _environment(**changes):
-    import os
-
-    env = dict(os.environ)
-    for name, value in changes.items():
-        if value is None:
-            env.pop(name, None)
-        else:
-            env[name] = value
-    return env

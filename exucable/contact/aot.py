@@ -19,7 +19,9 @@ At run time (:func:`exported`, on a kernel's first call): a valid module is load
 every call whose arguments have the exact types it was compiled for; otherwise (no module, stale,
 unloadable, other argument types, or ``EXUCABLE_KERNELS=jit`` in the environment) the call goes to
 numba's JIT dispatcher as before, cached on disk. An unloadable module warns once; a missing one
-is the normal state before ``exucable compile`` and is silent.
+is the normal state before ``exucable compile`` and is silent. Unlike the ``nogil`` dispatchers,
+the exports hold the GIL while they run (pycc's wrappers do not release it); exucable runs one
+case per process, so nothing waits on it.
 """
 
 from __future__ import annotations
