@@ -99,11 +99,11 @@ class Kernel:
     def _numba_type_(self):
         return self.dispatcher._numba_type_
 
-    def __call__(self, *args):
-        compiled = exported(self.name)
+    def __call__(self, *args, **kwargs):
+        compiled = exported(self.name) if not kwargs else None   # the exports take positional arguments
         if compiled is not None and compiled.accepts(args):
             return compiled.function(*args)
-        return self.dispatcher(*args)
+        return self.dispatcher(*args, **kwargs)
 
     def __repr__(self):
         return f"<exucable kernel {self.name}>"
