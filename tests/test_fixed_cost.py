@@ -28,7 +28,10 @@ def modules_after_a_trivial_run(tmp_path, **environment) -> set[str]:
             "print(json.dumps(sorted(m for m in sys.modules if '.' not in m or m.startswith('scipy.'))))")
     env = dict(os.environ)
     for name, value in environment.items():
-        env.pop(name, None) if value is None else env.__setitem__(name, value)
+        if value is None:
+            env.pop(name, None)
+        else:
+            env[name] = value
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=600,
                          env=env)
     assert out.returncode == 0, out.stderr[-2000:]
