@@ -167,9 +167,20 @@ def test_without_a_writable_directory_compile_fails_clearly_and_runs_use_the_jit
     monkeypatch.delenv(aot.MODE_VARIABLE, raising=False)
     aot.reset()
     try:
-        with pytest.raises(RuntimeError, match="NUMBA_CACHE_DIR"):
+        with pytest.raises(aot_build.CompilerUnavailable, match="NUMBA_CACHE_DIR"):
             aot_build.build()
         assert aot.find() is None and aot.exported("nearest._nearest") is None
         assert NearestSample(np.eye(3))(np.array([[0.9, 0.0, 0.1]]))[0] == 0
     finally:
         aot.reset()
+
+
+def test_the_compile_command_says_whether_the_module_is_up_to_date(aot_module, monkeypatch, capsys):
+    from exucable.cli import main
+
+    assert main(["compile", "--check"]) == 0
+    assert str(aot_module) in capsys.readouterr().out
+    monkeypatch.setattr(aot, "key", lambda sources=None: "0" * 24)       # as after an edit of a kernel
+    assert main(["compile", "--check"]) == 1
+    assert "exucable compile" in capsys.readouterr().out
+    aot.reset()

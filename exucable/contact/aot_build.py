@@ -15,9 +15,13 @@ from pathlib import Path
 from ..io import atomic_write_bytes
 from . import aot, broadphase, fast, nearest, steady
 
-__all__ = ["build", "numba_argtypes"]
+__all__ = ["CompilerUnavailable", "build", "numba_argtypes"]
 
 _MODULES = {"fast": fast, "steady": steady, "broadphase": broadphase, "nearest": nearest}
+
+
+class CompilerUnavailable(RuntimeError):
+    """No C compiler, no pycc or no writable directory: the kernels stay numba's JIT ones."""
 
 
 def _writable(directory: Path) -> bool:
@@ -35,19 +39,23 @@ def build(directory: Path | None = None) -> tuple[Path, float]:
 
     Writes it atomically to ``directory`` or the first writable of :func:`directories`, removes
     modules of older keys there, and returns (path, seconds). Imports numba; compiles (and caches)
-    the JIT kernels first if they are not cached. Raises RuntimeError when no directory is writable
-    or the C compiler fails.
+    the JIT kernels first if they are not cached. Raises :class:`CompilerUnavailable` when no
+    directory is writable or pycc or the C compiler fails, RuntimeError when a kernel does not
+    compile for its row of the table.
     """
     t0 = time.perf_counter()
     candidates = [Path(directory)] if directory is not None else aot.directories()
     target = next((d for d in candidates if _writable(d)), None)
     if target is None:
-        raise RuntimeError("no writable directory for the compiled kernels among "
-                           f"{', '.join(map(str, candidates))}; set NUMBA_CACHE_DIR to a writable directory")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")          # pycc is deprecated (numba 0.68 ships it and it works)
-        from numba.core import types
-        from numba.pycc import CC
+        raise CompilerUnavailable("no writable directory for the compiled kernels among "
+                                  f"{', '.join(map(str, candidates))}; set NUMBA_CACHE_DIR to a writable directory")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")          # pycc is deprecated (numba 0.68 ships it and it works)
+            from numba.core import types
+            from numba.pycc import CC
+    except ImportError as exc:                       # a numba without pycc, a Python without distutils
+        raise CompilerUnavailable(f"numba's pycc cannot be imported: {exc}") from exc
     module_key = aot.key()
     cc = CC(aot.MODULE_NAME)
     cc.target_cpu = "host"
@@ -56,7 +64,11 @@ def build(directory: Path | None = None) -> tuple[Path, float]:
         module, function = name.split(".")
         dispatcher = getattr(_MODULES[module], function).dispatcher
         argtypes = numba_argtypes(tokens, types)
-        dispatcher.compile(argtypes)
+        try:
+            dispatcher.compile(argtypes)
+        except Exception as exc:
+            raise RuntimeError(f"{name} does not compile for the argument types of exucable/contact/aot.py's "
+                               f"KERNELS table ({tokens!r}); update the table to its call sites: {exc}") from exc
         returns = dispatcher.overloads[argtypes].signature.return_type
         cc.export(aot.export_name(name), returns(*argtypes))(_call_through(dispatcher, len(argtypes)))
     with tempfile.TemporaryDirectory(prefix="exucable-kernels-") as tmp:
@@ -67,7 +79,7 @@ def build(directory: Path | None = None) -> tuple[Path, float]:
                 warnings.simplefilter("ignore")
                 cc.compile()
         except Exception as exc:   # distutils/setuptools report a missing compiler in several ways
-            raise RuntimeError(f"compiling the kernels failed: {exc}") from exc
+            raise CompilerUnavailable(f"compiling the kernels failed: {exc}") from exc
         built = Path(tmp) / aot.filename(module_key)
         path = atomic_write_bytes(target / built.name, built.read_bytes())
         os.chmod(path, 0o755)            # as the compiler left it (the temporary file was private)
