@@ -17,8 +17,8 @@ and the second the weight component along the cable. The bearing pressure is
 On a straight incline this gives the paper's Eq. (25); without weight it gives the capstan law, Eq. (26).
 
 The centreline only needs the interface of :mod:`exucable.geometry`'s ``Centreline``: ``length_m``,
-``pieces`` (each with ``s_start_m`` and ``length_m``), ``tangent(s)``, ``curvature_vector(s)`` and
-``reversed()``.
+``pieces`` (each with ``s_start_m``, ``length_m`` and ``tangent_and_curvature_fn()``), ``tangent(s)``,
+``curvature_vector(s)`` and ``reversed()``.
 """
 
 from __future__ import annotations
@@ -168,15 +168,16 @@ def _evaluate_branches(branches, s: np.ndarray) -> np.ndarray:
     return out
 
 
-def _piece_intervals(centreline, s_from: float, s_to: float) -> list[tuple[float, float, float, float]]:
-    """Pieces clipped to [s_from, s_to] as (lo, hi, piece_lo, piece_hi) [m], in order; empty ones dropped."""
+def _piece_intervals(centreline, s_from: float, s_to: float) -> list[tuple[float, float, float, float, object]]:
+    """Pieces clipped to [s_from, s_to] as (lo, hi, piece_lo, piece_hi) [m] and the piece, in order;
+    empty ones dropped."""
     out = []
     for piece in sorted(centreline.pieces, key=lambda p: p.s_start_m):
         a = float(piece.s_start_m)
         b = a + float(piece.length_m)
         lo, hi = max(a, s_from), min(b, s_to)
         if hi - lo > 1e-14 * max(1.0, abs(s_to)):
-            out.append((lo, hi, a, b))
+            out.append((lo, hi, a, b, piece))
     return out
 
 
@@ -270,16 +271,20 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
     branches = []
     slack_seen = False
     tension = float(trailing_N)
-    for lo, hi, plo, phi in _piece_intervals(curve, s0, s1):
+    for lo, hi, plo, phi, piece in _piece_intervals(curve, s0, s1):
         s_min, s_max = _inside(plo, phi)
         curved = bool(np.linalg.norm(_as_rows(curve.curvature_vector(np.array([0.5 * (lo + hi)])), 1)[0]) > 0.0)
         mu = mu_curved if (curved and mu_curved is not None) else mu_straight
 
-        def rate(s, y, s_min=s_min, s_max=s_max, mu_here=mu):
+        def rate(s, y, s_min=s_min, s_max=s_max, mu_here=mu, frame=piece.tangent_and_curvature_fn(), s_piece=plo):
             # s is clamped into the piece so that RK stages at the piece's end use this piece's curvature.
+            # The sidewall load T κn − w (e_z − (e_z·t) t) of _transverse_load in plain floats: DOP853
+            # calls this ~100 times a piece, and numpy's overhead on 3-vectors was 90 % of its cost.
             sc = min(max(s, s_min), s_max)
-            load, tz = _transverse_load(curve, np.array([sc]), np.array([y[0]]), w)
-            return [mu_here * np.linalg.norm(load[0]) + w * tz[0]]
+            (tx, ty, tz), (kx, ky, kz) = frame(sc - s_piece)
+            T = float(y[0])
+            load = math.hypot(T * kx + w * tz * tx, T * ky + w * tz * ty, T * kz - w * (1.0 - tz * tz))
+            return [mu_here * load + w * tz]
 
         def g0(s, rate=rate):
             return rate(s, [0.0])[0]
@@ -433,15 +438,17 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
     pressure = sidewall_pressure_N_per_m(curve, s_curve, tension, w)
 
     # Maxima over the output grid plus the integrator's nodes, each evaluated inside its own piece.
-    max_t = float(np.max(tension))
-    max_p = float(np.max(pressure))
-    for b in raw_branches:
-        s_lo, s_hi, plo, phi, fn, nodes = b
-        pts = np.concatenate([nodes, [s_lo, s_hi], s_curve[(s_curve >= s_lo) & (s_curve <= s_hi)]])
-        pts = np.clip(pts, *_inside(plo, phi))
-        tens = fn(pts)
-        max_t = max(max_t, float(np.max(tens)))
-        max_p = max(max_p, float(np.max(sidewall_pressure_N_per_m(curve, pts, tens, w))))
+    # (one pressure evaluation for all branches: each point lies inside its own piece, so the
+    # centreline answers for it as it would alone)
+    pts, tens = [], []
+    for s_lo, s_hi, plo, phi, fn, nodes in raw_branches:
+        p = np.clip(np.concatenate([nodes, [s_lo, s_hi], s_curve[(s_curve >= s_lo) & (s_curve <= s_hi)]]),
+                    *_inside(plo, phi))
+        pts.append(p)
+        tens.append(fn(p))
+    pts, tens = np.concatenate(pts), np.concatenate(tens)
+    max_t = max(float(np.max(tension)), float(np.max(tens)))
+    max_p = max(float(np.max(pressure)), float(np.max(sidewall_pressure_N_per_m(curve, pts, tens, w))))
 
     s_conduit = s_curve if direction == "forward" else conduit_length - s_curve
     return RopeSolution(
