@@ -36,7 +36,7 @@ from exucable.errors import ModelError
 # (with the scipy.spatial, scipy.sparse and scipy.special they pull in) is a third of a second of an
 # `exucable run` of such a route (issue 15, fixed cost).
 
-__all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "sidewall_pressure_N_per_m"]
+__all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "rope_pull_force_N", "sidewall_pressure_N_per_m"]
 
 # solve_ivp tolerances. DOP853 at rtol 1e-11 reproduces the closed forms to ~1e-12 relative; the absolute
 # tolerance only matters where T passes close to zero (slack onset) and is set far below any force of interest.
@@ -367,6 +367,13 @@ def _validate(centreline, friction, w, direction, cable_length_m):
     return mu, w, min(length, conduit_length), conduit_length
 
 
+def _trailing_tension(value) -> float:
+    trailing = float(value)
+    if not np.isfinite(trailing) or trailing < 0.0:
+        raise ModelError("trailing_tension_N", f"trailing tension must be finite and >= 0, got {value!r}")
+    return trailing
+
+
 def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0.0, trailing_tension_N: float = 0.0,
                direction: str = "forward", cable_length_m: float | None = None, n_output: int = 801,
                bend_friction: float | None = None) -> RopeSolution:
@@ -415,9 +422,7 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
         bend_mu = None
     mu, w, length, conduit_length = _validate(centreline, friction, weight_per_length_N_per_m, direction,
                                               cable_length_m)
-    trailing = float(trailing_tension_N)
-    if not np.isfinite(trailing) or trailing < 0.0:
-        raise ModelError("trailing_tension_N", f"trailing tension must be finite and >= 0, got {trailing_tension_N!r}")
+    trailing = _trailing_tension(trailing_tension_N)
     if int(n_output) < 2:
         raise ModelError("n_output", "n_output must be >= 2")
     curve = centreline if direction == "forward" else centreline.reversed()
@@ -464,6 +469,19 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
         slack=bool(slack),
         _branches=branches,
     )
+
+
+def rope_pull_force_N(centreline, friction: float, weight_per_length_N_per_m: float = 0.0,
+                      trailing_tension_N: float = 0.0, direction: str = "forward",
+                      cable_length_m: float | None = None) -> float:
+    """The pulling force [N] of :func:`solve_rope` alone, bit for bit: the same integration without
+    its dense output, tension profile and maxima (for a caller that needs only the force, such as
+    :func:`exucable.model.layout.steady_lead_out_m`'s rule). Parameters as in :func:`solve_rope`."""
+    mu, w, length, conduit_length = _validate(centreline, friction, weight_per_length_N_per_m, direction,
+                                              cable_length_m)
+    trailing = _trailing_tension(trailing_tension_N)
+    curve = centreline if direction == "forward" else centreline.reversed()
+    return float(_integrate(curve, mu, w, conduit_length - length, conduit_length, trailing, dense=False)[0])
 
 
 def _shifted(fn, offset, lo, hi):

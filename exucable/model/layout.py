@@ -483,7 +483,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     InitialLayout
     """
     from ..errors import ModelError
-    from ..rope import solve_rope, solve_rope_for_pull_force
+    from ..rope import rope_pull_force_N, solve_rope, solve_rope_for_pull_force
 
     sc = scenario
     conduit = sc.build_conduit()
@@ -501,16 +501,26 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
             return solve_rope_for_pull_force(centre, pull_force_N=sc.pull.force_N, **common, cable_length_m=length_m)
         return solve_rope(centre, trailing_tension_N=sc.pull.back_tension_N, **common, cable_length_m=length_m)
 
-    rope = rope_for(L_cable)
+    full = None          # the rope of the whole cable inside, where the lead-out rule needed it
     lead_out = 0.0
     if sc.solver.pretension and (sc.solver.mode == "steady" or (sc.solver.start_from == "steady" and sc.pull.force_N is None)):
-        lead_out = (steady_lead_out_m(centre, c.bending_stiffness_N_m2, rope.pull_force_N)
-                    if sc.solver.steady_lead_out_m is None else float(sc.solver.steady_lead_out_m))
+        if sc.solver.steady_lead_out_m is not None:
+            lead_out = float(sc.solver.steady_lead_out_m)
+        else:
+            # the rule needs the whole cable's exit tension only: its force alone (no profile) for a
+            # velocity-controlled pull, whose rope is then solved once, for the cable as laid
+            if sc.pull.force_N is None:
+                exit_N = rope_pull_force_N(centre, trailing_tension_N=sc.pull.back_tension_N, **common,
+                                           cable_length_m=L_cable)
+            else:
+                full = rope_for(L_cable)
+                exit_N = full.pull_force_N
+            lead_out = steady_lead_out_m(centre, c.bending_stiffness_N_m2, exit_N)
         if lead_out >= L_cable:
             raise ModelError("solver.steady_lead_out", f"{lead_out:.4g} m laid out past the exit leaves none of the "
                              f"{L_cable:.4g} m cable in the conduit; give less than the cable's length")
-        if lead_out > 0.0:
-            rope = rope_for(L_cable - lead_out)    # the reference of the cable as laid: less inside
+    # the reference of the cable as laid: less inside by the lead-out
+    rope = full if full is not None and lead_out == 0.0 else rope_for(L_cable - lead_out)
     clearance = conduit.inner_radius_m - c.radius_m
     mesh = plan_cable_mesh(sc, conduit, rope, refine, check_points_per_element)
     n_el = mesh.elements
