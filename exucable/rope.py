@@ -259,6 +259,21 @@ def _closed_form(curve, s_min: float, s_max: float, mu: float, w: float):
     return None
 
 
+class _OnePiece:
+    """One piece of a centreline answering ``tangent`` and ``curvature_vector`` at centreline arc
+    lengths inside it, as the centreline would (the same piece method at the same local arc
+    length), without the centreline's range check and piece lookup."""
+
+    def __init__(self, piece):
+        self.piece = piece
+
+    def tangent(self, s_m):
+        return self.piece.tangent(np.asarray(s_m, dtype=float) - self.piece.s_start_m)
+
+    def curvature_vector(self, s_m):
+        return self.piece.curvature_vector(np.asarray(s_m, dtype=float) - self.piece.s_start_m)
+
+
 def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, trailing_N: float, dense: bool,
                mu_curved: float | None = None):
     """Integrate the rope ODE from s0 to s1 on ``curve``; return (T(s1) [N], branches, slack).
@@ -273,7 +288,8 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
     tension = float(trailing_N)
     for lo, hi, plo, phi, piece in _piece_intervals(curve, s0, s1):
         s_min, s_max = _inside(plo, phi)
-        curved = bool(np.linalg.norm(_as_rows(curve.curvature_vector(np.array([0.5 * (lo + hi)])), 1)[0]) > 0.0)
+        local = _OnePiece(piece)
+        curved = bool(np.linalg.norm(_as_rows(local.curvature_vector(np.array([0.5 * (lo + hi)])), 1)[0]) > 0.0)
         mu = mu_curved if (curved and mu_curved is not None) else mu_straight
 
         def rate(s, y, s_min=s_min, s_max=s_max, mu_here=mu, frame=piece.tangent_and_curvature_fn(), s_piece=plo):
@@ -294,7 +310,7 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
 
         hits_zero.terminal = True
         hits_zero.direction = -1.0
-        exact = _closed_form(curve, s_min, s_max, mu, w)
+        exact = _closed_form(local, s_min, s_max, mu, w)
 
         s = lo
         for _ in range(10_000):  # guard: every pass advances s (a slack stretch or an ODE run)
