@@ -144,40 +144,29 @@ def _jacobian_moments(tab, basis, mom):
             x = ja[k]
             y = jb[k]
             z = jc[k]
-            v = b0[k]
-            a0 += v * x
-            c0 += v * y
-            d0 += v * z
-            v = b1[k]
-            a1 += v * x
-            c1 += v * y
-            d1 += v * z
-            v = b2[k]
-            a2 += v * x
-            c2 += v * y
-            d2 += v * z
-            v = b3[k]
-            a3 += v * x
-            c3 += v * y
-            d3 += v * z
-            v = b4[k]
-            a4 += v * x
-            c4 += v * y
-            d4 += v * z
-            v = b5[k]
-            a5 += v * x
-            c5 += v * y
-            d5 += v * z
-            v = b6[k]
-            a6 += v * x
-            c6 += v * y
-            d6 += v * z
-        mom[0, col], mom[1, col], mom[2, col], mom[3, col] = a0, a1, a2, a3
-        mom[4, col], mom[5, col], mom[6, col] = a4, a5, a6
-        mom[0, col + 1], mom[1, col + 1], mom[2, col + 1], mom[3, col + 1] = c0, c1, c2, c3
-        mom[4, col + 1], mom[5, col + 1], mom[6, col + 1] = c4, c5, c6
-        mom[0, col + 2], mom[1, col + 2], mom[2, col + 2], mom[3, col + 2] = d0, d1, d2, d3
-        mom[4, col + 2], mom[5, col + 2], mom[6, col + 2] = d4, d5, d6
+            a0, c0, d0 = _add_products(b0[k], x, y, z, a0, c0, d0)
+            a1, c1, d1 = _add_products(b1[k], x, y, z, a1, c1, d1)
+            a2, c2, d2 = _add_products(b2[k], x, y, z, a2, c2, d2)
+            a3, c3, d3 = _add_products(b3[k], x, y, z, a3, c3, d3)
+            a4, c4, d4 = _add_products(b4[k], x, y, z, a4, c4, d4)
+            a5, c5, d5 = _add_products(b5[k], x, y, z, a5, c5, d5)
+            a6, c6, d6 = _add_products(b6[k], x, y, z, a6, c6, d6)
+        _store_moments(mom, col, a0, a1, a2, a3, a4, a5, a6)
+        _store_moments(mom, col + 1, c0, c1, c2, c3, c4, c5, c6)
+        _store_moments(mom, col + 2, d0, d1, d2, d3, d4, d5, d6)
+
+
+@njit(inline="always", **_JIT)
+def _add_products(v, x, y, z, sx, sy, sz):
+    """(sx + v x, sy + v y, sz + v z): one basis value into three running sums."""
+    return sx + v * x, sy + v * y, sz + v * z
+
+
+@njit(inline="always", **_JIT)
+def _store_moments(mom, col, s0, s1, s2, s3, s4, s5, s6):
+    """The seven moments of column ``col``."""
+    mom[0, col], mom[1, col], mom[2, col], mom[3, col] = s0, s1, s2, s3
+    mom[4, col], mom[5, col], mom[6, col] = s4, s5, s6
 
 
 @njit(inline="always", **_JIT)
