@@ -1,4 +1,5 @@
-"""Shared helpers for the tests: scenarios built from dicts (the TOML contract)."""
+"""Shared helpers for the tests: scenarios built from dicts (the TOML contract), the ahead-of-time
+kernel module."""
 
 from __future__ import annotations
 
@@ -36,3 +37,19 @@ def make_scenario(**tables):
 @pytest.fixture
 def scenario_factory():
     return make_scenario
+
+
+@pytest.fixture(scope="session")
+def aot_module():
+    """The valid ahead-of-time kernel module for this checkout and machine (tests/test_aot.py), built
+    here if ``python3 dev.py`` or ``exucable compile`` has not built it (about 10-40 s)."""
+    from exucable.contact import aot, aot_build
+
+    path = aot.find()
+    if path is None:
+        try:
+            path, _ = aot_build.build()
+        except aot_build.CompilerUnavailable as exc:     # a kernel that does not compile fails the test
+            pytest.skip(f"cannot build the ahead-of-time kernels: {exc}")
+    aot.reset()
+    return path

@@ -628,7 +628,7 @@ def test_numba_cache_and_first_call_in_fresh_process():
     """The compiled kernel is cached on disk and a new process imports and runs it."""
     from exucable.contact import fast
 
-    assert type(fast._contact_kernel._cache).__name__ != "NullCache"
+    assert type(fast._contact_kernel.dispatcher._cache).__name__ != "NullCache"
     code = textwrap.dedent("""
         import numpy as np
         from exucable.contact import ContactKernel, ContactLaw
@@ -649,22 +649,24 @@ def test_numba_cache_and_first_call_in_fresh_process():
 def test_kernel_imports_and_runs_when_no_cache_directory_is_writable():
     """Numba finds no writable cache directory (simulated by offering it only a locator that
     never applies: IPython's): exucable warns once per compiled module, with the fix, instead of
-    failing at import, and compiles in memory (checked on the broad phase, which compiles in a
-    second; the kernel's own compilation takes tens of seconds and is the same code path)."""
+    failing, and compiles in memory (checked on the broad phase, which compiles in a second; the
+    kernel's own compilation takes tens of seconds and is the same code path). The JIT path is
+    forced: the ahead-of-time module (tests/test_aot.py) would serve the call without numba."""
     code = textwrap.dedent("""
         import warnings
         warnings.simplefilter("always")
         with warnings.catch_warnings(record=True) as caught:
             from exucable.contact import broadphase, fast
-        print(type(fast._contact_kernel._cache).__name__,
+            fast._contact_kernel.dispatcher, fast._points_kernel.dispatcher, broadphase._element_boxes.dispatcher
+        print(type(fast._contact_kernel.dispatcher._cache).__name__,
               len([w for w in caught if "NUMBA_CACHE_DIR" in str(w.message)]))
         import numpy as np
         lo, hi = np.empty((1, 3)), np.empty((1, 3))
         broadphase._element_boxes(np.array([0.0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0]), np.array([1.0]),
                                   0.01, lo, hi)
-        print(type(broadphase._element_boxes._cache).__name__, np.allclose(lo[0], [-0.01] * 3))
+        print(type(broadphase._element_boxes.dispatcher._cache).__name__, np.allclose(lo[0], [-0.01] * 3))
     """)
-    env = dict(os.environ, NUMBA_CACHE_LOCATOR_CLASSES="IPythonCacheLocator")
+    env = dict(os.environ, NUMBA_CACHE_LOCATOR_CLASSES="IPythonCacheLocator", EXUCABLE_KERNELS="jit")
     env.pop("NUMBA_CACHE_DIR", None)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=300, env=env)

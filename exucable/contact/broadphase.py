@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .jitcache import njit
+
 __all__ = [
     "element_aabbs",
     "sweep_axis",
@@ -33,22 +35,10 @@ __all__ = [
     "candidates_all_segments",
 ]
 
-try:  # numba is a dependency, but the numpy reference must not need it
-    from numba import njit as _njit
-
-    from .jitcache import jit_cache_available
-
-    def _cache_probe():
-        """Stands for this file's functions in the check for a writable numba cache."""
-
-    _CACHE = jit_cache_available(_cache_probe)
-
-    def _jit(func):
-        return _njit(cache=_CACHE, nogil=True)(func)
-
-except ImportError:  # pragma: no cover - exercised only without numba
-    def _jit(func):
-        return func
+def _jit(func):
+    """Compiled by numba (or ahead of time, see .jitcache); runs as Python when numba is missing,
+    so that the numpy reference never needs it."""
+    return njit(nogil=True)(func)
 
 
 def element_aabbs(q: np.ndarray, element_length_m: np.ndarray, cable_radius_m: float):

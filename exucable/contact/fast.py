@@ -13,9 +13,10 @@ One pass per element, each step a loop over the element's check points over cont
   products N_a N_b tabulated once (unit element length, scaled by L afterwards);
 - nothing is allocated inside the loops.
 
-Compiled with ``cache=True``: the first call in a fresh environment compiles (a few seconds),
-later processes load the machine code from disk (where: :mod:`.jitcache`). A :class:`FastKernel` owns its work
-buffers: use one per thread.
+Run ahead-of-time compiled when ``exucable compile`` built them (numba is then not imported),
+else compiled by numba with ``cache=True``: the first call in a fresh environment compiles (a few
+seconds), later processes load the machine code from disk (where, and the choice: :mod:`.jitcache`).
+A :class:`FastKernel` owns its work buffers: use one per thread.
 """
 
 from __future__ import annotations
@@ -23,10 +24,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from .broadphase import SweepBroadPhase, candidates_all_segments
-from .jitcache import jit_cache_available
+from .jitcache import njit
 from .smooth import NEWTON_ITERATIONS
 
 __all__ = ["FastKernel"]
@@ -42,13 +42,8 @@ _PAIRS = np.array([(a, b) for a in range(4) for b in range(a, 4)], dtype=np.int6
 _SEG_COLUMNS = 10
 
 
-def _cache_probe():
-    """Stands for this file's functions in the check for a writable numba cache."""
-
-
-# cached on disk where numba can write (see .jitcache: where, and what happens when it cannot)
-_CACHE = jit_cache_available(_cache_probe)
-_JIT = dict(cache=_CACHE, fastmath=_FASTMATH, nogil=True, error_model="numpy")
+# cached on disk where numba can write (.jitcache adds cache=...: where, and what happens when it cannot)
+_JIT = dict(fastmath=_FASTMATH, nogil=True, error_model="numpy")
 
 # Rows of the per-element work table, one column per check point. Each loop below reads and
 # writes contiguous rows; LLVM vectorises a loop only while the number of runtime alias checks
@@ -467,7 +462,7 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
     return n_contact, max_pen
 
 
-@njit(cache=_CACHE, fastmath=_FASTMATH | {"nnan"}, nogil=True, error_model="numpy")
+@njit(fastmath=_FASTMATH | {"nnan"}, nogil=True, error_model="numpy")
 def _max_finite(x, n):
     """Largest finite entry of x[:n], -1 if none (x >= 0 or inf, never NaN: lets it vectorise)."""
     m = -1.0

@@ -27,6 +27,7 @@ derivatives, so for a stable contact ∂Q/∂q is negative semi-definite in the 
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass
 
 import numpy as np
@@ -255,11 +256,8 @@ class ContactKernel:
         self._seg_hi = np.ascontiguousarray(segments.aabb_max_m)
 
         if backend == "auto":
-            try:
-                import numba  # noqa: F401
-                backend = "numba"
-            except ImportError:  # pragma: no cover
-                backend = "numpy"
+            # found, not imported: with the ahead-of-time kernels a run never imports numba (.jitcache)
+            backend = "numba" if importlib.util.find_spec("numba") is not None else "numpy"
         self.backend = backend
         # the one switch: every call below goes to this object
         if backend == "numba":

@@ -30,7 +30,7 @@ from dataclasses import replace
 from math import comb
 
 import numpy as np
-from numba import njit
+from .jitcache import njit
 
 from .checkpoints import hermite_unit
 from .kernel import ContactKernel
