@@ -9,7 +9,7 @@ runs as one compiled loop over the points, except the polar angle of Pc on a ben
 goes through the numpy form's own :func:`~exucable.contact.smooth.angles_on_pieces` (its
 ``arctan2`` and ``einsum`` may round differently from a compiled ``atan2`` and dot product, by an
 ulp). Everything else is elementwise arithmetic in the numpy form's order, without fast-math, so
-both give the same bits (``tests/test_contact_profiles.py``). On Example 4's 80 000 check points
+both give the same bits (``tests/test_contact_smooth.py``). On Example 4's 80 000 check points
 the numpy form spends ~15 ms gathering segment and piece rows for every point; this, ~2 ms.
 """
 
