@@ -180,7 +180,7 @@ def _near_end(s, F, s_end_m: float, reach_m: float):
     on each side: all that :func:`bend_end_point_load` looks at (its selections lie within the
     reach; the first point past its window is at most the next one out), as contiguous slices, so
     that its sums run over the same numbers in the same order as over the whole route (Example 4:
-    78 400 points, six ends, 5 ms → 0.5 ms). Unsorted input is returned whole."""
+    78 400 points on the route, a few thousand near an end). Unsorted input is returned whole."""
     if s.size < 2 or not np.all(s[1:] >= s[:-1]):
         return s, F
     margin = reach_m * (1.0 + 1e-9) + 1e-9          # beyond the rounding of u = ±(s − s_end)
