@@ -10,7 +10,7 @@ goes through the numpy form's own :func:`~exucable.contact.smooth.angles_on_piec
 ``arctan2`` and ``einsum`` may round differently from a compiled ``atan2`` and dot product, by an
 ulp). Everything else is elementwise arithmetic in the numpy form's order, without fast-math, so
 both give the same bits (``tests/test_contact_smooth.py``). On Example 4's 80 000 check points
-the numpy form spends ~15 ms gathering segment and piece rows for every point; this, ~2 ms.
+the numpy form spends ~15 ms gathering segment and piece rows for every point; this, 2-3 ms.
 """
 
 from __future__ import annotations
@@ -33,15 +33,16 @@ def _cache_probe():
 _JIT = dict(cache=jit_cache_available(_cache_probe), nogil=True, error_model="numpy")
 
 # piece table columns (exucable.contact.smooth)
-_C, _CURVED = 0, 15
+_C, _E1, _E2, _PHI, _CURVED = 0, 3, 6, 14, 15
 
 
 @njit(**_JIT)
 def _profiles(p, seg, residual, gap, seg_start, seg_axis, seg_length, s_vertex, smooth, seg_piece,
-              pieces, seg_phi, penetration, normal, s_conduit, curved, piece, estimate, relative):
+              pieces, seg_phi, penetration, normal, s_conduit, curved, piece, estimate, relative, e1, e2,
+              phi_max):
     """Fill δ, n and the segments' arc length of every point; list the points on curved pieces
-    (``curved``, their ``piece``, the chord's ``estimate`` of φ and Pc − c in ``relative``) for
-    the angles. Returns how many were listed."""
+    (``curved``, their ``piece``, the chord's ``estimate`` of φ, Pc − c in ``relative``, the
+    piece's axes ``e1``, ``e2`` and angle ``phi_max``) for the angles. Returns how many."""
     n_curved = 0
     for i in range(seg.shape[0]):
         r0, r1, r2 = residual[i, 0], residual[i, 1], residual[i, 2]
@@ -79,6 +80,10 @@ def _profiles(p, seg, residual, gap, seg_start, seg_axis, seg_length, s_vertex, 
         relative[n_curved, 0] = p[i, 0] - r0 - pieces[k, _C]
         relative[n_curved, 1] = p[i, 1] - r1 - pieces[k, _C + 1]
         relative[n_curved, 2] = p[i, 2] - r2 - pieces[k, _C + 2]
+        for j in range(3):
+            e1[n_curved, j] = pieces[k, _E1 + j]
+            e2[n_curved, j] = pieces[k, _E2 + j]
+        phi_max[n_curved] = pieces[k, _PHI]
         n_curved += 1
     return n_curved
 
@@ -112,6 +117,7 @@ def point_profiles(p, seg, residual, gap_m: float, segments, wall=None):
     n_list = m if smooth else 0
     curved, piece = np.empty(n_list, dtype=np.int64), np.empty(n_list, dtype=np.int64)
     estimate, relative = np.empty(n_list), np.empty((n_list, 3))
+    e1, e2, phi_max = np.empty((n_list, 3)), np.empty((n_list, 3)), np.empty(n_list)
     tables = ((wall.seg_piece, wall.pieces, wall.seg_phi) if smooth
               else (np.zeros(1, dtype=np.int64), np.zeros((1, 16)), np.zeros((1, 2))))
     n_curved = _profiles(np.ascontiguousarray(p, dtype=float), np.ascontiguousarray(seg, dtype=np.int64),
@@ -120,10 +126,11 @@ def point_profiles(p, seg, residual, gap_m: float, segments, wall=None):
                          np.ascontiguousarray(segments.axis, dtype=float),
                          np.ascontiguousarray(segments.length_m, dtype=float),
                          np.ascontiguousarray(segments.s_vertex_m, dtype=float), smooth, *tables,
-                         penetration, normal, s_conduit, curved, piece, estimate, relative)
+                         penetration, normal, s_conduit, curved, piece, estimate, relative, e1, e2, phi_max)
     if n_curved:
         k = piece[:n_curved]
-        phi = angles_on_pieces(relative[:n_curved], estimate[:n_curved], wall.pieces[k])
+        phi = angles_on_pieces(relative[:n_curved], estimate[:n_curved], e1[:n_curved], e2[:n_curved],
+                               phi_max[:n_curved])
         ok = np.isfinite(phi)
         s_conduit[curved[:n_curved][ok]] = wall.s_piece_start_m[k[ok]] + phi[ok] * wall.piece_speed_m_per_rad[k[ok]]
     return penetration, normal, s_conduit

@@ -175,16 +175,20 @@ def closest_point_angles(p, residual, seg, t, seg_length, wall: SmoothWall):
     mask, idx, pc, estimate = _on_curved_pieces(seg, t, seg_length, wall)
     if not idx.size:
         return mask, phi_out
-    phi_out[idx] = angles_on_pieces(p[idx] - residual[idx] - pc[:, _C:_C + 3], estimate, pc)
+    # the piece's axes as contiguous (m, 3) arrays, the layout the compiled profiles pass
+    # (exucable.contact.profiles): both take the same einsum path, so give the same bits
+    phi_out[idx] = angles_on_pieces(p[idx] - residual[idx] - pc[:, _C:_C + 3], estimate,
+                                    np.ascontiguousarray(pc[:, _E1:_E1 + 3]),
+                                    np.ascontiguousarray(pc[:, _E2:_E2 + 3]), pc[:, _PHI])
     return mask, phi_out
 
 
-def angles_on_pieces(relative_m, estimate_rad, piece_rows):
+def angles_on_pieces(relative_m, estimate_rad, e1, e2, phi_max_rad):
     """Helix angle φ [rad] of closest points Pc given relative to their pieces' centres,
-    ``relative_m`` = Pc − c (m, 3) [m], next to the chord's estimates ``estimate_rad`` (m,) and
-    clamped to the piece (rows ``piece_rows`` (m, 16) of :attr:`SmoothWall.pieces`): the polar
-    angle in the (e1, e2) plane, unwrapped (see :func:`closest_point_angles`). NaN stays NaN."""
-    polar = np.arctan2(np.einsum("ij,ij->i", relative_m, piece_rows[:, _E2:_E2 + 3]),
-                       np.einsum("ij,ij->i", relative_m, piece_rows[:, _E1:_E1 + 3]))
+    ``relative_m`` = Pc − c (m, 3) [m], next to the chord's estimates ``estimate_rad`` (m,):
+    the polar angle in the plane of the pieces' axes ``e1``, ``e2`` (m, 3), unwrapped next to the
+    estimate (a helix may coil more than one turn) and clamped to [0, ``phi_max_rad``] (m,) (see
+    :func:`closest_point_angles`). NaN stays NaN."""
+    polar = np.arctan2(np.einsum("ij,ij->i", relative_m, e2), np.einsum("ij,ij->i", relative_m, e1))
     phi = estimate_rad + ((polar - estimate_rad + np.pi) % (2.0 * np.pi) - np.pi)
-    return np.clip(phi, 0.0, piece_rows[:, _PHI])
+    return np.clip(phi, 0.0, phi_max_rad)
