@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import ModelError
-from .rope import solve_rope
+from .rope import rope_pull_force_N
 from .rope_clearance import solve_rope_with_clearance
 
 __all__ = ["pull_force_references_N", "reference_drift_N_per_s"]
@@ -66,9 +66,9 @@ def pull_force_references_N(scenario, conduit, pulled_out_m: float = 0.0, with_c
                          f"{sc.cable_length_m:.4g} m)")
     head = w * float(np.asarray(centre.tangent(centre.length_m))[2]) * out
     mu, back = sc.contact.friction, sc.pull.back_tension_N
-    if rope_solution is None:
-        rope_solution = solve_rope(centre, mu, w, back, cable_length_m=inside)
-    rope = rope_solution.pull_force_N + head
+    # only the force is needed: without a solution at hand, the rope's force alone (no profile)
+    rope = (rope_solution.pull_force_N if rope_solution is not None
+            else rope_pull_force_N(centre, mu, w, back, cable_length_m=inside)) + head
     clearance = conduit.inner_radius_m - sc.cable.radius_m
     clear = None
     if clearance > 0.0 and with_clearance and clearance_solution is not None:

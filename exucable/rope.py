@@ -17,8 +17,8 @@ and the second the weight component along the cable. The bearing pressure is
 On a straight incline this gives the paper's Eq. (25); without weight it gives the capstan law, Eq. (26).
 
 The centreline only needs the interface of :mod:`exucable.geometry`'s ``Centreline``: ``length_m``,
-``pieces`` (each with ``s_start_m`` and ``length_m``), ``tangent(s)``, ``curvature_vector(s)`` and
-``reversed()``.
+``pieces`` (each with ``s_start_m``, ``length_m`` and ``tangent_and_curvature_fn()``), ``tangent(s)``,
+``curvature_vector(s)`` and ``reversed()``.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from exucable.errors import ModelError
 # (with the scipy.spatial, scipy.sparse and scipy.special they pull in) is a third of a second of an
 # `exucable run` of such a route (issue 15, fixed cost).
 
-__all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "sidewall_pressure_N_per_m"]
+__all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "rope_pull_force_N", "sidewall_pressure_N_per_m"]
 
 # solve_ivp tolerances. DOP853 at rtol 1e-11 reproduces the closed forms to ~1e-12 relative; the absolute
 # tolerance only matters where T passes close to zero (slack onset) and is set far below any force of interest.
@@ -168,15 +168,16 @@ def _evaluate_branches(branches, s: np.ndarray) -> np.ndarray:
     return out
 
 
-def _piece_intervals(centreline, s_from: float, s_to: float) -> list[tuple[float, float, float, float]]:
-    """Pieces clipped to [s_from, s_to] as (lo, hi, piece_lo, piece_hi) [m], in order; empty ones dropped."""
+def _piece_intervals(centreline, s_from: float, s_to: float) -> list[tuple[float, float, float, float, object]]:
+    """Pieces clipped to [s_from, s_to] as (lo, hi, piece_lo, piece_hi) [m] and the piece, in order;
+    empty ones dropped."""
     out = []
     for piece in sorted(centreline.pieces, key=lambda p: p.s_start_m):
         a = float(piece.s_start_m)
         b = a + float(piece.length_m)
         lo, hi = max(a, s_from), min(b, s_to)
         if hi - lo > 1e-14 * max(1.0, abs(s_to)):
-            out.append((lo, hi, a, b))
+            out.append((lo, hi, a, b, piece))
     return out
 
 
@@ -258,6 +259,21 @@ def _closed_form(curve, s_min: float, s_max: float, mu: float, w: float):
     return None
 
 
+class _OnePiece:
+    """One piece of a centreline answering ``tangent`` and ``curvature_vector`` at centreline arc
+    lengths inside it, as the centreline would (the same piece method at the same local arc
+    length), without the centreline's range check and piece lookup."""
+
+    def __init__(self, piece):
+        self.piece = piece
+
+    def tangent(self, s_m):
+        return self.piece.tangent(np.asarray(s_m, dtype=float) - self.piece.s_start_m)
+
+    def curvature_vector(self, s_m):
+        return self.piece.curvature_vector(np.asarray(s_m, dtype=float) - self.piece.s_start_m)
+
+
 def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, trailing_N: float, dense: bool,
                mu_curved: float | None = None):
     """Integrate the rope ODE from s0 to s1 on ``curve``; return (T(s1) [N], branches, slack).
@@ -270,16 +286,21 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
     branches = []
     slack_seen = False
     tension = float(trailing_N)
-    for lo, hi, plo, phi in _piece_intervals(curve, s0, s1):
+    for lo, hi, plo, phi, piece in _piece_intervals(curve, s0, s1):
         s_min, s_max = _inside(plo, phi)
-        curved = bool(np.linalg.norm(_as_rows(curve.curvature_vector(np.array([0.5 * (lo + hi)])), 1)[0]) > 0.0)
+        local = _OnePiece(piece)
+        curved = bool(np.linalg.norm(_as_rows(local.curvature_vector(np.array([0.5 * (lo + hi)])), 1)[0]) > 0.0)
         mu = mu_curved if (curved and mu_curved is not None) else mu_straight
 
-        def rate(s, y, s_min=s_min, s_max=s_max, mu_here=mu):
+        def rate(s, y, s_min=s_min, s_max=s_max, mu_here=mu, frame=piece.tangent_and_curvature_fn(), s_piece=plo):
             # s is clamped into the piece so that RK stages at the piece's end use this piece's curvature.
+            # The sidewall load T κn − w (e_z − (e_z·t) t) of _transverse_load in plain floats: DOP853
+            # calls this ~100 times a piece, and numpy's overhead on 3-vectors was 90 % of its cost.
             sc = min(max(s, s_min), s_max)
-            load, tz = _transverse_load(curve, np.array([sc]), np.array([y[0]]), w)
-            return [mu_here * np.linalg.norm(load[0]) + w * tz[0]]
+            (tx, ty, tz), (kx, ky, kz) = frame(sc - s_piece)
+            T = float(y[0])
+            load = math.hypot(T * kx + w * tz * tx, T * ky + w * tz * ty, T * kz - w * (1.0 - tz * tz))
+            return [mu_here * load + w * tz]
 
         def g0(s, rate=rate):
             return rate(s, [0.0])[0]
@@ -289,7 +310,7 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
 
         hits_zero.terminal = True
         hits_zero.direction = -1.0
-        exact = _closed_form(curve, s_min, s_max, mu, w)
+        exact = _closed_form(local, s_min, s_max, mu, w)
 
         s = lo
         for _ in range(10_000):  # guard: every pass advances s (a slack stretch or an ODE run)
@@ -362,6 +383,13 @@ def _validate(centreline, friction, w, direction, cable_length_m):
     return mu, w, min(length, conduit_length), conduit_length
 
 
+def _trailing_tension(value) -> float:
+    trailing = float(value)
+    if not np.isfinite(trailing) or trailing < 0.0:
+        raise ModelError("trailing_tension_N", f"trailing tension must be finite and >= 0, got {value!r}")
+    return trailing
+
+
 def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0.0, trailing_tension_N: float = 0.0,
                direction: str = "forward", cable_length_m: float | None = None, n_output: int = 801,
                bend_friction: float | None = None) -> RopeSolution:
@@ -410,9 +438,7 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
         bend_mu = None
     mu, w, length, conduit_length = _validate(centreline, friction, weight_per_length_N_per_m, direction,
                                               cable_length_m)
-    trailing = float(trailing_tension_N)
-    if not np.isfinite(trailing) or trailing < 0.0:
-        raise ModelError("trailing_tension_N", f"trailing tension must be finite and >= 0, got {trailing_tension_N!r}")
+    trailing = _trailing_tension(trailing_tension_N)
     if int(n_output) < 2:
         raise ModelError("n_output", "n_output must be >= 2")
     curve = centreline if direction == "forward" else centreline.reversed()
@@ -433,15 +459,17 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
     pressure = sidewall_pressure_N_per_m(curve, s_curve, tension, w)
 
     # Maxima over the output grid plus the integrator's nodes, each evaluated inside its own piece.
-    max_t = float(np.max(tension))
-    max_p = float(np.max(pressure))
-    for b in raw_branches:
-        s_lo, s_hi, plo, phi, fn, nodes = b
-        pts = np.concatenate([nodes, [s_lo, s_hi], s_curve[(s_curve >= s_lo) & (s_curve <= s_hi)]])
-        pts = np.clip(pts, *_inside(plo, phi))
-        tens = fn(pts)
-        max_t = max(max_t, float(np.max(tens)))
-        max_p = max(max_p, float(np.max(sidewall_pressure_N_per_m(curve, pts, tens, w))))
+    # (one pressure evaluation for all branches: each point lies inside its own piece, so the
+    # centreline answers for it as it would alone)
+    pts, tens = [], []
+    for s_lo, s_hi, plo, phi, fn, nodes in raw_branches:
+        p = np.clip(np.concatenate([nodes, [s_lo, s_hi], s_curve[(s_curve >= s_lo) & (s_curve <= s_hi)]]),
+                    *_inside(plo, phi))
+        pts.append(p)
+        tens.append(fn(p))
+    pts, tens = np.concatenate(pts), np.concatenate(tens)
+    max_t = max(float(np.max(tension)), float(np.max(tens)))
+    max_p = max(float(np.max(pressure)), float(np.max(sidewall_pressure_N_per_m(curve, pts, tens, w))))
 
     s_conduit = s_curve if direction == "forward" else conduit_length - s_curve
     return RopeSolution(
@@ -457,6 +485,19 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
         slack=bool(slack),
         _branches=branches,
     )
+
+
+def rope_pull_force_N(centreline, friction: float, weight_per_length_N_per_m: float = 0.0,
+                      trailing_tension_N: float = 0.0, direction: str = "forward",
+                      cable_length_m: float | None = None) -> float:
+    """The pulling force [N] of :func:`solve_rope` alone, bit for bit: the same integration without
+    its dense output, tension profile and maxima (for a caller that needs only the force, such as
+    :func:`exucable.model.layout.steady_lead_out_m`'s rule). Parameters as in :func:`solve_rope`."""
+    mu, w, length, conduit_length = _validate(centreline, friction, weight_per_length_N_per_m, direction,
+                                              cable_length_m)
+    trailing = _trailing_tension(trailing_tension_N)
+    curve = centreline if direction == "forward" else centreline.reversed()
+    return float(_integrate(curve, mu, w, conduit_length - length, conduit_length, trailing, dense=False)[0])
 
 
 def _shifted(fn, offset, lo, hi):

@@ -59,6 +59,12 @@ _ON_WALL = 1e-7
 # Chains of more segments than this start from the solution on a chain _COARSEN times coarser.
 _COARSEN_ABOVE = 4000
 _COARSEN = 4
+# ... and so does the chain a caller asks for (not the coarser chains solved for it) above this many:
+# Example 4's 970-segment chain spent 31 of its 47 Newton steps opening its free spans a node or two a
+# step, which the 4× coarser chain does 4× faster and 4× cheaper (39 -> 24 ms, 2026-11-29); more
+# levels below 4000 segments cost more than they saved (100 m: 150 -> 210 ms, commscope: 190 -> 260 ms),
+# and Example 2's 559 segments, which open no long spans, 18 -> 26 ms.
+_COARSEN_REQUESTED_ABOVE = 800
 
 
 @dataclass(frozen=True, eq=False)
@@ -359,8 +365,8 @@ class _Chain:
 def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
                               weight_per_length_N_per_m: float = 0.0, trailing_tension_N: float = 0.0,
                               direction: str = "forward", cable_length_m: float | None = None,
-                              node_spacing_m: float | None = None, rtol: float = 1e-10
-                              ) -> ClearanceRopeSolution:
+                              node_spacing_m: float | None = None, rtol: float = 1e-10,
+                              _coarsen_above: int | None = None) -> ClearanceRopeSolution:
     """Steady pull of a perfectly flexible cable through a conduit with clearance (module docstring).
 
     Parameters
@@ -385,6 +391,9 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     rtol : float
         Relative change of the tensions (and of the shape, in units of the clearance) at which the
         fixed point stops.
+    _coarsen_above : int, optional
+        Internal: a chain of more segments starts from the solution on a coarser chain (default
+        ``_COARSEN_REQUESTED_ABOVE``; the coarser chains' own solves use ``_COARSEN_ABOVE``).
 
     Returns
     -------
@@ -438,12 +447,13 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     G[:, 2] = -w * hs
     newton = 0
     ramp = True
-    if n_seg > _COARSEN_ABOVE:
+    if n_seg > (_COARSEN_REQUESTED_ABOVE if _coarsen_above is None else _coarsen_above):
         # Nested iteration: the same problem on a chain _COARSEN times coarser places the free spans and
         # the tensions to within a few of these nodes, from where few Newton steps finish (a free span's
         # end moves about one node per step; on 1 km, 50 000 nodes, the fine chain needed ~110 steps).
         coarse = solve_rope_with_clearance(centreline, clearance_m, friction, weight_per_length_N_per_m,
-                                           trailing_tension_N, direction, cable_length_m, _COARSEN * hs, rtol)
+                                           trailing_tension_N, direction, cable_length_m, _COARSEN * hs, rtol,
+                                           _coarsen_above=_COARSEN_ABOVE)
         s_c = coarse.s_conduit_m if direction == "forward" else L - coarse.s_conduit_m
         order = np.argsort(s_c)
         off = np.stack([np.interp(s, s_c[order], coarse.offset_m[order, j]) for j in range(3)], axis=1)

@@ -341,3 +341,39 @@ def test_closest_point_angles_from_the_residual_match_newtons(kind):
     mask2, phi2 = closest_point_angles(p, residual, nearest, t, seg.length_m, wall)
     np.testing.assert_array_equal(mask2, mask)
     np.testing.assert_allclose(phi2[mask], phi[mask], rtol=0.0, atol=1e-11)
+
+
+def test_segment_sectors_are_the_segments_angular_sides():
+    """The compiled bend refinement skips the angle test for a point strictly inside its segment's
+    sector: the table holds (cos, sin) of each segment's end angles, and zero sides (no point is
+    ever inside) for a segment spanning π/2 or more."""
+    from exucable.contact.fast import segment_sectors
+
+    phi = np.array([[0.0, 0.1], [0.1, 0.2], [0.0, 2.0], [0.0, 0.0]])
+    table = segment_sectors(phi)
+    np.testing.assert_array_equal(table[:, :2], phi)
+    np.testing.assert_allclose(table[0, 2:], [1.0, 0.0, np.cos(0.1), np.sin(0.1)], rtol=0, atol=1e-16)
+    np.testing.assert_allclose(table[1, 2:], [np.cos(0.1), np.sin(0.1), np.cos(0.2), np.sin(0.2)], rtol=0, atol=1e-16)
+    np.testing.assert_array_equal(table[2, 2:], 0.0)
+
+
+def test_bend_ends_and_segment_joints_agree_with_numpy():
+    """Check points densely across a bend's start and end and the joints between its chords
+    (inside their nearest segment's sector, on its sides, and past the bend's ends): the compiled
+    penetration, normal and arc length equal the numpy reference's (1e-12, round-off of metre
+    positions)."""
+    cond = conduit("bend", segments_per_bend=12)
+    c = cond.centreline
+    for s0 in (0.3, 0.3 + 0.5 * np.pi / 2):  # the bend's start and end
+        s_nodes = np.linspace(s0 - 0.15, s0 + 0.15, 5)  # chords of 0.065 m
+        # offset in the bend's plane, toward its centre: in contact with the inner wall
+        q, q_t = cable_on_offset_curve(cond, s_nodes, lambda s, t: np.cross([0.0, 0.0, 1.0], t), GAP + 2e-4)
+        L = np.diff(s_nodes)
+        kw = dict(surface="smooth", centreline=c)
+        ref = ContactKernel(cond.segments, L, R_CABLE, LAW, 400, backend="numpy", **kw).points(q, q_t)
+        fast = ContactKernel(cond.segments, L, R_CABLE, LAW, 400, backend="numba", **kw).points(q, q_t)
+        np.testing.assert_array_equal(fast.segment, ref.segment)
+        assert len(np.unique(ref.segment)) >= 3  # a straight and at least two chords of the bend
+        assert ref.in_contact.all()
+        for name in ("penetration_m", "normal", "s_conduit_m"):
+            assert np.abs(getattr(fast, name) - getattr(ref, name)).max() <= 1e-12, name

@@ -364,3 +364,19 @@ def test_one_point_evaluation_equals_the_array_path():
         c.point(c.length_m + 1.0)
     with pytest.raises(ValueError, match="arc length outside"):
         c.tangent(float("nan"))
+
+
+def test_scalar_tangent_and_curvature_equal_the_array_methods():
+    """The plain-float evaluator (the rope ODE's right-hand side) gives each piece's tangent and
+    curvature vector to a few ulps (TOL) on straights, bends in three planes, a helix and the
+    reversed route (whose pieces are helices about −k)."""
+    c = centreline_from_path([0, 0, 0], [1, 0, 0], [Straight(2.0), Bend(90, 1.5, "left"), Bend(30, 2.0, "up"),
+                                                     Bend(60, 0.7, "right"), Helix(2.0, 0.4, 0.3), Straight(1.0)])
+    for route in (c, c.reversed()):
+        for piece in route.pieces:
+            at = piece.tangent_and_curvature_fn()
+            for u in np.linspace(0.0, piece.length_m, 7):
+                t, kn = at(float(u))
+                assert all(isinstance(x, float) for x in t + kn)
+                np.testing.assert_allclose(t, piece.tangent(u), rtol=0, atol=TOL)
+                np.testing.assert_allclose(kn, piece.curvature_vector(u), rtol=0, atol=TOL)

@@ -15,7 +15,7 @@ import pytest
 from exucable import closed_forms as cf
 from exucable.errors import ModelError
 from exucable.geometry import Bend, Helix, Straight, centreline_from_path
-from exucable.rope import RopeSolution, solve_rope, solve_rope_for_pull_force
+from exucable.rope import RopeSolution, rope_pull_force_N, solve_rope, solve_rope_for_pull_force
 
 RTOL = 1e-6  # see the module docstring
 W = 1000.0 * math.pi * 2.5e-3**2 * 9.8  # the paper's cable: rho A g [N/m] (Sect. 3, Eq. 25)
@@ -309,3 +309,20 @@ def test_closed_form_covers_straights_and_horizontal_or_weightless_bends_only():
     flat = centreline_from_path([0, 0, 0], [1, 0, 0], [Straight(1.0), Bend(90.0, 0.5, turn="right")])
     piece = flat.pieces[1]
     assert rope._closed_form(flat, *rope._inside(piece.s_start_m, piece.s_start_m + piece.length_m), 0.3, W)
+
+
+@pytest.mark.parametrize("items, start_dir, back", [
+    (SPATIAL, [1, 0, 0], 5.0),                                                                  # ODE pieces
+    ([Straight(3.0), Bend(30.0, 1.0, turn="up"), Straight(4.0)], heading(-40.0), 0.1),            # slack stretch
+])
+def test_pull_force_alone_is_the_full_solutions_bit_for_bit(items, start_dir, back):
+    """rope_pull_force_N (the steady lead-out rule's exit tension) is the same integration as
+    solve_rope without the profile: the same float, in both directions and for a shorter cable;
+    and it refuses a negative back tension like solve_rope."""
+    route = centreline_from_path([0, 0, 0], start_dir, items)
+    for direction in ("forward", "reverse"):
+        for length in (None, 0.8 * route.length_m):
+            full = solve_rope(route, 0.3, W, back, direction=direction, cable_length_m=length)
+            assert rope_pull_force_N(route, 0.3, W, back, direction=direction, cable_length_m=length) == full.pull_force_N
+    with pytest.raises(ModelError, match="trailing"):
+        rope_pull_force_N(route, 0.3, W, -1.0)

@@ -180,8 +180,8 @@ def test_nested_iteration_from_a_coarser_chain_gives_the_same_solution(monkeypat
 
     centre = route(Straight(3.0), Bend(40.0, 2.0, turn="up"), Straight(2.0), Bend(70.0, 3.0), Straight(2.0))
     h = centre.length_m / 1200
-    direct = solve_rope_with_clearance(centre, 0.01, 0.4, W, 80.0, node_spacing_m=h)
-    monkeypatch.setattr(rc, "_COARSEN_ABOVE", 1000)
+    direct = solve_rope_with_clearance(centre, 0.01, 0.4, W, 80.0, node_spacing_m=h, _coarsen_above=10**9)
+    monkeypatch.setattr(rc, "_COARSEN_REQUESTED_ABOVE", 1000)
     nested = solve_rope_with_clearance(centre, 0.01, 0.4, W, 80.0, node_spacing_m=h)
     assert nested.pull_force_N == pytest.approx(direct.pull_force_N, rel=2e-6)
     np.testing.assert_allclose(nested.tension_N, direct.tension_N, rtol=2e-6)

@@ -183,6 +183,31 @@ def test_one_iteration_steps_reach_the_exact_step_answer(monkeypatch):
     assert abs(F_one / F_tight - 1) < 1e-8
 
 
+def test_a_rejected_step_restarts_from_the_saved_kernel_pass(monkeypatch):
+    """A rejected pseudo-time step restarts from the saved state with the kernel pass made when
+    the state was reached: Example 2 (coarse) rejects 6 of its 29 one-iteration steps and makes
+    one kernel pass per Newton iteration plus the start's (36 passes before), with the same
+    iterates bit for bit as without the reuse."""
+    from dataclasses import replace
+
+    import exucable.solve_steady as ss
+    from exucable.model.build import build_model
+    from exucable.model.coupling import ContactCoupling
+
+    sc = fast("paper_ex2_bend90")
+    sc = replace(sc, solver=replace(sc.solver, mode="steady"))
+    model = build_model(sc)
+    out = ss.solve_steady(model)
+    assert out.status == "ok" and out.steps > len(out.history.pull_force_N)   # some steps were rejected
+    assert model.coupling.kernel_evaluations == out.newton_iterations + 1
+    monkeypatch.setattr(ContactCoupling, "offer_evaluation", lambda self, evaluation: None)
+    again = build_model(sc)
+    without = ss.solve_steady(again)
+    assert again.coupling.kernel_evaluations > model.coupling.kernel_evaluations
+    assert without.history.pull_force_N == out.history.pull_force_N
+    assert without.newton_iterations == out.newton_iterations
+
+
 def test_exact_steps_stop_above_the_round_off_floor(monkeypatch):
     """What stalled the fine industry meshes (Gera 2032, MachineCalcs 4064 elements): the residual has a
     round-off floor that grows with the mesh (2e-5 N at Gera's 2032 elements), the exact pseudo-time

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from exucable.contact import ContactKernel, ContactLaw, assemble_blocks_dense
-from exucable.contact.steady import SteadySlidingKernel, hermite_unit_derivative
+from exucable.contact.fast import _PAIRS
+from exucable.contact.steady import SteadySlidingKernel, bernstein, block_coefficients, hermite_unit_derivative
 from exucable.contact.checkpoints import hermite_unit
 from exucable.geometry import Bend, Conduit, Straight, centreline_from_path
 
@@ -81,12 +82,27 @@ def test_friction_direction_jacobian_matches_finite_differences(backend):
     assert np.abs(jq - jq_fixed_v).max() > 1e-3 * np.abs(jq).max()
 
 
-def test_numba_equals_numpy():
+def test_block_coefficients_reproduce_the_shape_products():
+    """The compiled Jacobian sums Σ_k N_a N_b J_k and Σ_k N_a N'_b J_k through seven Bernstein
+    moments: the coefficients must give the products themselves (polynomials of degree ≤ 6, so
+    exactly up to round-off: 1e-14 against products of order 1)."""
+    xi = np.random.default_rng(1).uniform(0.0, 1.0, 50)
+    nh, dnh = hermite_unit(xi), hermite_unit_derivative(xi)
+    direct = np.stack([nh[:, a] * nh[:, b] for a, b in _PAIRS]
+                      + [nh[:, a] * dnh[:, b] for a in range(4) for b in range(4)], axis=1)
+    assert np.abs(bernstein(xi) @ block_coefficients().T - direct).max() < 1e-14
+    assert np.allclose(bernstein(xi).sum(axis=1), 1.0, rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("n_k", [7, 64])
+def test_numba_equals_numpy(n_k):
+    """Same force and Jacobian blocks (the numpy reference sums the products directly, the
+    compiled path through Bernstein moments)."""
     cond = bend_conduit()
     q, L = cable_in_bend(cond, np.random.default_rng(4))
     zero = np.zeros_like(q)
-    a = kernels(cond, L, "numpy").evaluate(q, zero, jacobian=True)
-    b = kernels(cond, L, "numba").evaluate(q, zero, jacobian=True)
+    a = kernels(cond, L, "numpy", n_k).evaluate(q, zero, jacobian=True)
+    b = kernels(cond, L, "numba", n_k).evaluate(q, zero, jacobian=True)
     assert np.allclose(a.generalized_force, b.generalized_force, rtol=1e-10, atol=1e-9)
     assert np.abs(a.jac_q_blocks - b.jac_q_blocks).max() < 1e-9 * np.abs(a.jac_q_blocks).max()
 

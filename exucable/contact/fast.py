@@ -164,6 +164,40 @@ def _nearest_segments(px, py, pz, seg, cand, c0, c1, best, sel, rx, ry, rz, ax_i
         best[k] = 0.0 if beyond[k] != 0.0 else best[k]
 
 
+# A bend point's direction must clear its segment's sector sides by this angle [rad] to skip the
+# angle test: far above the rounding of that test's unwrapped atan2 (~1e-15 rad) and of the
+# sectors' own ends (SmoothWall's segment angles vs the piece's Φ).
+_SECTOR_MARGIN = 1e-9
+
+
+def segment_sectors(seg_phi):
+    """The smooth wall's segment angles [rad], shape (n_seg, 2), extended by the sector sides
+    (cos, sin) of each segment's start and end angle: shape (n_seg, 6). A segment spanning π/2 or
+    more gets zero sides, so that no point is ever found inside its sector (the exact test runs)."""
+    phi = np.asarray(seg_phi, dtype=float)
+    out = np.zeros((phi.shape[0], 6))
+    out[:, :2] = phi
+    narrow = np.abs(phi[:, 1] - phi[:, 0]) < 0.5 * math.pi
+    out[narrow, 2] = np.cos(phi[narrow, 0])
+    out[narrow, 3] = np.sin(phi[narrow, 0])
+    out[narrow, 4] = np.cos(phi[narrow, 1])
+    out[narrow, 5] = np.sin(phi[narrow, 1])
+    return out
+
+
+@njit(inline="always", **_JIT)
+def _chord_angle(px, py, pz, seg, sg, seg_phi):
+    """The chord's estimate of a point's helix angle [rad]: from its clamped projection parameter
+    on segment ``sg``, linear between the segment's end angles."""
+    dx = px - seg[sg, 0]
+    dy = py - seg[sg, 1]
+    dz = pz - seg[sg, 2]
+    ln = seg[sg, 6]
+    t = dx * seg[sg, 3] + dy * seg[sg, 4] + dz * seg[sg, 5]
+    t = min(max(t, 0.0), ln)
+    return seg_phi[sg, 0] + t / ln * (seg_phi[sg, 1] - seg_phi[sg, 0])
+
+
 @njit(inline="always", **_JIT)
 def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, seg_piece, pieces,
                    seg_phi, n_newton):
@@ -171,6 +205,8 @@ def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, 
 
     Overwrites the residual, the squared distance and the Jacobian axis √β·T of every point whose
     nearest segment lies on a curved piece. Points beyond an open end (d² = 0) are left alone.
+    ``seg_phi`` is :func:`segment_sectors`' table: a point on a bend whose direction lies inside its
+    nearest segment's angular sector is inside the bend, and needs no angle (no atan2).
     """
     for k in range(px.shape[0]):
         sg = sel[k]
@@ -179,14 +215,6 @@ def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, 
         pi = seg_piece[sg]
         if pieces[pi, 15] == 0.0:
             continue
-        # initial angle from the chord's projection parameter
-        dx = px[k] - seg[sg, 0]
-        dy = py[k] - seg[sg, 1]
-        dz = pz[k] - seg[sg, 2]
-        ln = seg[sg, 6]
-        t = dx * seg[sg, 3] + dy * seg[sg, 4] + dz * seg[sg, 5]
-        t = min(max(t, 0.0), ln)
-        phi = seg_phi[sg, 0] + t / ln * (seg_phi[sg, 1] - seg_phi[sg, 0])
         xx = px[k] - pieces[pi, 0]
         xy = py[k] - pieces[pi, 1]
         xz = pz[k] - pieces[pi, 2]
@@ -196,10 +224,24 @@ def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, 
         a = pieces[pi, 12]
         h = pieces[pi, 13]
         big_phi = pieces[pi, 14]
+        rho = 0.0
+        in_sector = False
         if h == 0.0:
+            # a bend: strictly inside the segment's sector (by _SECTOR_MARGIN rad) is inside
+            # [0, Φ] for the angle test below too, whatever its rounding
+            rho = math.sqrt(x1 * x1 + x2 * x2)
+            margin = _SECTOR_MARGIN * rho
+            in_sector = ((seg_phi[sg, 2] * x2 - seg_phi[sg, 3] * x1 > margin)
+                         & (seg_phi[sg, 5] * x1 - seg_phi[sg, 4] * x2 > margin))
+        if in_sector:
+            inside = True
+            cs = x1 / rho
+            sn = x2 / rho
+            phic = 0.0  # unused on a bend (h = 0)
+        elif h == 0.0:
             # a bend: the closest point is in the direction of P's projection, no iteration;
             # the angle (for the range test only) unwrapped next to the chord's estimate
-            rho = math.sqrt(x1 * x1 + x2 * x2)
+            phi = _chord_angle(px[k], py[k], pz[k], seg, sg, seg_phi)
             ang = math.atan2(x2, x1)
             phi = phi + ((ang - phi + math.pi) % (2.0 * math.pi) - math.pi)
             inside = 0.0 <= phi <= big_phi
@@ -212,6 +254,7 @@ def _refine_smooth(px, py, pz, seg, sel, best, rx, ry, rz, ax_in, ay_in, az_in, 
                 cs = math.cos(phic)
                 sn = math.sin(phic)
         else:
+            phi = _chord_angle(px[k], py[k], pz[k], seg, sg, seg_phi)
             # Newton on the helix angle; the steps are tiny (the chord's estimate is close), so
             # cos/sin are carried along by rotating with the series of the step (error < 1e-14
             # for |Δφ| < 1e-2) instead of being recomputed: 2 trigonometric calls per point
@@ -846,11 +889,12 @@ class FastKernel:
         self.open_last = n_s - 1 if open_ends else -1
         self.smooth = wall is not None
         if wall is not None:
-            self.seg_piece, self.pieces, self.seg_phi = wall.seg_piece, wall.pieces, wall.seg_phi
+            self.seg_piece, self.pieces = wall.seg_piece, wall.pieces
+            self.seg_phi = segment_sectors(wall.seg_phi)
         else:
             self.seg_piece = np.zeros(n_s, dtype=np.int64)
             self.pieces = np.zeros((1, 16))
-            self.seg_phi = np.zeros((n_s, 2))
+            self.seg_phi = np.zeros((n_s, 6))
         self.seg = np.empty((n_s, _SEG_COLUMNS))
         self.seg[:, 0:3] = seg_start_m
         self.seg[:, 3:6] = seg_axis

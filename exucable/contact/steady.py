@@ -13,7 +13,10 @@ the term of the velocity's dependence on the slopes,
 
     ∂Q_e/∂q_e = Σ_k S_kᵀ (∂F/∂P) S_k + Σ_k S_kᵀ (∂F/∂v) V S'_k,
 
-which the compiled path accumulates from the sixteen products N_a N'_b (not symmetric in a, b).
+which the compiled path sums in a polynomial basis: every product N_a N_b (degree 6 in ξ) and
+N_a N'_b (degree 5, not symmetric in a, b) is a fixed combination of the seven Bernstein
+polynomials of degree 6, so seven moments Σ_k B_m(ξ_k) J_k per column of the point Jacobians
+replace the 10 + 16 product sums (:func:`block_coefficients`).
 
 |∂r/∂x| = 1 + ε: the material speed is taken as V (the pull speed) everywhere rather than
 V (1 + ε)/(1 + ε_lead); the difference (strain, < 1e-3 on the paper's examples) changes only the
@@ -24,6 +27,7 @@ damping's share, whose entry and exit contributions cancel along a contact zone.
 from __future__ import annotations
 
 from dataclasses import replace
+from math import comb
 
 import numpy as np
 from numba import njit
@@ -32,11 +36,15 @@ from .checkpoints import hermite_unit
 from .kernel import ContactKernel
 from .reference import ReferenceKernel
 from .fast import (_JIT, _PAIRS, _J0, _PX, _PY, _PZ, _BEST, _RX, _RY, _RZ, _AX, _AY, _AZ, _BEYOND,
-                   _VX, _VY, _VZ, _accumulate_blocks, _add_generalized_force, _exponent_mode, _friction, _nearest_segments,
+                   _VX, _VY, _VZ, _add_generalized_force, _exponent_mode, _friction, _nearest_segments,
                    _normal_force, _normals, _point_jacobians, _positions, _refine_smooth)
 from .smooth import NEWTON_ITERATIONS
 
 __all__ = ["SteadySlidingKernel", "hermite_unit_derivative"]
+
+# Degree of the polynomials in ξ whose sums over the check points make the Jacobian blocks:
+# N_a N_b (6) and N_a N'_b (5); see block_coefficients
+BLOCK_DEGREE = 6
 
 
 def hermite_unit_derivative(xi) -> np.ndarray:
@@ -65,7 +73,7 @@ class SteadySlidingKernel(ContactKernel):
         self._dnh = hermite_unit_derivative(self.xi)
         self._base_law = self.law
         if self.backend == "numba":
-            self._impl = _SteadyFast(self._impl, self._dnh, self.speed_m_per_s)
+            self._impl = _SteadyFast(self._impl, self.xi, self._dnh, self.speed_m_per_s)
         else:
             self._impl = _SteadyReference(self)
 
@@ -95,36 +103,117 @@ class _SteadyReference(ReferenceKernel):
         return k.speed_m_per_s * d, q
 
 
+def bernstein(xi, degree: int = BLOCK_DEGREE) -> np.ndarray:
+    """Bernstein polynomials C(n, m) ξ^m (1 - ξ)^(n - m), m = 0..n, shape (..., n + 1) [-]."""
+    x = np.asarray(xi, dtype=float)[..., None]
+    m = np.arange(degree + 1)
+    binomial = np.array([comb(degree, i) for i in m], dtype=float)
+    return binomial * x**m * (1.0 - x) ** (degree - m)
+
+
+def block_coefficients() -> np.ndarray:
+    """Bernstein coefficients (degree 6) of the ten products N_a N_b (rows in the order of
+    ``fast._PAIRS``) and the sixteen N_a N'_b (row 10 + 4a + b), shape (26, 7) [-].
+
+    Both are polynomials of degree ≤ 6 in ξ (N cubic, N' quadratic), so they are interpolated
+    exactly (to round-off, ~1e-16) at seven Chebyshev nodes, where the Bernstein collocation
+    matrix is well conditioned. Every N_a has Bernstein coefficients of one sign, hence so have
+    the products N_a N_b: the sums over these coefficients cancel no more than the direct ones."""
+    nodes = 0.5 - 0.5 * np.cos(np.pi * (2 * np.arange(BLOCK_DEGREE + 1) + 1) / (2 * BLOCK_DEGREE + 2))
+    nh = hermite_unit(nodes)
+    dnh = hermite_unit_derivative(nodes)
+    products = [nh[:, a] * nh[:, b] for a, b in _PAIRS] + [nh[:, a] * dnh[:, b] for a in range(4) for b in range(4)]
+    return np.ascontiguousarray(np.linalg.solve(bernstein(nodes), np.stack(products, axis=1)).T)
+
+
 @njit(inline="always", **_JIT)
-def _accumulate_rate_blocks(tab, cross_t, le, speed, acc, bq):
-    """Add Σ_k S_kᵀ (∂F/∂v)_k V S'_k to the element block ``bq`` (16 products N_a N'_b)."""
-    n_k = cross_t.shape[1]
-    for p in range(16):
-        cp = cross_t[p]
-        for col in range(9):
-            jc = tab[_J0 + 9 + col]
-            s = 0.0
-            for k in range(n_k):
-                s += cp[k] * jc[k]
-            acc[p, col] = s
+def _jacobian_moments(tab, basis, mom):
+    """mom[m, c] = Σ_k B_m(ξ_k) J_c(k) for the 18 columns of ∂F/∂P and ∂F/∂v (B: Bernstein,
+    degree 6). Three columns per pass: each basis value loaded once serves three sums (the loop
+    is bound by loads, not by arithmetic), 21 running sums held in registers."""
+    n_k = basis.shape[1]
+    b0, b1, b2, b3, b4, b5, b6 = basis[0], basis[1], basis[2], basis[3], basis[4], basis[5], basis[6]
+    for col in range(0, 18, 3):
+        ja = tab[_J0 + col]
+        jb = tab[_J0 + col + 1]
+        jc = tab[_J0 + col + 2]
+        a0 = a1 = a2 = a3 = a4 = a5 = a6 = 0.0
+        c0 = c1 = c2 = c3 = c4 = c5 = c6 = 0.0
+        d0 = d1 = d2 = d3 = d4 = d5 = d6 = 0.0
+        for k in range(n_k):
+            x = ja[k]
+            y = jb[k]
+            z = jc[k]
+            a0, c0, d0 = _add_products(b0[k], x, y, z, a0, c0, d0)
+            a1, c1, d1 = _add_products(b1[k], x, y, z, a1, c1, d1)
+            a2, c2, d2 = _add_products(b2[k], x, y, z, a2, c2, d2)
+            a3, c3, d3 = _add_products(b3[k], x, y, z, a3, c3, d3)
+            a4, c4, d4 = _add_products(b4[k], x, y, z, a4, c4, d4)
+            a5, c5, d5 = _add_products(b5[k], x, y, z, a5, c5, d5)
+            a6, c6, d6 = _add_products(b6[k], x, y, z, a6, c6, d6)
+        _store_moments(mom, col, a0, a1, a2, a3, a4, a5, a6)
+        _store_moments(mom, col + 1, c0, c1, c2, c3, c4, c5, c6)
+        _store_moments(mom, col + 2, d0, d1, d2, d3, d4, d5, d6)
+
+
+@njit(inline="always", **_JIT)
+def _add_products(v, x, y, z, sx, sy, sz):
+    """(sx + v x, sy + v y, sz + v z): one basis value into three running sums."""
+    return sx + v * x, sy + v * y, sz + v * z
+
+
+@njit(inline="always", **_JIT)
+def _store_moments(mom, col, s0, s1, s2, s3, s4, s5, s6):
+    """The seven moments of column ``col``."""
+    mom[0, col], mom[1, col], mom[2, col], mom[3, col] = s0, s1, s2, s3
+    mom[4, col], mom[5, col], mom[6, col] = s4, s5, s6
+
+
+@njit(inline="always", **_JIT)
+def _steady_blocks(mom, coeff, pair_ab, le, speed, bq):
+    """∂Q_e/∂q_e = Σ_k S_kᵀ (∂F/∂P)_k S_k + Σ_k S_kᵀ (∂F/∂v)_k V S'_k from the moments of
+    :func:`_jacobian_moments`: Σ_k N_a N_b J = Σ_m c_abm mom_m (``coeff``: :func:`block_coefficients`)."""
+    for p in range(10):
+        a = pair_ab[p, 0]
+        b = pair_ab[p, 1]
+        scale = (le if (a == 1 or a == 3) else 1.0) * (le if (b == 1 or b == 3) else 1.0)
+        for i in range(3):
+            for j in range(3):
+                c = 3 * i + j
+                v = 0.0
+                for m in range(BLOCK_DEGREE + 1):
+                    v += coeff[p, m] * mom[m, c]
+                v *= scale
+                bq[3 * a + i, 3 * b + j] = v
+                if a != b:  # (N Nᵀ) is symmetric: block (b, a) has the same 3×3
+                    bq[3 * b + i, 3 * a + j] = v
     for a in range(4):
         row_scale = le if (a == 1 or a == 3) else 1.0     # S: slope functions carry L
         for b in range(4):
             col_scale = 1.0 if (b == 1 or b == 3) else 1.0 / le   # S' = dS/dx
             scale = speed * row_scale * col_scale
-            p = 4 * a + b
+            p = 10 + 4 * a + b
             for i in range(3):
                 for j in range(3):
-                    bq[3 * a + i, 3 * b + j] += scale * acc[p, 3 * i + j]
+                    c = 9 + 3 * i + j
+                    v = 0.0
+                    for m in range(BLOCK_DEGREE + 1):
+                        v += coeff[p, m] * mom[m, c]
+                    bq[3 * a + i, 3 * b + j] += scale * v
 
 
 @njit(**_JIT)
-def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, pair_t, pair_ab, cross_t,
+def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, basis, pair_ab, coeff,
                    omega, seg, off, cand, gap, stiffness, damping, exponent, exponent_mode, mu_k,
                    dmu, inv_vs2, eps2, inv_href, jacobian, force, jq, scratch, tab, sel, acc,
                    acc16, open_first, open_last, smooth, seg_piece, pieces, seg_phi, n_newton,
                    inv_onset):
-    """As :func:`exucable.contact.fast._contact_kernel`, with v = V S'(ξ) q_e."""
+    """As :func:`exucable.contact.fast._contact_kernel`, with v = V S'(ξ) q_e.
+
+    ``basis`` (7, n_k): Bernstein values B_m(ξ_k) (:func:`bernstein`); ``coeff`` (26, 7): the
+    products' coefficients (:func:`block_coefficients`); ``acc`` (≥ 7, 18): the moments.
+    ``scratch`` and ``acc16`` are not used (left in so that the compiled signature, which the
+    ahead-of-time build lists, stays that of the former product sums)."""
     n_k = n1.shape[0]
     n_contact = 0
     max_d2 = -1.0
@@ -164,8 +253,8 @@ def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, pair_t, pai
         if not jacobian:
             continue
         _point_jacobians(tab, n_k, stiffness, damping)
-        _accumulate_blocks(tab, pair_t, pair_ab, le, acc, jq[e], scratch)
-        _accumulate_rate_blocks(tab, cross_t, le, speed, acc16, jq[e])
+        _jacobian_moments(tab, basis, acc)
+        _steady_blocks(acc, coeff, pair_ab, le, speed, jq[e])
     max_pen = np.sqrt(max_d2) - gap if max_d2 >= 0.0 else -np.inf
     return n_contact, max_pen
 
@@ -176,15 +265,14 @@ class _SteadyFast:
 
     velocity_from_coordinates = True    # v = V ∂r/∂x: q_t is ignored
 
-    def __init__(self, fast, dnh_unit, speed_m_per_s):
+    def __init__(self, fast, xi, dnh_unit, speed_m_per_s):
         self.fast = fast
         self.speed = float(speed_m_per_s)
         self._d = [np.ascontiguousarray(dnh_unit[:, i]) for i in range(4)]
-        nh = fast.nh
-        self.cross_t = np.ascontiguousarray(
-            np.stack([nh[:, a] * dnh_unit[:, b] for a in range(4) for b in range(4)]))
-        self._acc16 = np.empty((16, 9))
-        self._scratch = np.empty((12, 12))
+        # the Jacobian blocks from seven moments per column instead of 10 + 16 products
+        self.basis = np.ascontiguousarray(bernstein(xi).T)
+        self.coeff = block_coefficients()
+        self._unused_work = np.empty((0, 0))
 
     def candidates(self, q):
         return self.fast.candidates(q)
@@ -209,12 +297,12 @@ class _SteadyFast:
         n1, n2, n3, n4 = f._n
         d1, d2, d3, d4 = self._d
         n_contact, max_pen = _steady_kernel(
-            q, f.length, n1, n2, n3, n4, d1, d2, d3, d4, self.speed, f.pair_t, _PAIRS, self.cross_t,
+            q, f.length, n1, n2, n3, n4, d1, d2, d3, d4, self.speed, self.basis, _PAIRS, self.coeff,
             f.omega, f.seg, off, cand, f.gap, float(law.stiffness), float(law.damping),
             float(law.exponent), _exponent_mode(law.exponent), float(law.friction),
             float(law.static_excess), 1.0 / law.stribeck_velocity_m_per_s**2,
             law.regularisation_velocity_m_per_s**2, f.inv_href, bool(jacobian), force, jq,
-            self._scratch, f._tab, f._sel, f._acc, self._acc16, f.open_first, f.open_last,
+            self._unused_work, f._tab, f._sel, f._acc, self._unused_work, f.open_first, f.open_last,
             f.smooth, f.seg_piece, f.pieces, f.seg_phi, NEWTON_ITERATIONS,
             1.0 / law.damping_onset_m if law.damping_onset_m > 0.0 else 0.0)
         if not jacobian:

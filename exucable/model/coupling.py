@@ -120,6 +120,21 @@ class ContactCoupling:
         self._last = (t, q.copy(), q_t.copy(), res)
         return res
 
+    def last_evaluation(self):
+        """The last kernel pass (time, coordinates, rates, result), to :meth:`offer_evaluation`
+        back when the solve restarts from that state (None before the first pass)."""
+        return self._last
+
+    def offer_evaluation(self, evaluation) -> None:
+        """Make ``evaluation`` (from :meth:`last_evaluation`) the pass the next user-function
+        call may reuse; it is reused only at the same t, q and q̇ bit for bit (see _evaluate)."""
+        if evaluation is not None:
+            self._last = evaluation
+
+    def forget_evaluation(self) -> None:
+        """Reuse no former kernel pass: the kernel's law changed (its friction scale)."""
+        self._last = None
+
     def _force(self, mbs, t, item, q, q_t):
         t0 = time.perf_counter()
         qa, va = self.absolute(q, q_t)

@@ -1,0 +1,155 @@
+"""Newton iterations and kernel passes of the steady solve, case by case (issue 11), in one run.
+
+For each case (the paper's examples and their coarse variants, Fig. 12's coils and the coarse
+sweep's, the industry worked pulls, the 100 m study route, the 100 m and, with ``--long``, 1 km
+benchmark routes of ``steady_scale.py``) it builds the steady model, solves it and prints the
+Newton iterations, the pseudo-time steps tried (rejected ones included), the contact kernel's
+passes, the solve's wall time, the pulling force and whether the exact-step continuation ran
+(Newton iterations > steps tried: a one-iteration step takes exactly one).
+
+``--set NAME=VALUE`` overrides a constant of :mod:`exucable.solve_steady` (e.g. ``RATE_FALL=16``)
+to compare a rule across all cases; ``--tight`` also solves each case to 1/1000 of the stop
+tolerance and prints how far the pulling force moves (how converged it is); ``--trace CASE``
+prints, for each accepted pseudo-time step of one case, its residual and the check points whose
+contact state (δ > 0) still differs from the converged one.
+
+    nice .venv/bin/python benchmarks/steady_iterations.py [--only ex4,ex3] [--long] [--tight]
+    nice .venv/bin/python benchmarks/steady_iterations.py --trace ex4
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from exucable.model.build import build_model
+from exucable.scenario import load_scenario, parse_scenario
+from exucable.sweep.spec import load_sweep
+import exucable.solve_steady as solve_steady_module
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIOS = ROOT / "scenarios"
+PAPER = {"ex1": "paper_ex1_incline", "ex2": "paper_ex2_bend90", "ex3": "paper_ex3_helix", "ex4": "paper_ex4_spatial"}
+
+
+def cases(long: bool = False) -> dict:
+    """Case name -> a function returning its scenario (any mode; solved in steady mode)."""
+    out = {}
+    for key, stem in PAPER.items():
+        out[key] = lambda stem=stem: load_scenario(SCENARIOS / f"{stem}.toml")
+        out[f"{key}-coarse"] = lambda stem=stem: load_scenario(SCENARIOS / "fast" / f"{stem}.toml")
+    for folder, tag in ((SCENARIOS / "sweeps", "fig12"), (SCENARIOS / "sweeps" / "fast", "fig12-coarse")):
+        sweep = load_sweep(folder / "paper_fig12_coils.toml")
+        for i, case in enumerate(sweep.cases):
+            out[f"{tag}-{i + 1}"] = lambda scenario=case.scenario: scenario
+    for path in sorted((SCENARIOS / "industry").glob("*.toml")):
+        out[path.stem] = lambda path=path: load_scenario(path)
+    out["route100-study"] = lambda: load_scenario(SCENARIOS / "studies" / "route100_4bends.toml")
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import steady_scale
+
+    out["bench-100m"] = lambda: steady_scale.route_scenario(100.0)
+    if long:
+        out["bench-1km"] = lambda: steady_scale.route_scenario(1000.0)
+    return out
+
+
+def steady(scenario, name: str):
+    """``scenario`` with ``solver.mode = "steady"``."""
+    data = scenario.to_dict()
+    return parse_scenario({**data, "solver": {**data["solver"], "mode": "steady"}}, SCENARIOS, default_name=name)
+
+
+class _StateTrace:
+    """A progress sink that keeps the cable's coordinates and the residual of every accepted step."""
+
+    def __init__(self, model):
+        self.model = model
+        self.states, self.residuals = [], []
+
+    def update(self, fraction, text=""):
+        q = np.asarray(self.model.mbs.systemData.GetODE2Coordinates())[self.model.ode2_index]
+        self.states.append(self.model.coupling.q_ref + q)
+        self.residuals.append(text.split("residual ")[1].split(" N")[0] if "residual " in text else "?")
+
+    def close(self):
+        pass
+
+
+def trace(name: str, scenario) -> None:
+    """Per accepted step: residual, check points in contact, and those whose state differs from the last."""
+    model = build_model(steady(scenario, name))
+    sink = _StateTrace(model)
+    out = solve_steady_module.solve_steady(model, progress=sink)
+    kernel = model.kernel
+    zero = np.zeros_like(sink.states[-1])
+    final = kernel.points(sink.states[-1], zero).penetration_m > 0.0
+    print(f"{name}: {out.status}, {out.newton_iterations} Newton iterations, {out.message}; "
+          f"{final.size} check points, {int(final.sum())} in contact at the end")
+    print("step  residual [N]  in contact  differing from the end")
+    for i, q in enumerate(sink.states):
+        touch = kernel.points(q, zero).penetration_m > 0.0
+        print(f"{i + 1:4d}  {sink.residuals[i]:>12s}  {int(touch.sum()):10d}  {int(np.count_nonzero(touch != final)):10d}")
+
+
+def solve(name: str, scenario, tolerance: float) -> dict:
+    model = build_model(steady(scenario, name))
+    t0 = time.perf_counter()
+    out = solve_steady_module.solve_steady(model, tolerance=tolerance)
+    wall = time.perf_counter() - t0
+    F = out.history.pull_force_N[-1] if out.history.pull_force_N else float("nan")
+    return {"status": out.status, "newton": out.newton_iterations, "steps": out.steps,
+            "accepted": len(out.history.pull_force_N), "passes": model.coupling.kernel_evaluations,
+            "wall_s": wall, "F": F, "message": out.message}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", help="comma-separated case names")
+    ap.add_argument("--long", action="store_true", help="include the 1 km benchmark route")
+    ap.add_argument("--tight", action="store_true", help="also solve to 1/1000 of the stop tolerance")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="override a constant of exucable.solve_steady")
+    ap.add_argument("--trace", metavar="CASE", help="per-step residual and contact state of one case")
+    args = ap.parse_args(argv)
+    for item in args.set:
+        key, value = item.split("=", 1)
+        if not hasattr(solve_steady_module, key):
+            ap.error(f"--set {item}: exucable.solve_steady has no {key}")
+        setattr(solve_steady_module, key, type(getattr(solve_steady_module, key))(float(value)))
+    table = cases(long=args.long or (args.only is not None and "bench-1km" in args.only))
+    if args.trace:
+        if args.trace not in table:
+            ap.error(f"--trace: no case {args.trace!r}; cases: {', '.join(table)}")
+        trace(args.trace, table[args.trace]())
+        return 0
+    wanted = args.only.split(",") if args.only else list(table)
+    unknown = [w for w in wanted if w not in table]
+    if unknown:
+        ap.error(f"--only: no case {', '.join(unknown)}; cases: {', '.join(table)}")
+    tol = solve_steady_module.STATIC_TOLERANCE
+    # compile the kernels before the first timed solve
+    solve("warm-up", table["ex1-coarse"](), tol)
+    print(f"{'case':34s} {'status':6s} {'Newton':>6s} {'steps':>5s} {'kept':>4s} {'passes':>6s} {'solve [s]':>9s} "
+          f"{'pulling force [N]':>18s}" + ("  vs tol/1000" if args.tight else "") + "  exact steps")
+    totals = np.zeros(3)
+    for name in wanted:
+        r = solve(name, table[name](), tol)
+        totals += (r["newton"], r["passes"], r["wall_s"])
+        line = (f"{name:34s} {r['status']:6s} {r['newton']:6d} {r['steps']:5d} {r['accepted']:4d} {r['passes']:6d} "
+                f"{r['wall_s']:9.2f} {r['F']:18.10g}")
+        if args.tight:
+            t = solve(name, table[name](), tol / 1000.0)
+            line += f"  {r['F'] / t['F'] - 1:+.1e}" if t["status"] == "ok" else f"  ({t['status']})"
+        line += "  yes" if r["newton"] > r["steps"] else "  no"
+        print(line, flush=True)
+    print(f"{'total':34s} {'':6s} {int(totals[0]):6d} {'':5s} {'':4s} {int(totals[1]):6d} {totals[2]:9.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
