@@ -128,10 +128,11 @@ def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_pe
     H = 2.0 * bending_length_m + 3.0 * element_length_m
     if max_capture_m is not None:
         H = min(H, max_capture_m)
-    u = inward * (s - s_end_m)                       # > 0 inside the bend
     # from the bend's body (half its length in) outwards: the cable may land well inside the bend
     # (a free span across the clearance under gravity)
     inside = max_capture_m if max_capture_m is not None else bending_length_m + H
+    s, F = _near_end(s, F, s_end_m, max(H + bending_length_m + window_m / 2, inside + H, window_m / 2))
+    u = inward * (s - s_end_m)                       # > 0 inside the bend
     near = np.flatnonzero((u >= -(H + bending_length_m + window_m / 2)) & (u <= inside))
     near = near[np.argsort(-u[near])]
     loaded = F[near] > 1e-12 * max(float(F[near].max()) if near.size else 0.0, 1e-300)
@@ -174,6 +175,20 @@ def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_pe
     return P, float(s_end_m + inward * (u_end - ze))
 
 
+def _near_end(s, F, s_end_m: float, reach_m: float):
+    """The sorted points ``s`` [m] (forces ``F``) within ``reach_m`` of ``s_end_m``, and one more
+    on each side: all that :func:`bend_end_point_load` looks at (its selections lie within the
+    reach; the first point past its window is at most the next one out), as contiguous slices, so
+    that its sums run over the same numbers in the same order as over the whole route (Example 4:
+    78 400 points on the route, a few thousand near an end). Unsorted input is returned whole."""
+    if s.size < 2 or not np.all(s[1:] >= s[:-1]):
+        return s, F
+    margin = reach_m * (1.0 + 1e-9) + 1e-9          # beyond the rounding of u = ±(s − s_end)
+    i0 = max(int(np.searchsorted(s, s_end_m - margin, side="left")) - 1, 0)
+    i1 = int(np.searchsorted(s, s_end_m + margin, side="right")) + 1
+    return s[i0:i1], F[i0:i1]
+
+
 @dataclass(frozen=True)
 class _Piece:
     s0: float
@@ -212,6 +227,7 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
         L_e [m] (the point loads' capture window, :func:`bend_end_point_load`).
     """
     s_pts, cum = _cumulative_points(s_m, force_N)
+    f_pts = np.diff(cum)                             # the forces in the order of s_pts
     rs, rc = _rope_cumulative(rope_s_m, rope_pressure_N_per_m)
     ro = np.argsort(rope_s_m)
     rope_T = (np.asarray(rope_s_m, dtype=float)[ro], np.asarray(rope_tension_N, dtype=float)[ro])
@@ -241,7 +257,7 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
             lam = bending_length_m if bending_stiffness_N_m2 is None else float(
                 np.sqrt(bending_stiffness_N_m2 / max(T_here, 1e-12)))
             lams.append(lam)
-            ends[name] = bend_end_point_load(s_pts, np.diff(cum), s_end, inward, body_pressure, lam,
+            ends[name] = bend_end_point_load(s_pts, f_pts, s_end, inward, body_pressure, lam,
                                              element_length_m, window_m, max_capture_m=0.5 * (b.s1 - b.s0))
         t_start = (float(np.interp(b.s0, *cab_T)), float(np.interp(b.s1, *cab_T)))
         r_start = (float(np.interp(b.s0, *rope_T)), float(np.interp(b.s1, *rope_T)))

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 # The writers live in io.py (one atomic writer); re-exported here, where callers have found them.
-from .io import atomic_write_bytes, atomic_write_text, read_csv, write_csv, write_json
+from .io import AtomicBatch, atomic_write_bytes, atomic_write_text, read_csv, write_csv, write_json
 from .plots.results import plot_pressure, plot_pull_force, plot_tension_profile
 from .pressure import BEND_COLUMNS, PRESSURE_COLUMNS
 
@@ -65,30 +65,28 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
-    write_csv(out / "history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
-    written.append(out / "history.csv")
-    if result.tension_profile is not None:
-        write_csv(out / "tension_profile.csv", PROFILE_COLUMNS, result.tension_profile)
-        written.append(out / "tension_profile.csv")
-    if result.contact_profile is not None:
-        write_csv(out / "contact_profile.csv", CONTACT_COLUMNS, result.contact_profile)
-        written.append(out / "contact_profile.csv")
-    if result.rope_profile is not None:
-        write_csv(out / "rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
-        written.append(out / "rope_profile.csv")
-    if result.bends:
-        write_csv(out / "bends.csv", BEND_COLUMNS, {c: [row[c] for row in result.bends] for c in BEND_COLUMNS})
-        written.append(out / "bends.csv")
-    if result.pressure_profile is not None:
-        write_csv(out / "pressure_profile.csv", PRESSURE_COLUMNS, result.pressure_profile)
-        written.append(out / "pressure_profile.csv")
-    if result.snapshots:
-        from .formats import SNAPSHOT_FILES
-        for name, data in result.snapshots.items():
-            write_csv(out / name, SNAPSHOT_FILES[name], data)
-            written.append(out / name)
-    write_json(out / "summary.json", result.summary)
-    written.append(out / "summary.json")
+    # one batch: the files are flushed to disk together and renamed in this order, summary.json
+    # last; an error on the way still puts the files before it in place (io.AtomicBatch)
+    with AtomicBatch() as batch:
+        def add_csv(name, columns, data):
+            written.append(write_csv(out / name, columns, data, batch=batch))
+
+        add_csv("history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
+        if result.tension_profile is not None:
+            add_csv("tension_profile.csv", PROFILE_COLUMNS, result.tension_profile)
+        if result.contact_profile is not None:
+            add_csv("contact_profile.csv", CONTACT_COLUMNS, result.contact_profile)
+        if result.rope_profile is not None:
+            add_csv("rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
+        if result.bends:
+            add_csv("bends.csv", BEND_COLUMNS, {c: [row[c] for row in result.bends] for c in BEND_COLUMNS})
+        if result.pressure_profile is not None:
+            add_csv("pressure_profile.csv", PRESSURE_COLUMNS, result.pressure_profile)
+        if result.snapshots:
+            from .formats import SNAPSHOT_FILES
+            for name, data in result.snapshots.items():
+                add_csv(name, SNAPSHOT_FILES[name], data)
+        written.append(write_json(out / "summary.json", result.summary, batch=batch))
     # the figures come after the numbers: they cost about half a second of matplotlib, and a
     # failure to draw must not hold back (or lose) a result already computed
     if plots:

@@ -242,22 +242,17 @@ def test_damping_onset_values():
     np.testing.assert_array_equal(damping_onset(LAW, d), np.ones(5))
 
 
-@pytest.mark.parametrize("surface", ["segments", "smooth"])
-@pytest.mark.parametrize("kind", ["bend", "helix", "sbend"])
-def test_profiles_of_both_backends_agree(kind, surface):
-    """ContactKernel.points() goes to the kernel's backend like every other call: the compiled
-    profiles (segment, penetration, normal, arc length, forces, slip) equal the numpy reference's,
-    on a cable partly in contact, partly free, with its lead pulled out past the conduit's end."""
-    cond = conduit(kind)
+def cable_partly_in_contact(cond, seed=5):
+    """(q, q̇, element lengths) of a cable along the conduit from a fifth of its length to 3 %
+    past its open end, at a distance from the axis that varies along it (in contact with δ up to
+    0.4 mm, and free), offset in random directions across the tangent."""
     length = cond.centreline.length_m
     s_nodes = np.linspace(0.2 * length, 1.03 * length, 21)  # the last node 3 % past the open end
-    rng = np.random.default_rng(5)
-    # distance from the axis varies along the cable: in contact (δ up to 0.4 mm) and free
+    rng = np.random.default_rng(seed)
     distance = GAP + rng.uniform(-3e-4, 4e-4, size=(s_nodes.size, 1))
     c = cond.centreline
     inside = np.minimum(s_nodes, length)
     t = c.tangent(inside)
-    # offset in a random direction across the tangent
     e1 = np.cross(t, [0.3, 0.2, 1.0])
     e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
     e2 = np.cross(t, e1)
@@ -267,8 +262,19 @@ def test_profiles_of_both_backends_agree(kind, surface):
     q = np.hstack([pos, t]).reshape(-1)
     q_t = np.hstack([0.1 * t + rng.normal(scale=0.02, size=t.shape),
                      rng.normal(scale=0.05, size=t.shape)]).reshape(-1)
-    L = np.linalg.norm(np.diff(pos, axis=0), axis=1)
-    kw = dict(n_elements=L.size, surface=surface, centreline=c)
+    return q, q_t, np.linalg.norm(np.diff(pos, axis=0), axis=1)
+
+
+@pytest.mark.parametrize("surface", ["segments", "smooth"])
+@pytest.mark.parametrize("kind", ["bend", "helix", "sbend"])
+def test_profiles_of_both_backends_agree(kind, surface):
+    """ContactKernel.points() goes to the kernel's backend like every other call: the compiled
+    profiles (segment, penetration, normal, arc length, forces, slip) equal the numpy reference's,
+    on a cable partly in contact, partly free, with its lead pulled out past the conduit's end."""
+    cond = conduit(kind)
+    length = cond.centreline.length_m
+    q, q_t, L = cable_partly_in_contact(cond)
+    kw = dict(n_elements=L.size, surface=surface, centreline=cond.centreline)
     ref = ContactKernel(cond.segments, L, R_CABLE, LAW, 24, backend="numpy", **kw).points(q, q_t)
     fast = ContactKernel(cond.segments, L, R_CABLE, LAW, 24, backend="numba", **kw).points(q, q_t)
     assert ref.in_contact.sum() > 20 and (~ref.in_contact).sum() > 20
@@ -286,6 +292,30 @@ def test_profiles_of_both_backends_agree(kind, surface):
         a, b = getattr(fast, name), getattr(ref, name)
         assert np.array_equal(np.isnan(a), np.isnan(b)), name
         assert np.nanmax(np.abs(a - b)) <= 1e-10 * scale, name
+
+
+@pytest.mark.parametrize("surface", ["segments", "smooth"])
+@pytest.mark.parametrize("kind", ["bend", "helix", "sbend"])
+def test_compiled_profiles_are_the_numpy_definitions_bits(kind, surface):
+    """From one point state, the compiled profiles (exucable.contact.profiles) give exactly the
+    numpy definition's penetration, normal and arc length (the same operations in the same order;
+    the result files must not change by an ulp), for points in contact, free, past the open end
+    and outside every segment."""
+    from exucable.contact.profiles import point_profiles
+
+    cond = conduit(kind)
+    q, q_t, L = cable_partly_in_contact(cond, seed=11)
+    k = ContactKernel(cond.segments, L, R_CABLE, LAW, 24, backend="numba", n_elements=L.size,
+                      surface=surface, centreline=cond.centreline)
+    st = k._point_state(q, q_t)
+    p, seg, residual = st["position_m"], st["segment"].copy(), st["residual_m"].copy()
+    seg[:5], residual[:5] = -1, np.nan                  # as the kernel reports points outside
+    beyond = np.all(residual == 0.0, axis=1)            # past the open end: Pc = P
+    assert beyond.any() and (seg >= 0).sum() > 100
+    ref = k._profiles_numpy(p, seg, residual)
+    got = point_profiles(p, seg, residual, k.gap_m, k.segments, k.wall)
+    for name, a, b in zip(("penetration_m", "normal", "s_conduit_m"), got, ref):
+        np.testing.assert_array_equal(a, b, err_msg=name)
 
 
 @pytest.mark.parametrize("kind", ["bend", "helix", "sbend"])

@@ -71,6 +71,25 @@ def test_bend_table_recovers_a_known_distribution(spread_points):
     assert rev["entry_point_load_N"] == b["exit_point_load_N"] and rev["tension_in_N"] == b["tension_out_N"]
 
 
+@pytest.mark.parametrize("spread_points", [1, 7])
+@pytest.mark.parametrize("weight_N", [0.0, 1e-6])
+def test_point_loads_look_only_near_their_bend_end(spread_points, weight_N, monkeypatch):
+    """bend_end_point_load works on the sorted points near its bend end only (pressure._near_end,
+    for speed): the same loads and places, to the bit, as over the whole route, at both ends,
+    whether a lift-off gap is found or not (every point loaded by a weight: the excess over ±w/2)."""
+    import exucable.pressure as pressure
+
+    cl, s, F, T, s_rope, T_rope, p_rope, s1 = _stiff_cable_loads(spread_points)
+    F = F + weight_N
+    w = default_window_m(cl)
+    args = (cl.pieces, s, F, s, T, s_rope, T_rope, p_rope, w, 0.012)
+    near = bend_table(*args, element_length_m=0.003)
+    monkeypatch.setattr(pressure, "_near_end", lambda s, F, s_end_m, reach_m: (s, F))
+    whole = bend_table(*args, element_length_m=0.003)
+    assert near == whole
+    assert near[0]["entry_point_load_N"] != 0.0 and near[0]["exit_point_load_N"] != 0.0
+
+
 @pytest.fixture(scope="module")
 def ex2_rule_mesh(tmp_path_factory):
     """Paper Example 2 (fast variant) on the mesh rule's mesh: 32 elements × 29 check points."""

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-__all__ = ["SmoothWall", "refine_closest_points", "closest_point_angles", "NEWTON_ITERATIONS"]
+__all__ = ["SmoothWall", "refine_closest_points", "closest_point_angles", "angles_on_pieces", "NEWTON_ITERATIONS"]
 
 # Newton steps for a helix: the chord's estimate is within ~1e-3 rad (the sagitta's angle), and
 # the convergence is quadratic: 1e-6 after one step, 1e-12 after two. (Bends need none: closed form.)
@@ -175,9 +175,20 @@ def closest_point_angles(p, residual, seg, t, seg_length, wall: SmoothWall):
     mask, idx, pc, estimate = _on_curved_pieces(seg, t, seg_length, wall)
     if not idx.size:
         return mask, phi_out
-    x = p[idx] - residual[idx] - pc[:, _C:_C + 3]
-    polar = np.arctan2(np.einsum("ij,ij->i", x, pc[:, _E2:_E2 + 3]),
-                       np.einsum("ij,ij->i", x, pc[:, _E1:_E1 + 3]))
-    phi = estimate + ((polar - estimate + np.pi) % (2.0 * np.pi) - np.pi)
-    phi_out[idx] = np.clip(phi, 0.0, pc[:, _PHI])
+    # the piece's axes as contiguous (m, 3) arrays, the layout the compiled profiles pass
+    # (exucable.contact.profiles): both take the same einsum path, so give the same bits
+    phi_out[idx] = angles_on_pieces(p[idx] - residual[idx] - pc[:, _C:_C + 3], estimate,
+                                    np.ascontiguousarray(pc[:, _E1:_E1 + 3]),
+                                    np.ascontiguousarray(pc[:, _E2:_E2 + 3]), pc[:, _PHI])
     return mask, phi_out
+
+
+def angles_on_pieces(relative_m, estimate_rad, e1, e2, phi_max_rad):
+    """Helix angle φ [rad] of closest points Pc given relative to their pieces' centres,
+    ``relative_m`` = Pc − c (m, 3) [m], next to the chord's estimates ``estimate_rad`` (m,):
+    the polar angle in the plane of the pieces' axes ``e1``, ``e2`` (m, 3), unwrapped next to the
+    estimate (a helix may coil more than one turn) and clamped to [0, ``phi_max_rad``] (m,) (see
+    :func:`closest_point_angles`). NaN stays NaN."""
+    polar = np.arctan2(np.einsum("ij,ij->i", relative_m, e2), np.einsum("ij,ij->i", relative_m, e1))
+    phi = estimate_rad + ((polar - estimate_rad + np.pi) % (2.0 * np.pi) - np.pi)
+    return np.clip(phi, 0.0, phi_max_rad)

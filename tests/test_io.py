@@ -1,0 +1,59 @@
+"""The one atomic writer (exucable.io): a batch of files flushed together, renamed in order, and
+no result already written lost on an error."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+import exucable.io as eio
+from exucable.io import AtomicBatch, write_csv
+
+
+def test_a_batch_lands_every_file_in_the_order_added(tmp_path, monkeypatch):
+    """Nothing is in place before the commit; then every file is, with its content, renamed in the
+    order added (summary.json last marks complete results), each only after all are on disk."""
+    events = []
+    real_fsync, real_replace = os.fsync, os.replace
+    monkeypatch.setattr(eio.os, "fsync", lambda fd: (events.append("fsync"), real_fsync(fd))[1])
+    monkeypatch.setattr(eio.os, "replace", lambda a, b: (events.append(os.path.basename(b)), real_replace(a, b))[1])
+    batch = AtomicBatch()
+    write_csv(tmp_path / "a.csv", ["x_m"], {"x_m": [0.5, 1.0]}, batch=batch)
+    batch.add_text(tmp_path / "sub" / "b.txt", "bee\n")
+    batch.add(tmp_path / "summary.json", b"{}\n")
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == ["sub"]
+    assert batch.commit() == [tmp_path / "a.csv", tmp_path / "sub" / "b.txt", tmp_path / "summary.json"]
+    assert events == ["fsync"] * 3 + ["a.csv", "b.txt", "summary.json"]
+    assert (tmp_path / "a.csv").read_text() == "x_m\n0.5\n1.0\n"
+    assert (tmp_path / "sub" / "b.txt").read_text() == "bee\n"
+    assert not list(tmp_path.rglob(".*.tmp"))
+
+
+def test_an_error_keeps_the_files_added_before_it(tmp_path):
+    """Leaving the batch by an error commits what was added before it (a run's CSVs stay when a
+    later file fails), leaves no temporary file, and lets the error through."""
+    with pytest.raises(KeyError):
+        with AtomicBatch() as batch:
+            write_csv(tmp_path / "history.csv", ["t_s"], {"t_s": [1.0]}, batch=batch)
+            write_csv(tmp_path / "bends.csv", ["bend"], {}, batch=batch)     # no such column
+    assert (tmp_path / "history.csv").read_text() == "t_s\n1.0\n"
+    assert not (tmp_path / "bends.csv").exists()
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_a_failed_flush_puts_nothing_in_place_and_leaves_no_temporary_file(tmp_path, monkeypatch):
+    (tmp_path / "old.csv").write_text("old\n")
+
+    def full(fd):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(eio.os, "fsync", full)
+    batch = AtomicBatch()
+    batch.add_text(tmp_path / "old.csv", "new\n")
+    batch.add_text(tmp_path / "other.csv", "other\n")
+    with pytest.raises(OSError, match="No space"):
+        batch.commit()
+    assert (tmp_path / "old.csv").read_text() == "old\n"        # the old file, never a torn one
+    assert not (tmp_path / "other.csv").exists()
+    assert not list(tmp_path.glob(".*.tmp"))
