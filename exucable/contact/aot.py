@@ -55,6 +55,7 @@ KERNELS = {
     "fast._search_kernel": "f1 f1 f1 f1 f1 f1 f2 i1 i1 f2 i2 i i",
     "steady._steady_kernel": "f1 f1 f1 f1 f1 f1 f1 f1 f1 f1 f f2 i2 f2 f1 f2 i1 i1 f f f f i f f f f f b f1 "
                              "f3 f2 f2 i1 f2 f2 i i b i1 f2 f2 i f",
+    "profiles._profiles": "f2 i1 f2 f f2 f2 f1 f1 b i1 f2 f2 f1 f2 f1 i1 i1 f1 f2 f2 f2 f1",
     "broadphase._element_boxes": "f1 f1 f f2 f2",
     "broadphase._sweep_pairs": "f2 f2 f2 f2 i1 i1 i i1 i1 i1 i1",
     "broadphase._pairs_to_csr": "i i1 i1 i i i1 i1 i1 i1",

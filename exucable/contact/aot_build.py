@@ -6,6 +6,7 @@ Imports numba (and its deprecated but working ``pycc``) only when :func:`build` 
 from __future__ import annotations
 
 import contextlib
+import importlib
 import os
 import tempfile
 import time
@@ -13,12 +14,9 @@ import warnings
 from pathlib import Path
 
 from ..io import atomic_write_bytes
-from . import aot, broadphase, fast, nearest, steady
+from . import aot
 
 __all__ = ["CompilerUnavailable", "build", "numba_argtypes"]
-
-_MODULES = {"fast": fast, "steady": steady, "broadphase": broadphase, "nearest": nearest}
-
 
 class CompilerUnavailable(RuntimeError):
     """No C compiler, no pycc or no writable directory: the kernels stay numba's JIT ones."""
@@ -62,7 +60,7 @@ def build(directory: Path | None = None) -> tuple[Path, float]:
     cc.verbose = False
     for name, tokens in aot.KERNELS.items():
         module, function = name.split(".")
-        dispatcher = getattr(_MODULES[module], function).dispatcher
+        dispatcher = getattr(importlib.import_module(f"{__package__}.{module}"), function).dispatcher  # the table names them
         argtypes = numba_argtypes(tokens, types)
         try:
             dispatcher.compile(argtypes)

@@ -18,19 +18,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
-
-from .jitcache import jit_cache_available
+from .jitcache import njit
 from .smooth import angles_on_pieces
 
 __all__ = ["point_profiles"]
 
 
-def _cache_probe():
-    """Stands for this file's functions in the check for a writable numba cache."""
-
-
-_JIT = dict(cache=jit_cache_available(_cache_probe), nogil=True, error_model="numpy")
+# no fast-math: the numpy form's bits (the deferred njit caches on disk where it can)
+_JIT = dict(nogil=True, error_model="numpy")
 
 # piece table columns (exucable.contact.smooth)
 _C, _E1, _E2, _PHI, _CURVED = 0, 3, 6, 14, 15
