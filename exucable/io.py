@@ -142,6 +142,9 @@ def csv_text(columns, data: dict) -> str:
     Floats are written with ``repr`` (shortest round-trip form), so reading them back is exact;
     integer arrays (indices) as integers.
     """
+    lengths = {c: len(data[c]) for c in columns}
+    if len(set(lengths.values())) > 1:    # zip below would silently cut every column to the shortest
+        raise ValueError(f"columns of unequal length {lengths}: one row per value is needed")
     buf = io.StringIO()
     csv.writer(buf, lineterminator="\n").writerow(columns)
     # integer columns (node and element indices) stay integers; tolist() gives Python ints and

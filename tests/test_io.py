@@ -57,3 +57,11 @@ def test_a_failed_flush_puts_nothing_in_place_and_leaves_no_temporary_file(tmp_p
     assert (tmp_path / "old.csv").read_text() == "old\n"        # the old file, never a torn one
     assert not (tmp_path / "other.csv").exists()
     assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_columns_of_unequal_length_are_refused(tmp_path):
+    """One value per row in every column: a shorter column (an empty one) is an error naming the
+    lengths, not a file silently cut to the shortest column."""
+    with pytest.raises(ValueError, match="unequal length"):
+        write_csv(tmp_path / "history.csv", ["time_s", "max_penetration_m"], {"time_s": [1.0, 2.0], "max_penetration_m": []})
+    assert not (tmp_path / "history.csv").exists()

@@ -29,7 +29,11 @@ class History:
     max_axis_offset_s_conduit_m: list = field(default_factory=list)
 
     def arrays(self) -> dict[str, np.ndarray]:
-        return {k: np.asarray(v, dtype=float) for k, v in self.__dict__.items()}
+        """The recorded columns as float arrays; a column nothing was recorded into (the contact
+        columns of a steady solve, whose pseudo-time steps record forces only) is left out, so
+        that every column returned has one value per row."""
+        rows = len(self.time_s)
+        return {k: np.asarray(v, dtype=float) for k, v in self.__dict__.items() if len(v) or not rows}
 
 
 def earliest_steady_s(cable) -> float:
