@@ -184,3 +184,36 @@ def test_the_compile_command_says_whether_the_module_is_up_to_date(aot_module, m
     assert main(["compile", "--check"]) == 1
     assert "exucable compile" in capsys.readouterr().out
     aot.reset()
+
+
+def test_jit_machine_code_that_inlined_changed_sources_is_compiled_again(tmp_path, monkeypatch):
+    """Numba's disk cache keys a function on its own file only: machine code that inlined another
+    file's helper would load unchanged after that helper changed. A marker of the kernel sources'
+    hash beside the cache empties the index when the sources changed (a cache hit only while they
+    have not)."""
+    import importlib.util
+
+    from numba import njit as numba_njit
+    from numba.core.types import float64
+
+    from exucable.contact.jitcache import forget_stale_machine_code
+
+    source = tmp_path / "tiny_kernel.py"
+    source.write_text("def twice(x):\n    return 2.0 * x\n")
+    spec = importlib.util.spec_from_file_location("tiny_kernel", source)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+
+    def fresh_dispatcher():
+        d = numba_njit(cache=True)(module.twice)
+        assert d(1.5) == 3.0
+        return d
+
+    first = fresh_dispatcher()                       # compiled and saved; no marker yet
+    assert forget_stale_machine_code(first, "tiny.twice")          # so it is taken as stale
+    assert fresh_dispatcher().stats.cache_hits.get((float64,), 0) == 0
+    assert not forget_stale_machine_code(fresh_dispatcher(), "tiny.twice")   # marker current: kept
+    assert fresh_dispatcher().stats.cache_hits.get((float64,), 0) == 1
+    monkeypatch.setattr(aot, "key", lambda sources=None: "other sources")    # a helper file changed
+    assert forget_stale_machine_code(fresh_dispatcher(), "tiny.twice")
+    assert fresh_dispatcher().stats.cache_hits.get((float64,), 0) == 0

@@ -9,7 +9,9 @@ not numba's: it records the function and its numba options and imports nothing. 
    at all, which saves its import and CPU-target initialisation (0.7 s, issue 15, fixed cost);
 2. else to numba's JIT dispatcher, created on first use with ``cache=True``: the first call in a
    fresh environment compiles (tens of seconds for :mod:`.fast`), later processes load the machine
-   code from disk (a tenth of a second).
+   code from disk (a tenth of a second). Numba would load a kernel's machine code even after a
+   helper it inlined from another file changed; :func:`forget_stale_machine_code` compiles it
+   again then.
 
 Nothing here sets ``NUMBA_*`` options: a process that imports exucable keeps numba's configuration
 as the user set it. Numba looks for a writable cache directory in this order
@@ -31,10 +33,13 @@ from __future__ import annotations
 
 import functools
 import warnings
+from pathlib import Path
 
+from ..io import atomic_write_text
+from . import aot
 from .aot import exported
 
-__all__ = ["njit", "Kernel", "jit_cache_available"]
+__all__ = ["njit", "Kernel", "forget_stale_machine_code", "jit_cache_available"]
 
 
 def jit_cache_available(func) -> bool:
@@ -60,6 +65,36 @@ def _probe_cache(func) -> bool:
         warnings.warn(f"exucable: the contact kernel cannot be cached on disk ({exc}); it is compiled "
                       "in every process. Set NUMBA_CACHE_DIR to a writable directory to cache it.",
                       RuntimeWarning, stacklevel=4)
+        return False
+    return True
+
+
+def forget_stale_machine_code(dispatcher, name: str) -> bool:
+    """Empty ``dispatcher``'s on-disk cache if the kernel sources changed since it was written.
+
+    Numba keys a cached function on its own source file's time stamp and its own bytecode only:
+    machine code that inlined a function from another file (the steady kernel inlines
+    :mod:`.fast`'s closest-point and contact-law helpers) is loaded unchanged after that other file
+    changes, i.e. the old code runs. A marker file beside the cache holds the hash of all this
+    package's sources (:func:`exucable.contact.aot.key`, which keys the ahead-of-time module too);
+    a different or missing marker flushes the cache index, so the kernel is compiled again.
+    Returns whether it flushed. A cache it cannot write is left alone (numba then compiles in memory).
+    """
+    cache = getattr(dispatcher, "_cache", None)
+    path = getattr(cache, "cache_path", None)
+    if path is None:
+        return False
+    marker = Path(path) / f"{name}.sources"
+    current = aot.key()
+    try:
+        if marker.read_text() == current:
+            return False
+    except OSError:
+        pass
+    try:
+        cache.flush()
+        atomic_write_text(marker, current)
+    except OSError:
         return False
     return True
 
@@ -93,6 +128,8 @@ class Kernel:
                 options = dict(self.targetoptions)
                 options.setdefault("cache", jit_cache_available(self.py_func))
                 self._dispatcher = numba_njit(**options)(self.py_func)
+                if options["cache"]:
+                    forget_stale_machine_code(self._dispatcher, self.name)
         return self._dispatcher
 
     @property
