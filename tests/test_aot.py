@@ -196,6 +196,7 @@ def test_jit_machine_code_that_inlined_changed_sources_is_compiled_again(tmp_pat
     from numba import njit as numba_njit
     from numba.core.types import float64
 
+    from exucable.contact import jitcache
     from exucable.contact.jitcache import forget_stale_machine_code
 
     source = tmp_path / "tiny_kernel.py"
@@ -214,6 +215,6 @@ def test_jit_machine_code_that_inlined_changed_sources_is_compiled_again(tmp_pat
     assert fresh_dispatcher().stats.cache_hits.get((float64,), 0) == 0
     assert not forget_stale_machine_code(fresh_dispatcher(), "tiny.twice")   # marker current: kept
     assert fresh_dispatcher().stats.cache_hits.get((float64,), 0) == 1
-    monkeypatch.setattr(aot, "key", lambda sources=None: "other sources")    # a helper file changed
+    monkeypatch.setattr(jitcache, "sources_key", lambda: "other sources")    # a helper file changed
     assert forget_stale_machine_code(fresh_dispatcher(), "tiny.twice")
     assert fresh_dispatcher().stats.cache_hits.get((float64,), 0) == 0

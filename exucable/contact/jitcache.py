@@ -36,8 +36,7 @@ import warnings
 from pathlib import Path
 
 from ..io import atomic_write_text
-from . import aot
-from .aot import exported
+from .aot import exported, key as sources_key
 
 __all__ = ["njit", "Kernel", "forget_stale_machine_code", "jit_cache_available"]
 
@@ -85,7 +84,7 @@ def forget_stale_machine_code(dispatcher, name: str) -> bool:
     if path is None:
         return False
     marker = Path(path) / f"{name}.sources"
-    current = aot.key()
+    current = sources_key()
     try:
         if marker.read_text() == current:
             return False
