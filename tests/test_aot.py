@@ -218,3 +218,25 @@ def test_jit_machine_code_that_inlined_changed_sources_is_compiled_again(tmp_pat
     monkeypatch.setattr(jitcache, "sources_key", lambda: "other sources")    # a helper file changed
     assert forget_stale_machine_code(fresh_dispatcher(), "tiny.twice")
     assert fresh_dispatcher().stats.cache_hits.get((float64,), 0) == 0
+
+
+@pytest.mark.parametrize("forced", [False, True])
+def test_a_run_on_jit_kernels_says_how_to_build_the_compiled_ones(tmp_path, monkeypatch, capsys, forced):
+    """`exucable run` without an ahead-of-time module (numba's start-up paid) says so and names
+    `exucable compile`; not when the JIT kernels were asked for (EXUCABLE_KERNELS=jit)."""
+    import numba  # noqa: F401 - the JIT path has imported it in such a run
+
+    from exucable.cli import main as cli_main
+
+    monkeypatch.setattr(aot, "find", lambda: None)
+    if forced:
+        monkeypatch.setenv(aot.MODE_VARIABLE, "jit")
+    else:
+        monkeypatch.delenv(aot.MODE_VARIABLE, raising=False)
+    aot.reset()
+    try:
+        toml = Path(__file__).parent / "data" / "sweep" / "tiny_bend.toml"
+        assert cli_main(["run", str(toml), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    finally:
+        aot.reset()
+    assert ("`exucable compile`" in capsys.readouterr().out) is not forced
