@@ -1,7 +1,7 @@
 """Three-point bending predicted: the beam-in-conduit model's change of the pulling force against its own
 EJ → 0 limit, for the industry routes and the bending-stiffness study's `tight` bend (issue 10, items 6–7).
 
-`exucable.beam_conduit.stiff_route_difference` — an independent steady beam in the conduit (a node chain
+`exucable.quasistatic.beam.stiff_route_difference` — an independent steady beam in the conduit (a node chain
 with unilateral round walls, the weight, Coulomb friction; not Exudyn, not ANCF) — at two node spacings
 (λ/10 and λ/20), beside nothing of exucable's own: reference/README.md sets these predictions beside the
 measured exucable − rope with clearance (`exucable validate --suite industry`, `bending_stiffness_study.py`).
@@ -25,7 +25,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from exucable.beam_conduit import route_pieces, stiff_route_difference  # noqa: E402
+from exucable.quasistatic.beam import route_pieces, stiff_route_difference  # noqa: E402
 from exucable.io import atomic_write_text  # noqa: E402
 
 INDUSTRY = [("commscope_conquest_run_a_h", "forward"), ("commscope_conquest_run_a_h", "reverse"),
@@ -36,7 +36,7 @@ TIGHT = [(False, 2.25), (False, 4.0), (True, 1.0), (True, 2.25)]
 
 
 def industry_case(name, direction, ej_scale):
-    from exucable.scenario import load_scenario
+    from exucable.scenario.specs import load_scenario
     sc = load_scenario(ROOT / "scenarios" / "industry" / f"{name}.toml")
     conduit = sc.build_conduit()
     if direction == "reverse":

@@ -1,17 +1,17 @@
 """Bending stiffness at a bend, predicted and measured (issue 10, items 5–6).
 
-exucable's pulling force against the rope with clearance (the EJ → 0 limit, `exucable.rope_clearance`)
+exucable's pulling force against the rope with clearance (the EJ → 0 limit, `exucable.quasistatic.clearance`)
 on single bends, sweeping the bending length √(EJ/T_in)/R (T_in the rope's tension entering the
-bend), set beside the stiff-bend model `exucable.stiff_bend.stiff_bend` (the elastica landing on the
+bend), set beside the stiff-bend model `exucable.quasistatic.stiff_bend.stiff_bend` (the elastica landing on the
 bend's wall with a point load and its friction; derivation in reference/README.md). Also the bend-end
-point loads of `exucable.pressure` against the model's T sin ψ_e and their places.
+point loads of `exucable.post.pressure` against the model's T sin ψ_e and their places.
 
 Each exucable run is a steady-mode solve (`solver.mode = "steady"`: no start-up vibration, no
 scatter), with elements of at most λ/3 and check points at most λ/8 apart. The cases are those of
 `rope_difference_study.py` (`tight`: R 0.5 m, 15 mm clearance, 18 mm cable, μ 0.5, 100 N back
 tension; `hbend`, `upbend`, `downbend`); the model's exit is held on the rope's line where the
 rig holds the cable's head, the exit straight's length beyond the bend. With gravity the estimate
-also gets the gravity term of the linearised duct model (`exucable.duct_beam`): the stiff cable
+also gets the gravity term of the linearised duct model (`exucable.quasistatic.duct_beam`): the stiff cable
 crossing the floor's trough to a horizontal bend's inner wall, or held by its weight on a
 down-bend's floor, which the in-plane model lacks.
 
@@ -74,7 +74,7 @@ def model_estimate(case: str, clearance_m: float, ej: float, tension_in_N: float
     entry (grown by e^{μθ}) and at the exit (at the tension leaving the bend: the pull less the
     exit straight's rope load).
     """
-    from exucable.stiff_bend import free_span_stiffness_N, stiff_bend
+    from exucable.quasistatic.stiff_bend import free_span_stiffness_N, stiff_bend
     c = CASES[case]
     g = bend_geometry(case)
     mu, rho = c["friction"], g["R_m"] - clearance_m
@@ -91,11 +91,11 @@ def model_estimate(case: str, clearance_m: float, ej: float, tension_in_N: float
 
 def gravity_term(case: str, clearance_m: float, ej: float) -> float:
     """What gravity changes in the stiff cable's pull against the rope with clearance [relative], by
-    the linearised duct model (`exucable.duct_beam.gravity_change_of_stiffness`: the beam crossing
+    the linearised duct model (`exucable.quasistatic.duct_beam.gravity_change_of_stiffness`: the beam crossing
     the floor's trough to a horizontal bend's inner wall, or held on a down-bend's floor by its
     weight; on an up-bend the free spans). Nodes λ/8 apart, 2.5–10 mm (converged to ≤ 0.002
     percentage point: tested at 5 and 2.5 mm on the tight bend)."""
-    from exucable.duct_beam import gravity_change_of_stiffness
+    from exucable.quasistatic.duct_beam import gravity_change_of_stiffness
     c = CASES[case]
     g = bend_geometry(case)
     w = c["mass_kg_per_m"] * G
@@ -125,7 +125,7 @@ def add_gravity_terms(rows) -> None:
 def run_one(case: str, gravity: bool, clearance_m: float, ej: float, refine: float = 1.0) -> dict:
     """One steady-mode run and the model's estimate; a row of the table."""
     from exucable.run import run_scenario
-    from exucable.scenario import parse_scenario
+    from exucable.scenario.specs import parse_scenario
 
     c = CASES[case]
     g = bend_geometry(case)

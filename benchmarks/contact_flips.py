@@ -28,9 +28,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import exucable.model.coupling as coupling  # noqa: E402
-import exucable.solve as solve  # noqa: E402
+import exucable.solve.dynamic as solve  # noqa: E402
 from exucable.model.build import build_model  # noqa: E402
-from exucable.scenario import load_scenario  # noqa: E402
+from exucable.scenario.specs import load_scenario  # noqa: E402
 
 
 def record_force_calls(scenario_path, t_from: float, t_to: float):

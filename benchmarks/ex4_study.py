@@ -25,8 +25,8 @@ from run_examples import run  # noqa: E402
 
 def main():
     path = ROOT / "scenarios" / "paper_ex4_spatial.toml"
-    from exucable.scenario import load_scenario
-    from exucable.rope import solve_rope
+    from exucable.scenario.specs import load_scenario
+    from exucable.quasistatic.rope import solve_rope
     sc = load_scenario(path)
     w = sc.cable.mass_per_length_kg_per_m * sc.gravity.g_m_per_s2
     rope = solve_rope(sc.build_conduit().centreline, sc.contact.friction, w,
@@ -71,8 +71,8 @@ steady_stop = true
 
 def bend_study():
     import tempfile
-    from exucable.scenario import load_scenario
-    from exucable.rope import solve_rope
+    from exucable.scenario.specs import load_scenario
+    from exucable.quasistatic.rope import solve_rope
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "bend.toml"
         path.write_text(BEND)

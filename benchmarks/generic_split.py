@@ -35,7 +35,7 @@ from exudyn.itemInterface import NodePointSlope1, ObjectANCFCable  # noqa: E402
 
 from exucable.contact import block_sparsity  # noqa: E402
 from exucable.model.generic import add_user_force_object  # noqa: E402
-from exucable.solve import quiet_sparse  # noqa: E402
+from exucable.solve.dynamic import quiet_sparse  # noqa: E402
 
 
 class _Block:

@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 from exucable.run import run_scenario
-from exucable.scenario import load_scenario
+from exucable.scenario.specs import load_scenario
 
 ROUTES = ["commscope_conquest_500ft_bend90", "commscope_conquest_run_a_h", "gera_wire_pulling_example",
           "machinecalcs_two_bends"]

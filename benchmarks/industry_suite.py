@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 from exucable.io import write_json
-from exucable.validate_industry import load_industry_examples, validate_industry
+from exucable.validation.industry import load_industry_examples, validate_industry
 
 
 def main(argv=None) -> int:

@@ -33,8 +33,8 @@ sys.path.insert(0, str(ROOT))
 import exudyn as exu  # noqa: E402
 
 from exucable.model.build import build_model  # noqa: E402
-from exucable.scenario import load_scenario  # noqa: E402
-import exucable.solve as solve  # noqa: E402
+from exucable.scenario.specs import load_scenario  # noqa: E402
+import exucable.solve.dynamic as solve  # noqa: E402
 
 
 def residual(solver, mbs, settings) -> np.ndarray:

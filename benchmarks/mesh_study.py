@@ -1,4 +1,4 @@
-"""Does the default mesh (exucable.mesh's rule) give the pulling force within 0.2 % of the refined
+"""Does the default mesh (exucable.scenario.mesh's rule) give the pulling force within 0.2 % of the refined
 answer? Issue #10 item 1.
 
 For each route, ``exucable converge`` runs the scenario on the rule's mesh and on meshes refined by
@@ -27,7 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from exucable.commands.converge import converge  # noqa: E402
 from exucable.io import atomic_write_text  # noqa: E402
-from exucable.scenario import load_scenario  # noqa: E402
+from exucable.scenario.specs import load_scenario  # noqa: E402
 
 CASES = {
     "paper_ex2": ROOT / "scenarios" / "paper_ex2_bend90.toml",
@@ -39,7 +39,7 @@ CASES = {
 
 def rule_mesh(sc):
     """The scenario with its mesh overrides removed: the rule chooses."""
-    from exucable.scenario import parse_scenario
+    from exucable.scenario.specs import parse_scenario
     d = sc.to_dict()
     d["cable"].pop("elements", None)
     d["cable"].pop("element_length", None)

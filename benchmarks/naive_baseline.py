@@ -57,7 +57,7 @@ sys.path.insert(0, {root!r})
 import numpy as np
 import exudyn as exu
 import exucable.contact as contact
-from exucable.scenario import parse_scenario
+from exucable.scenario.specs import parse_scenario
 from exucable.model.build import build_model
 from exucable.model.recorder import History, record_state
 

@@ -53,8 +53,8 @@ def _case(args):
     """Run one case in this process; return its figures."""
     label, source, end_time = args
     import exudyn as exu
-    import exucable.solve as solve
-    from exucable.scenario import parse_scenario
+    import exucable.solve.dynamic as solve
+    from exucable.scenario.specs import parse_scenario
 
     if isinstance(source, dict):
         data, parent = dict(source), ROOT / "scenarios"

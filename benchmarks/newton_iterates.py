@@ -23,7 +23,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import exucable.solve as solve  # noqa: E402
+import exucable.solve.dynamic as solve  # noqa: E402
 from contact_flips import record_force_calls  # noqa: E402
 
 

@@ -38,9 +38,9 @@ _INITIAL = re.compile(r"Newton: initial residual = ([-0-9.e+infa]+)")
 _CHILD = r"""
 import sys, json, time
 sys.path.insert(0, {root!r})
-from exucable.scenario import load_scenario, parse_scenario
+from exucable.scenario.specs import load_scenario, parse_scenario
 from exucable.model.build import build_model
-import exucable.solve as solve
+import exucable.solve.dynamic as solve
 import tomllib
 with open({path!r}, "rb") as f:
     data = tomllib.load(f)
@@ -174,7 +174,7 @@ def main(argv=None) -> int:
     ap.add_argument("--exudyn", action="append", default=[], metavar="KEY=VALUE",
                     help="dotted attribute of SimulationSettings.timeIntegration")
     ap.add_argument("--solve", action="append", default=[], metavar="NAME=VALUE",
-                    help="module setting of exucable.solve (e.g. PREDICTOR=zero)")
+                    help="module setting of exucable.solve.dynamic (e.g. PREDICTOR=zero)")
     ap.add_argument("--json", default=None, help="write the parsed attempts here")
     args = ap.parse_args(argv)
     ov = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}

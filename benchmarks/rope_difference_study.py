@@ -1,8 +1,8 @@
 """What separates exucable from the rope: bending stiffness and the clearance (issue 10, item 6).
 
 On single bends the pulling force of exucable is compared with two flexible references:
-the centreline rope (``exucable.rope``: no bending stiffness, glued to the conduit's centreline)
-and the rope with clearance (``exucable.rope_clearance``: no bending stiffness, free to leave the
+the centreline rope (``exucable.quasistatic.rope``: no bending stiffness, glued to the conduit's centreline)
+and the rope with clearance (``exucable.quasistatic.clearance``: no bending stiffness, free to leave the
 wall and hang in free spans across the clearance). The sweep varies the bending length
 √(EJ/T) against the bend radius R (``cable.bending_stiffness``, at a fixed EA; the references do
 not depend on it) and the clearance c against R, with and without gravity:
@@ -14,7 +14,7 @@ not depend on it) and the clearance c against R, with and without gravity:
   issue's 1 kg/m cable (μ 0.3, 200 N back tension), gravity on.
 
 Both references are evaluated for the cable's extent at the mean time of the averaging window
-(``exucable.references``: the cable leaves the conduit at the pull speed, so the length inside
+(``exucable.quasistatic.extent``: the cable leaves the conduit at the pull speed, so the length inside
 shrinks and the part beyond the exit pulls along the exit line with its weight). Each exucable
 run stops once steady (0.2 s window, 0.1 %); its scatter is the standard deviation there.
 
@@ -87,9 +87,9 @@ def run_one(case: str, clearance_m: float, ej_N_m2: float, gravity: bool, elemen
             check_spacing_m: float = 0.005, end_time_s: float = 1.0) -> dict:
     """One exucable run and both references at the cable's extent; a row of the table."""
     from exucable.model.build import pull_oriented_conduit
-    from exucable.references import pull_force_references_N
+    from exucable.quasistatic.extent import pull_force_references_N
     from exucable.run import run_scenario
-    from exucable.scenario import parse_scenario
+    from exucable.scenario.specs import parse_scenario
 
     data = scenario_dict(case, clearance_m, ej_N_m2, gravity, element_length_m, check_spacing_m, end_time_s)
     sc = parse_scenario(data, ROOT, default_name=data["name"])
@@ -158,8 +158,8 @@ def free_span_estimate_N(case: str, clearance_m: float, gravity: bool) -> float:
 def clearance_limit(clearances_m=(1e-2, 1e-3, 1e-4, 1e-5)) -> list[dict]:
     """The rope with clearance against the centreline rope as c → 0 (no exucable run: seconds)."""
     from exucable.geometry import Bend, Straight, centreline_from_path
-    from exucable.rope import solve_rope
-    from exucable.rope_clearance import solve_rope_with_clearance
+    from exucable.quasistatic.rope import solve_rope
+    from exucable.quasistatic.clearance import solve_rope_with_clearance
 
     rows = []
     for case in ("hbend", "upbend"):
@@ -180,8 +180,8 @@ def clearance_limit(clearances_m=(1e-2, 1e-3, 1e-4, 1e-5)) -> list[dict]:
 def rereference(r: dict) -> dict:
     """Recompute a stored row's references (and differences) at its window's extent, without rerunning exucable."""
     from exucable.model.build import pull_oriented_conduit
-    from exucable.references import pull_force_references_N
-    from exucable.scenario import parse_scenario
+    from exucable.quasistatic.extent import pull_force_references_N
+    from exucable.scenario.specs import parse_scenario
 
     data = scenario_dict(r["case"], r["clearance_m"], r["EJ_N_m2"], r["gravity"], 0.1, 0.005, 1.0)
     data["cable"]["elements"] = r["elements"]
@@ -303,7 +303,7 @@ def mesh_check(path: str, element_length_m: float, check_spacing_m: float) -> li
     import tempfile
 
     from exucable.commands.converge import converge
-    from exucable.scenario import parse_scenario
+    from exucable.scenario.specs import parse_scenario
 
     print(MESH_HEADER, flush=True)
     rows = []

@@ -36,9 +36,9 @@ def _one(args):
     """Run one scenario (dict overrides applied) in this process; return its figures."""
     path, overrides, steady_stop, end_time = args
     import tomllib
-    from exucable.scenario import parse_scenario
+    from exucable.scenario.specs import parse_scenario
     from exucable.model.build import build_model
-    from exucable.solve import simulate
+    from exucable.solve.dynamic import simulate
 
     with open(path, "rb") as f:
         data = tomllib.load(f)

@@ -7,7 +7,7 @@ Newton iterations, the pseudo-time steps tried (rejected ones included), the con
 passes, the solve's wall time, the pulling force and whether the exact-step continuation ran
 (Newton iterations > steps tried: a one-iteration step takes exactly one).
 
-``--set NAME=VALUE`` overrides a constant of :mod:`exucable.solve_steady` (e.g. ``RATE_FALL=16``)
+``--set NAME=VALUE`` overrides a constant of :mod:`exucable.solve.steady` (e.g. ``RATE_FALL=16``)
 to compare a rule across all cases; ``--tight`` also solves each case to 1/1000 of the stop
 tolerance and prints how far the pulling force moves (how converged it is); ``--trace CASE``
 prints, for each accepted pseudo-time step of one case, its residual and the check points whose
@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from exucable.model.build import build_model
-from exucable.scenario import load_scenario, parse_scenario
+from exucable.scenario.specs import load_scenario, parse_scenario
 from exucable.sweep.spec import load_sweep
-import exucable.solve_steady as solve_steady_module
+import exucable.solve.steady as solve_steady_module
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -113,13 +113,13 @@ def main(argv=None) -> int:
     ap.add_argument("--long", action="store_true", help="include the 1 km benchmark route")
     ap.add_argument("--tight", action="store_true", help="also solve to 1/1000 of the stop tolerance")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                    help="override a constant of exucable.solve_steady")
+                    help="override a constant of exucable.solve.steady")
     ap.add_argument("--trace", metavar="CASE", help="per-step residual and contact state of one case")
     args = ap.parse_args(argv)
     for item in args.set:
         key, value = item.split("=", 1)
         if not hasattr(solve_steady_module, key):
-            ap.error(f"--set {item}: exucable.solve_steady has no {key}")
+            ap.error(f"--set {item}: exucable.solve.steady has no {key}")
         setattr(solve_steady_module, key, type(getattr(solve_steady_module, key))(float(value)))
     table = cases(long=args.long or (args.only is not None and "bench-1km" in args.only))
     if args.trace:

@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from exucable.run import run_scenario
-from exucable.scenario import load_scenario, parse_scenario
+from exucable.scenario.specs import load_scenario, parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -149,7 +149,7 @@ def mesh_check(length_m: float, base: dict) -> str:
 def tolerance_check(length_m: float) -> str:
     """Pulling force of the steady solve at the default stop tolerance and at 1/100 of it."""
     from exucable.model.build import build_model
-    from exucable.solve_steady import STATIC_TOLERANCE, solve_steady, steady_forces
+    from exucable.solve.steady import STATIC_TOLERANCE, solve_steady, steady_forces
 
     forces = []
     for tol in (STATIC_TOLERANCE, STATIC_TOLERANCE / 100.0):

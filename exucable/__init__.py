@@ -21,9 +21,22 @@ from .version import __version__
 # rebind the package attribute to the module (Python sets it when a submodule is first loaded).
 # It is light (no Exudyn, matplotlib or dask at import).
 from . import run as _run_module  # noqa: F401
-from .api import (Cable, Contact, Gravity, History, Output, Pull, Result, Route, Solver, TensionProfile, run, vary)
+from .api import (
+    Cable,
+    Contact,
+    Gravity,
+    History,
+    Output,
+    Pull,
+    Result,
+    Route,
+    Solver,
+    TensionProfile,
+    run,
+    vary,
+)
 from .errors import ExucableError, GeometryError, ModelError, ScenarioError, SolverError
-from .scenario import Scenario, load_scenario
+from .scenario.specs import Scenario, load_scenario
 
 # The plugin face on Exudyn, imported on first use so that "import exucable" does not load Exudyn.
 _PLUGIN = {"add_cable_in_conduit", "CableInConduit", "JoinToMarker", "ReelOnto"}

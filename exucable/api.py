@@ -27,9 +27,20 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
-from .scenario import (CableSpec, ConduitSpec, ContactSpec, GravitySpec, OutputSpec, PullSpec, Scenario,
-                       SolverSpec, _build_conduit, _conduit_length_m, _parse_conduit)
-from .scenario_fields import REQUIRED, fields_of
+from .scenario.specs import (
+    CableSpec,
+    ConduitSpec,
+    ContactSpec,
+    GravitySpec,
+    OutputSpec,
+    PullSpec,
+    Scenario,
+    SolverSpec,
+    _build_conduit,
+    _conduit_length_m,
+    _parse_conduit,
+)
+from .scenario.fields import REQUIRED, fields_of
 
 if TYPE_CHECKING:  # for the annotation only: Exudyn is imported when a run is asked for
     from .model.build import Model
@@ -65,7 +76,7 @@ def _part(section: str, spec_cls, summary: str):
 
     make.__name__ = make.__qualname__ = section.capitalize()
     make.__doc__ = (f"{summary}\n\nTakes the ``[{section}]`` keys of a scenario file; returns a validated "
-                    f":class:`~exucable.scenario.{spec_cls.__name__}`.\n\n{_keys_doc(section)}\n\n"
+                    f":class:`~exucable.scenario.specs.{spec_cls.__name__}`.\n\n{_keys_doc(section)}\n\n"
                     "Raises\n------\nScenarioError\n    Unknown key or bad value, naming the dotted key.\n")
     return make
 
@@ -169,7 +180,7 @@ class Route:
                    _survey=survey)
 
     def to_spec(self) -> ConduitSpec:
-        """The validated :class:`~exucable.scenario.ConduitSpec` of this route."""
+        """The validated :class:`~exucable.scenario.specs.ConduitSpec` of this route."""
         if not self._pieces and self._survey is None:
             from .errors import ScenarioError
             raise ScenarioError("conduit.path", "the route has no pieces: add .straight(...), .bend(...), ...")

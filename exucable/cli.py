@@ -35,7 +35,7 @@ class _VersionAction(argparse.Action):
         super().__init__(option_strings=option_strings, dest=dest, default=default, nargs=0, help=help)
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from .versions import version_line
+        from .output.versions import version_line
         print(version_line())            # stdout, as argparse's own version action
         parser.exit()
 

@@ -13,13 +13,13 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ModelError
-from .versions import versions
-from .export import conduit_s
-from .results import RunResult, write_results
-from .scenario import Scenario, load_scenario
-from .pressure import bend_table, default_window_m, pressure_profile
-from .tension import SteadyState, detect_steady_state, tension_at, tension_profile
-from .trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
+from .output.versions import versions
+from .output.export import conduit_s
+from .output.results import RunResult, write_results
+from .scenario.specs import Scenario, load_scenario
+from .post.pressure import bend_table, default_window_m, pressure_profile
+from .post.tension import SteadyState, detect_steady_state, tension_at, tension_profile
+from .post.trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile"]
 
@@ -79,7 +79,7 @@ def cable_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
-    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.pressure)."""
+    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.post.pressure)."""
     if points is None or rope is None:
         return {}, [], None
     centre = model.scenario.build_conduit().centreline
@@ -103,7 +103,7 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
 
 
 def _assess(model, out, st, h, pull_force_N):
-    """Status and flags of a finished run (see :mod:`exucable.trust`)."""
+    """Status and flags of a finished run (see :mod:`exucable.post.trust`)."""
     sc = model.scenario
     c = sc.cable
     pen = np.nan_to_num(h.get("max_penetration_m", np.zeros(0)), nan=-np.inf)
@@ -147,7 +147,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     ``solver.mode``.
     """
     from .model.build import build_model
-    from .solve import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
+    from .solve.dynamic import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
@@ -157,7 +157,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                                         "plan several cables per duct with `exucable plan`")
     _refuse_pulling_the_cable_out(sc)
     t_start = time.perf_counter()
-    from .solve_start import steady_start
+    from .solve.start import steady_start
     first = None
     if sc.solver.start_from == "steady" and sc.solver.mode == "dynamic" and sc.pull.force_N is None and sc.solver.pretension:
         first = steady_start(sc, refine=refine, check_points_per_element=check_points_per_element)
@@ -167,7 +167,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     sp = sc.solver
     recorder = None
     if sp.mode == "steady":
-        from .solve_steady import solve_steady
+        from .solve.steady import solve_steady
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
         h = out.history.arrays()
         # one static state, the start's extent of cable in the conduit (laid out past the exit by
@@ -182,7 +182,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
         snapshot_times = sc.output.times_s(sp.end_time_s)
         if snapshot_times:
-            from .snapshots import SnapshotRecorder
+            from .output.snapshots import SnapshotRecorder
             recorder = SnapshotRecorder(model, snapshot_times)
         out = simulate(model, progress=progress, steady_stop=steady_stop, snapshots=recorder)
         h = out.history.arrays()
@@ -308,7 +308,7 @@ def _refuse_pulling_the_cable_out(sc) -> None:
 
 
 def window_references(scenario, model, window_time_s) -> dict:
-    """Both flexible references (:mod:`exucable.references`) for the cable's extent at the mean
+    """Both flexible references (:mod:`exucable.quasistatic.extent`) for the cable's extent at the mean
     time of the averaging window ``window_time_s`` [s] of a velocity-controlled pull; ``{}`` for a
     force-controlled one (its references are the model's centreline rope)."""
     from .model.rig import ramped_displacement
@@ -324,7 +324,7 @@ def window_references(scenario, model, window_time_s) -> dict:
 def extent_references(scenario, model, pulled_out_m: float) -> dict:
     """Both flexible references for the cable pulled ``pulled_out_m`` [m] out of its start;
     ``{}`` for a force-controlled pull."""
-    from .references import pull_force_references_N
+    from .quasistatic.extent import pull_force_references_N
 
     if scenario.pull.force_N is not None:
         return {}

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from exucable.scenario import parse_scenario
+from exucable.scenario.specs import parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import exucable as xc
-from exucable.closed_forms import capstan_out_N
+from exucable.quasistatic.closed_forms import capstan_out_N
 
 
 def test_exports():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from exucable.run import run_scenario
-from exucable.scenario import load_scenario, parse_scenario
+from exucable.scenario.specs import load_scenario, parse_scenario
 
 from conftest import ROOT
 

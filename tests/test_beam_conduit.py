@@ -1,4 +1,4 @@
-"""The planar beam-in-conduit model against its closed-form limits (exucable/beam_conduit.py).
+"""The planar beam-in-conduit model against its closed-form limits (exucable/quasistatic/beam.py).
 
 Tolerances: the node spacing h = λ/10 resolves the bending length; the wall penalty lets the cable
 in by ~1e-4 c and the trough that fixes a free straight's place without gravity (1e-5 T/ρ per
@@ -10,8 +10,8 @@ import math
 
 import pytest
 
-from exucable.beam_conduit import BeamConduitError, solve_planar_beam, stiff_route_difference
-from exucable.stiff_bend import stiff_bend
+from exucable.quasistatic.beam import BeamConduitError, solve_planar_beam, stiff_route_difference
+from exucable.quasistatic.stiff_bend import stiff_bend
 
 R, C, MU, T = 0.5, 0.015, 0.5, 100.0
 ROUTE = [(0.6, 0.0), (R * math.pi / 2, 1.0 / R), (0.6, 0.0)]
@@ -52,8 +52,8 @@ def test_flexible_limit_in_3d_is_the_rope_with_clearance():
     solver: a string, its free spans lifting off the floor near the bend's ends): 2e-4 (h = 1 cm; 2e-5 at
     5 mm), while the free spans themselves move the pull by ~1 % from the capstan with μ w L."""
     from exucable.geometry import Bend, Straight, centreline_from_path
-    from exucable.rope_clearance import solve_rope_with_clearance
-    from exucable.beam_conduit import route_pieces
+    from exucable.quasistatic.clearance import solve_rope_with_clearance
+    from exucable.quasistatic.beam import route_pieces
 
     w, h = 0.21 * 9.80665, 0.01
     centre = centreline_from_path([0.0, 0.0, 0.0], (1.0, 0.0, 0.0), [Straight(1.0), Bend(90.0, R), Straight(1.0)])

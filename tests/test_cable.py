@@ -8,8 +8,8 @@ import exudyn as exu
 
 from exucable.model.build import build_model
 from exucable.model.cable import CableProperties, add_cable, add_gravity
-from exucable.solve import simulate
-from exucable.tension import tension_at, tension_profile
+from exucable.solve.dynamic import simulate
+from exucable.post.tension import tension_at, tension_profile
 
 from conftest import make_scenario
 
@@ -130,7 +130,7 @@ def test_internal_damping_does_not_change_steady_tension():
     transients: with τ = 0.25 ms and 4 ms the steady pulling force of the fast Example 2 agrees
     with τ = 1 ms to 0.05 % (its own scatter is ~0.03 %)."""
     from exucable.run import run_scenario
-    from exucable.scenario import load_scenario
+    from exucable.scenario.specs import load_scenario
     import dataclasses
     from conftest import ROOT
     base = load_scenario(ROOT / "scenarios/fast/paper_ex2_bend90.toml")

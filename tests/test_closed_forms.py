@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from exucable import closed_forms as cf
+from exucable.quasistatic import closed_forms as cf
 
 REFERENCE = Path(__file__).resolve().parents[1] / "reference" / "paper_values.toml"
 W = 1000.0 * math.pi * 2.5e-3**2 * 9.8  # the paper's cable, rho A g [N/m]
@@ -58,7 +58,7 @@ def test_vertical_bends_reduce_to_capstan_and_to_the_height_change(elevation_deg
 
 
 def _integrate_vertical_bend(t_in, mu, theta, w, radius, phi0, sag):
-    """The vertical-bend rope ODE integrated directly in the turned angle psi (independent of exucable.rope):
+    """The vertical-bend rope ODE integrated directly in the turned angle psi (independent of exucable.quasistatic.rope):
     dT/dpsi = mu |T -+ wR cos phi| + wR sin phi, phi = phi0 +- psi."""
     wr = w * radius
 

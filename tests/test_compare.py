@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from exucable.commands.compare import add_arguments, main
-from exucable.compare import compare_results, load_tolerances
+from exucable.output.compare import compare_results, load_tolerances
 from exucable.errors import ExucableError
 
 # Differences of exactly representable synthetic data are computed to rounding: 1e-12 relative/absolute.

@@ -10,7 +10,7 @@ import exudyn as exu
 from exucable.contact import ContactKernel, ContactLaw
 from exucable.geometry import Bend, Conduit, Straight, centreline_from_path
 from exucable.model.build import build_model
-from exucable.solve import simulate
+from exucable.solve.dynamic import simulate
 
 from conftest import make_scenario
 

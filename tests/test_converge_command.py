@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from exucable.cli import main as cli_main
-from exucable.results import read_csv
+from exucable.output.results import read_csv
 
 from conftest import ROOT
 

@@ -1,11 +1,11 @@
-"""Extrapolation (exucable.convergence) on problems of known order, and honest refusals."""
+"""Extrapolation (exucable.post.convergence) on problems of known order, and honest refusals."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from exucable.convergence import extrapolate
+from exucable.post.convergence import extrapolate
 
 
 def _trapezoid_sin(n):

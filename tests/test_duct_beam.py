@@ -1,9 +1,9 @@
-"""The linearised stiff cable in a duct (exucable.duct_beam) against its closed-form limits.
+"""The linearised stiff cable in a duct (exucable.quasistatic.duct_beam) against its closed-form limits.
 
 The capstan (EJ = 0, no gravity, paper Eq. 26), a level straight's μwL (Eq. 25), the stiff bend's
-point load √(EJ T)/ρ at λ = √(EJ/T) into the bend (exucable.stiff_bend at first order), the
-rope with clearance (exucable.rope_clearance, an independent solver of the EJ → 0 problem), the
-up-bend's free-span term μ EJ/(ρ X₀) (exucable.stiff_bend.free_span_stiffness_N) and
+point load √(EJ T)/ρ at λ = √(EJ/T) into the bend (exucable.quasistatic.stiff_bend at first order), the
+rope with clearance (exucable.quasistatic.clearance, an independent solver of the EJ → 0 problem), the
+up-bend's free-span term μ EJ/(ρ X₀) (exucable.quasistatic.stiff_bend.free_span_stiffness_N) and
 convergence in h. Short routes, coarse enough for seconds each.
 """
 
@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from exucable.duct_beam import duct_route, gravity_change_of_stiffness, solve_duct_beam
+from exucable.quasistatic.duct_beam import duct_route, gravity_change_of_stiffness, solve_duct_beam
 
 TIGHT = [{"straight": 0.6}, {"bend": 90.0, "radius": 0.5, "turn": "left"}, {"straight": 0.6}]
 
@@ -59,7 +59,7 @@ def test_rope_limit_matches_the_rope_with_clearance():
     """EJ = 0 with gravity: the cable rides up the floor's trough to the bend's inner wall, as the
     independent rope-with-clearance solver has it (both converge as h²; 0.02 % apart at h 5 mm)."""
     from exucable.geometry.path import Bend, Straight, centreline_from_path
-    from exucable.rope_clearance import solve_rope_with_clearance
+    from exucable.quasistatic.clearance import solve_rope_with_clearance
     w = 0.21 * 9.81
     s = solve_duct_beam(TIGHT, 0.015, 0.5, w, 100.0, 0.0, 0.005)
     centreline = centreline_from_path((0, 0, 0), (1, 0, 0), [Straight(0.6), Bend(90.0, 0.5, "left"), Straight(0.6)])
@@ -91,7 +91,7 @@ def test_up_bend_free_spans_match_their_closed_form():
     """Up-bend with gravity: the cable crosses from the straights' floors to the bend's upper wall in
     free spans; bending stiffness keeps more weight on the floor, ΔF = μ EJ/(ρ X₀) per span
     (first order in λ/X₀ ≈ 0.3 here), the entry's grown by e^{μθ}."""
-    from exucable.stiff_bend import free_span_stiffness_N
+    from exucable.quasistatic.stiff_bend import free_span_stiffness_N
     path = [{"straight": 2.5}, {"bend": 60.0, "radius": 5.0, "turn": "up"}, {"straight": 2.0}]
     mu, w, ej, c, t_back, theta = 0.3, 9.81, 25.0, 0.01, 200.0, math.pi / 3
     h = 0.02

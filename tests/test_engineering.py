@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from exucable import engineering as eng
+from exucable.quasistatic import engineering as eng
 from exucable.errors import ScenarioError
-from exucable.units import to_si
+from exucable.scenario.units import to_si
 
 REFERENCE = tomllib.loads((Path(__file__).resolve().parents[1] / "reference" / "engineering.toml").read_text())
 IN = 0.0254

@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 
 from exucable.errors import ScenarioError
-from exucable.export import export_problem
-from exucable.formats import EXPORT_FILES, SNAPSHOT_FILES, schema_of
+from exucable.output.export import export_problem
+from exucable.output.formats import EXPORT_FILES, SNAPSHOT_FILES, schema_of
 from exucable.model.build import build_model
-from exucable.results import read_csv
+from exucable.output.results import read_csv
 from exucable.run import run_scenario
-from exucable.scenario import load_scenario, parse_scenario
+from exucable.scenario.specs import load_scenario, parse_scenario
 
 from conftest import ROOT
 
@@ -141,7 +141,7 @@ def test_snapshot_tension_integrates_to_the_pulling_force(ex2_run):
 
 
 def test_a_run_compared_with_itself_agrees_in_every_family(ex2_run):
-    from exucable.compare import FAMILIES, compare_results
+    from exucable.output.compare import FAMILIES, compare_results
 
     out, _ = ex2_run
     result = compare_results(out, out, rtol=0.0)
@@ -167,7 +167,7 @@ def test_snapshot_times_are_checked(scenario_factory):
 
 
 def test_hermite_in_time_is_exact_for_a_cubic_and_at_step_ends():
-    from exucable.snapshots import hermite_in_time
+    from exucable.output.snapshots import hermite_in_time
 
     def q(t):
         return np.array([1.0 - 2.0 * t + 3.0 * t**2 - 0.5 * t**3, 4.0 * t**3])

@@ -1,4 +1,4 @@
-"""The mesh rule (exucable.mesh): element length from bend radius and clearance, check points from
+"""The mesh rule (exucable.scenario.mesh): element length from bend radius and clearance, check points from
 the bending length, overrides checked, too-coarse meshes refused with the count needed."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import pytest
 
 from exucable.errors import ModelError
 from exucable.geometry.path import Bend, Straight, centreline_from_path
-from exucable.mesh import MAX_SAGITTA_CLEARANCES, MAX_TURN_RAD, plan_mesh
+from exucable.scenario.mesh import MAX_SAGITTA_CLEARANCES, MAX_TURN_RAD, plan_mesh
 
 from conftest import make_scenario
 

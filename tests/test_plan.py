@@ -13,7 +13,7 @@ import pytest
 
 from exucable.cli import main as cli_main
 from exucable.errors import ExucableError, ScenarioError
-from exucable.plan import parse_plan_scenario, plan_pull
+from exucable.plan.pull import parse_plan_scenario, plan_pull
 
 ROOT = Path(__file__).resolve().parents[1]
 G = 9.80665
@@ -257,7 +257,7 @@ def test_cli_names_the_key_of_a_bad_limit(tmp_path, capsys):
 
 
 def test_imperial_file_reads_the_manuals_numbers():
-    from exucable.plan import load_plan_scenario
+    from exucable.plan.pull import load_plan_scenario
 
     scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml")
     plan = plan_pull(scenario, spec)

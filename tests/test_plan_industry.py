@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from exucable.plan import load_plan_scenario, plan_pull
-from exucable.validate_industry import published_bounds_N, published_values
+from exucable.plan.pull import load_plan_scenario, plan_pull
+from exucable.validation.industry import published_bounds_N, published_values
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = tomllib.loads((ROOT / "reference" / "industry_values.toml").read_text())

@@ -8,7 +8,7 @@ that closed form — and the reverse pull meets the bends in the other order.
 Tolerances, from runs of this route (2026-11-29) at 12/24/48 elements:
 - section tensions at the boundaries within 1 % of the rope's. Measured worst 3.2/1.45/0.64 % (steady)
   and 0.68 % (dynamic, 48 elements): the stiff cable takes part of each bend's contact on point loads
-  just outside the bend ends (exucable.pressure), which moves friction between a bend and its
+  just outside the bend ends (exucable.post.pressure), which moves friction between a bend and its
   neighbouring straights; the difference shrinks with the mesh (about ∝ element length).
 - pull force within 0.2 % of the rope's: measured -0.07 % (steady) and -0.09 % (dynamic); the shifted
   friction cancels over the route.
@@ -26,7 +26,7 @@ from pathlib import Path
 import pytest
 
 from exucable.cli import main as cli_main
-from exucable.plan import parse_plan_scenario, plan_pull
+from exucable.plan.pull import parse_plan_scenario, plan_pull
 
 ROOT = Path(__file__).resolve().parents[1]
 MU = 0.3

@@ -85,7 +85,7 @@ def test_leading_end_joined_to_a_user_vehicle_pulls_the_capstan():
 
 def test_simulate_keeps_and_calls_the_users_post_step_function():
     from exucable.model.build import build_model
-    from exucable.solve import simulate
+    from exucable.solve.dynamic import simulate
     model = build_model(ex2(end_time=0.03))
     calls = []
 

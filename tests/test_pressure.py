@@ -1,4 +1,4 @@
-"""Sidewall pressure an engineer can use (exucable.pressure, issue #10 item 5): windowed pressure
+"""Sidewall pressure an engineer can use (exucable.post.pressure, issue #10 item 5): windowed pressure
 against the rope's T/R in a bend's body, point loads at bend ends as forces, bends.csv."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from exucable.geometry.path import Bend, Straight, centreline_from_path
-from exucable.pressure import BEND_COLUMNS, bend_table, default_window_m
-from exucable.results import read_csv
+from exucable.post.pressure import BEND_COLUMNS, bend_table, default_window_m
+from exucable.output.results import read_csv
 from exucable.run import run_scenario
-from exucable.scenario import load_scenario
+from exucable.scenario.specs import load_scenario
 
 from conftest import ROOT
 
@@ -77,7 +77,7 @@ def test_point_loads_look_only_near_their_bend_end(spread_points, weight_N, monk
     """bend_end_point_load works on the sorted points near its bend end only (pressure._near_end,
     for speed): the same loads and places, to the bit, as over the whole route, at both ends,
     whether a lift-off gap is found or not (every point loaded by a weight: the excess over ±w/2)."""
-    import exucable.pressure as pressure
+    import exucable.post.pressure as pressure
 
     cl, s, F, T, s_rope, T_rope, p_rope, s1 = _stiff_cable_loads(spread_points)
     F = F + weight_N

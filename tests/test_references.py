@@ -13,9 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from exucable.references import pull_force_references_N, reference_drift_N_per_s
-from exucable.scenario import parse_scenario
-from exucable.tension import detect_steady_state
+from exucable.quasistatic.extent import pull_force_references_N, reference_drift_N_per_s
+from exucable.scenario.specs import parse_scenario
+from exucable.post.tension import detect_steady_state
 
 W_KG_PER_M, G, MU, TB, L = 1.0, 9.81, 0.3, 50.0, 20.0
 
@@ -65,7 +65,7 @@ def test_a_pull_starts_on_the_rope_with_clearance():
     # its free span before the bend (the old start pressed it on the floor there, and it rang as the span
     # formed), with that rope's tension.
     from exucable.model.build import build_model
-    from exucable.rope_clearance import solve_rope_with_clearance
+    from exucable.quasistatic.clearance import solve_rope_with_clearance
 
     data = {
         "cable": {"radius": 0.009, "mass_per_length": 1.0, "youngs_modulus": 5e8, "bending_stiffness": 0.079,

@@ -12,10 +12,10 @@ import math
 import numpy as np
 import pytest
 
-from exucable import closed_forms as cf
+from exucable.quasistatic import closed_forms as cf
 from exucable.errors import ModelError
 from exucable.geometry import Bend, Helix, Straight, centreline_from_path
-from exucable.rope import RopeSolution, rope_pull_force_N, solve_rope, solve_rope_for_pull_force
+from exucable.quasistatic.rope import RopeSolution, rope_pull_force_N, solve_rope, solve_rope_for_pull_force
 
 RTOL = 1e-6  # see the module docstring
 W = 1000.0 * math.pi * 2.5e-3**2 * 9.8  # the paper's cable: rho A g [N/m] (Sect. 3, Eq. 25)
@@ -276,7 +276,7 @@ def test_closed_form_pieces_agree_with_the_ode(monkeypatch, items, start_dir, w,
     """Pieces solved in closed form (straights; bends and helices without weight; horizontal bends with
     weight) give the tension the DOP853 integration gives (rtol 1e-11) to 1e-9: the closed forms are the
     ODE's exact solutions, so only the integrator's own error remains."""
-    import exucable.rope as rope
+    import exucable.quasistatic.rope as rope
 
     route = centreline_from_path([0, 0, 0], start_dir, items)
     for direction in ("forward", "reverse"):
@@ -295,7 +295,7 @@ def test_closed_form_pieces_agree_with_the_ode(monkeypatch, items, start_dir, w,
 
 
 def test_closed_form_covers_straights_and_horizontal_or_weightless_bends_only():
-    import exucable.rope as rope
+    import exucable.quasistatic.rope as rope
 
     route = centreline_from_path([0, 0, 0], heading(10.0), [Straight(1.0), Bend(90.0, 0.5, turn="left"),
                                                           Bend(45.0, 1.0, turn="up"), Helix(2.0, 1.0, 0.05)])

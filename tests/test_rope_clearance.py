@@ -13,11 +13,11 @@ import math
 import numpy as np
 import pytest
 
-from exucable import closed_forms as cf
+from exucable.quasistatic import closed_forms as cf
 from exucable.errors import ModelError
 from exucable.geometry import Bend, Straight, centreline_from_path
-from exucable.rope import solve_rope
-from exucable.rope_clearance import solve_rope_with_clearance
+from exucable.quasistatic.rope import solve_rope
+from exucable.quasistatic.clearance import solve_rope_with_clearance
 
 W = 0.21 * 9.81  # the 18 mm fibre cable, 0.21 kg/m [N/m]
 
@@ -153,7 +153,7 @@ def test_vectorised_frames_and_march_equal_the_node_loops():
     # choice is iterated to consistency) are the node-by-node loops, vectorised: equal to rounding (1e-12) on a
     # spatial route whose cable touches and leaves the wall, from a tension guess far off (1 N: too low for the
     # up-bend's tension to hold the cable on its upper wall against its weight, so the first choice is wrong).
-    from exucable.rope_clearance import _Chain, _frames
+    from exucable.quasistatic.clearance import _Chain, _frames
 
     centre = route(Straight(3.0), Bend(40.0, 2.0, turn="up"), Straight(2.0), Bend(70.0, 3.0), Straight(2.0))
     s = np.linspace(0.0, centre.length_m, 801)
@@ -176,7 +176,7 @@ def test_nested_iteration_from_a_coarser_chain_gives_the_same_solution(monkeypat
     # here on a short route (1200 nodes, coarsened to 300): the same fixed point as the direct solve, to 2e-6 (5e-7 seen)
     # (each is converged to rtol 1e-10 but the wall is a penalty of finite stiffness, so the two stop at
     # nearby points), with its free spans where the direct solve has them.
-    import exucable.rope_clearance as rc
+    import exucable.quasistatic.clearance as rc
 
     centre = route(Straight(3.0), Bend(40.0, 2.0, turn="up"), Straight(2.0), Bend(70.0, 3.0), Straight(2.0))
     h = centre.length_m / 1200

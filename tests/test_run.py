@@ -11,7 +11,7 @@ import pytest
 
 from exucable.errors import ModelError, ScenarioError
 from exucable.model.build import build_model
-from exucable.results import read_csv
+from exucable.output.results import read_csv
 from exucable.run import run_scenario
 
 from conftest import ROOT, make_scenario
@@ -99,7 +99,7 @@ def test_cli_imports_only_the_chosen_subcommand():
     code = ("import sys\nfrom exucable.cli import build_parser, _command_in\n"
             "build_parser(only=_command_in(['run', 'x.toml']))\n"
             "print(sorted(m for m in ('exucable.commands.sweep', 'exucable.commands.validate', "
-            "'exucable.commands.compare', 'exucable.sweep', 'exucable.validate', "
+            "'exucable.commands.compare', 'exucable.sweep', 'exucable.validation.paper', "
             "'matplotlib') if m in sys.modules))")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert p.returncode == 0, p.stderr

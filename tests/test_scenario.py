@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from exucable.errors import ScenarioError
-from exucable.scenario import Scenario, load_scenario, parse_scenario
+from exucable.scenario.specs import Scenario, load_scenario, parse_scenario
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 SCENARIO_FILES = sorted(SCENARIOS.glob("*.toml")) + sorted((SCENARIOS / "fast").glob("*.toml"))
@@ -271,7 +271,7 @@ def test_defaults_filled():
     assert v.pretension is True
     # the echo carries every default under its TOML name
     d = s.to_dict()
-    assert "check_points_per_element" not in d["contact"]      # the mesh rule chooses (exucable.mesh)
+    assert "check_points_per_element" not in d["contact"]      # the mesh rule chooses (exucable.scenario.mesh)
     assert d["solver"]["output_interval"] == 1.0e-2
     assert d["conduit"]["max_segment_angle"] == 1.0
     assert d["cable"]["damping_time"] == 1.0e-3

@@ -1,4 +1,4 @@
-"""The one field table (exucable.scenario_fields.FIELDS) drives the TOML parser, the checks of the
+"""The one field table (exucable.scenario.fields.FIELDS) drives the TOML parser, the checks of the
 dataclasses built in Python, to_dict and the README key tables: walk it and check they agree."""
 
 from __future__ import annotations
@@ -10,10 +10,17 @@ from pathlib import Path
 import pytest
 
 from exucable.errors import ScenarioError
-from exucable.scenario import (
-    CableSpec, ContactSpec, GravitySpec, PullSpec, Scenario, SolverSpec, default_elements, parse_scenario,
+from exucable.scenario.specs import (
+    CableSpec,
+    ContactSpec,
+    GravitySpec,
+    PullSpec,
+    Scenario,
+    SolverSpec,
+    default_elements,
+    parse_scenario,
 )
-from exucable.scenario_fields import FIELDS, REQUIRED, SECTIONS, fields_of, markdown_table, readme_with_tables
+from exucable.scenario.fields import FIELDS, REQUIRED, SECTIONS, fields_of, markdown_table, readme_with_tables
 
 README = Path(__file__).resolve().parent.parent / "scenarios" / "README.md"
 
@@ -61,7 +68,7 @@ SCALAR = [f for f in FIELDS if f.kind != "custom"]
 def test_readme_key_tables_are_the_field_table():
     text = README.read_text(encoding="utf-8")
     assert readme_with_tables(text) == text, (
-        "scenarios/README.md key tables differ from exucable/scenario_fields.py: "
+        "scenarios/README.md key tables differ from exucable/scenario/fields.py: "
         "run `.venv/bin/python -m exucable.commands.key_tables`"
     )
     for section in SECTIONS:
@@ -192,7 +199,7 @@ def test_default_elements_rule():
     L = sc.cable_length_m
     centre = sc.build_conduit().centreline
     c = sc.conduit.inner_radius_m - sc.cable.radius_m
-    # the mesh rule (exucable.mesh): chord sagitta ≤ 2 clearances, ≤ 0.2 rad per element
+    # the mesh rule (exucable.scenario.mesh): chord sagitta ≤ 2 clearances, ≤ 0.2 rad per element
     R = centre.min_bend_radius_m
     h = min((16 * R * c) ** 0.5, 0.2 * R, L / 10)
     assert sc.cable.elements == default_elements(centre, c, L) == -(-int(L / h * 1e9) // int(1e9))

@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from exucable.errors import ExucableError
-from exucable.reference import load_reference
+from exucable.data.reference_values import load_reference
 from exucable.run import run_scenario
-from exucable.results import read_csv
-from exucable.scenario import load_scenario
+from exucable.output.results import read_csv
+from exucable.scenario.specs import load_scenario
 from exucable.data import data_path
 
 from conftest import make_scenario
@@ -117,7 +117,7 @@ def test_a_route_that_needs_continuation(monkeypatch):
     to the same pulling force (within 1e-5)."""
     from dataclasses import replace
 
-    import exucable.solve_steady as ss
+    import exucable.solve.steady as ss
     from exucable.model.build import build_model
 
     sc = fast("paper_ex2_bend90")
@@ -152,7 +152,7 @@ def test_pseudo_time_budget_is_on_progress_not_on_the_count(monkeypatch):
     the one-iteration steps tried before it are switched off.)"""
     from dataclasses import replace
 
-    import exucable.solve_steady as ss
+    import exucable.solve.steady as ss
     from exucable.model.build import build_model
 
     monkeypatch.setattr(ss, "MAX_ONE_ITERATION_STEPS", 0)
@@ -175,7 +175,7 @@ def test_one_iteration_steps_reach_the_exact_step_answer(monkeypatch):
     tolerance (measured: 4e-10 and 4.5e-8 relative; 29 against 55 Newton iterations)."""
     from dataclasses import replace
 
-    import exucable.solve_steady as ss
+    import exucable.solve.steady as ss
     from exucable.model.build import build_model
 
     sc = fast("paper_ex2_bend90")
@@ -196,7 +196,7 @@ def test_a_rejected_step_restarts_from_the_saved_kernel_pass(monkeypatch):
     iterates bit for bit as without the reuse."""
     from dataclasses import replace
 
-    import exucable.solve_steady as ss
+    import exucable.solve.steady as ss
     from exucable.model.build import build_model
     from exucable.model.coupling import ContactCoupling
 
@@ -228,7 +228,7 @@ def test_exact_steps_stop_above_the_round_off_floor(monkeypatch):
     it are switched off.)"""
     from dataclasses import replace
 
-    import exucable.solve_steady as ss
+    import exucable.solve.steady as ss
     from exucable.model.build import build_model
 
     sc = fast("paper_ex2_bend90")
@@ -275,7 +275,7 @@ def test_steady_helix_converges_under_refinement():
     that layer (40/80/160 elements: +0.23/+0.64/+0.72 % against the capstan 18.7442 N). With the
     rig 10 bending lengths out (measured -0.041/-0.049 %, 2026-11-29) both meshes are within
     0.1 % and within 0.02 % of each other."""
-    from exucable.closed_forms import capstan_out_N, helix_turning_angle_rad
+    from exucable.quasistatic.closed_forms import capstan_out_N, helix_turning_angle_rad
 
     T1 = capstan_out_N(10.0, 0.1, helix_turning_angle_rad(1.0, 1.0, 0.05))
     coarse, fine = (_one_coil(n).summary for n in (40, 80))

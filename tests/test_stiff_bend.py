@@ -1,4 +1,4 @@
-"""The stiff-bend model (exucable.stiff_bend) and exucable against it (issue #10 items 5–6).
+"""The stiff-bend model (exucable.quasistatic.stiff_bend) and exucable against it (issue #10 items 5–6).
 
 The model's own limits are closed forms: the capstan (EJ = 0, paper Eq. 26), no change without
 friction (N + EJκ²/2 is conserved along a frictionless elastica), its small-λ expansion and the
@@ -13,7 +13,7 @@ import math
 
 import pytest
 
-from exucable.stiff_bend import free_span_stiffness_N, stiff_bend
+from exucable.quasistatic.stiff_bend import free_span_stiffness_N, stiff_bend
 
 
 @pytest.mark.parametrize("ej", [0.0, 0.1, 1.0, 4.0])
@@ -62,7 +62,7 @@ def test_free_span_term_is_linear_in_EJ_and_needs_a_span():
 def _tight_bend(element_length_m: float):
     """Tight horizontal bend, no gravity: R 0.5 m, 15 mm clearance, the 18 mm fibre cable with
     EJ 1 N m² (λ/R = 0.2 at the 100 N back tension), μ 0.5; a steady solve."""
-    from exucable.scenario import parse_scenario
+    from exucable.scenario.specs import parse_scenario
     from conftest import ROOT
     r, length = 0.009, 4.0 + math.pi * 0.5 / 2
     data = {"name": "tight-ej1",

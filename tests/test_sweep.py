@@ -23,7 +23,7 @@ import pytest
 from exucable import cli
 from exucable.errors import ExucableError, ScenarioError
 from exucable.sweep import load_sweep, parse_sweep, read_table, rows_from_disk, run_sweep
-from exucable.sweep.dotted import format_key, parse_key, set_value, unset_value
+from exucable.scenario.dotted import format_key, parse_key, set_value, unset_value
 from exucable.sweep.store import SweepLock
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -197,7 +197,7 @@ def test_dry_run_lists_cases_and_writes_nothing(tmp_path, capsys):
 
 def test_survey_csv_routes_travel_as_inline_points(tmp_path):
     """For Dask workers on other machines the CSV's points go inline; the route is the same."""
-    from exucable.scenario import parse_scenario
+    from exucable.scenario.specs import parse_scenario
     from exucable.sweep.execute import _task
 
     (tmp_path / "route.csv").write_text("x,y,z,bend_radius\n0,0,0,\n2,0,0,0.5\n2,2,0,\n")

@@ -1,4 +1,4 @@
-"""Results that must not be trusted say so (exucable.trust, issue #10 item 4), and every summary
+"""Results that must not be trusted say so (exucable.post.trust, issue #10 item 4), and every summary
 states the pulling force's uncertainty."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import pytest
 
 from exucable.cli import main as cli_main
 from exucable.run import run_scenario
-from exucable.trust import assess, pull_force_uncertainty
+from exucable.post.trust import assess, pull_force_uncertainty
 
 from conftest import ROOT, make_scenario
 

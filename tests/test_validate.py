@@ -1,7 +1,7 @@
 """`exucable validate --fast`: the paper's examples on coarse meshes, against reference/.
 
 Runs the fast scenario variants (a few minutes in all) with the fast tolerances of
-exucable.validate.TOLERANCES, which the coarse meshes hold; the paper-fidelity set is behind the
+exucable.validation.paper.TOLERANCES, which the coarse meshes hold; the paper-fidelity set is behind the
 ``slow`` marker.
 """
 
@@ -11,7 +11,7 @@ import csv
 
 import pytest
 
-from exucable.validate import TOLERANCES, format_table, validate
+from exucable.validation.paper import TOLERANCES, format_table, validate
 
 
 @pytest.fixture(scope="module")

@@ -10,11 +10,17 @@ from pathlib import Path
 import pytest
 
 from exucable.data import data_path
-from exucable.plan import plan_pull, plan_spec
-from exucable.reference import load_reference
-from exucable.scenario import load_scenario
-from exucable.validate_industry import (LBF_N, MESH_TOLERANCE, load_industry_examples, published_bounds_N,
-                                        published_values, validate_industry)
+from exucable.plan.pull import plan_pull, plan_spec
+from exucable.data.reference_values import load_reference
+from exucable.scenario.specs import load_scenario
+from exucable.validation.industry import (
+    LBF_N,
+    MESH_TOLERANCE,
+    load_industry_examples,
+    published_bounds_N,
+    published_values,
+    validate_industry,
+)
 
 
 def _capstan_example(published_N, rounding_lbf=0.05):
@@ -81,7 +87,7 @@ def test_cli_names_the_examples_when_none_matches(capsys):
 
 
 def test_mode_difference_and_scatter_checks_without_runs():
-    from exucable.validate_industry import IndustryRow, IndustryValidation
+    from exucable.validation.industry import IndustryRow, IndustryValidation
     steady = IndustryRow("r", "src", "closed form", "steady", 100.0, 1.0, 100.0, 0.0, 0.0, run_rope_N=100.0,
                          run_rope_clearance_N=100.0)
     dynamic = IndustryRow("r", "src", "closed form", "dynamic", 100.0, 1.0, 100.0, 0.0, 0.0, run_rope_N=99.0,

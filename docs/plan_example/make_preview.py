@@ -13,8 +13,8 @@ import matplotlib.image as mpimg
 
 from exucable.cli import main as cli_main
 from exucable.io import new_figure, save_figure
-from exucable.report.plan_html import section_rows
-from exucable.units import display_unit, from_si
+from exucable.plan.report import section_rows
+from exucable.scenario.units import display_unit, from_si
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]

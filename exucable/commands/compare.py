@@ -1,4 +1,4 @@
-"""``exucable compare A B``: cross-check two sets of results (see :mod:`exucable.compare`)."""
+"""``exucable compare A B``: cross-check two sets of results (see :mod:`exucable.output.compare`)."""
 
 from __future__ import annotations
 
@@ -6,8 +6,14 @@ import argparse
 import math
 from pathlib import Path
 
-from ..compare import (DEFAULT_RTOL, compare_results, format_report, load_tolerances, write_overlay_plot,
-                       write_overlay_plots)
+from ..output.compare import (
+    DEFAULT_RTOL,
+    compare_results,
+    format_report,
+    load_tolerances,
+    write_overlay_plot,
+    write_overlay_plots,
+)
 from ..errors import ExucableError
 
 __all__ = ["add_arguments", "main"]

@@ -1,7 +1,7 @@
 """``exucable converge SCENARIO [--levels N] [--ratio R] [--out DIR]``: the scenario's result on
 N ≥ 3 meshes, each refined by R in element length (and in check-point spacing: the check points
 per element stay those of the first level), with the observed order and an extrapolated value
-with its error estimate (:mod:`exucable.convergence`).
+with its error estimate (:mod:`exucable.post.convergence`).
 
 Writes ``DIR/level_K/`` (each a complete result directory), then ``DIR/converge.csv`` (one row
 per level) and ``DIR/converge.json`` (the table, the extrapolation and how it was made), each
@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..convergence import extrapolate
+from ..post.convergence import extrapolate
 from ..io import write_csv, write_json
 from ..run import run_scenario
-from ..scenario import load_scenario
-from ..trust import TRUSTED_STATUSES
+from ..scenario.specs import load_scenario
+from ..post.trust import TRUSTED_STATUSES
 
 __all__ = ["add_arguments", "main", "converge", "CONVERGE_COLUMNS"]
 

@@ -13,7 +13,7 @@ def add_arguments(p) -> None:
 
 
 def main(args) -> int:
-    from ..export import export_problem
+    from ..output.export import export_problem
 
     written = export_problem(args.scenario, Path(args.out))
     print(f"exported {len(written)} files to {args.out}/: " + ", ".join(p.name for p in written))

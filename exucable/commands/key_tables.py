@@ -1,5 +1,5 @@
 """Developer tool: rewrite the key tables of ``scenarios/README.md`` from the one field table
-(:data:`exucable.scenario_fields.FIELDS`). Run ``python -m exucable.commands.key_tables [README]``.
+(:data:`exucable.scenario.fields.FIELDS`). Run ``python -m exucable.commands.key_tables [README]``.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..data import data_path
 from ..io import atomic_write_text
-from ..scenario_fields import readme_with_tables
+from ..scenario.fields import readme_with_tables
 
 __all__ = ["main"]
 

@@ -13,9 +13,9 @@ import csv
 import io
 from pathlib import Path
 
-from exucable.plan import ENGINES, load_plan_scenario, plan_pull
+from exucable.plan.pull import ENGINES, load_plan_scenario, plan_pull
 from exucable.io import atomic_write_text, write_csv, write_json
-from exucable.units import SYSTEMS
+from exucable.scenario.units import SYSTEMS
 
 __all__ = ["add_arguments", "main", "write_plan"]
 
@@ -53,7 +53,7 @@ def _text_csv(columns, rows) -> str:
 def write_plan(out_dir, plan: dict, scenario, units: str) -> list[Path]:
     """Write the plan's files into ``out_dir`` (each atomically, ``plan.json`` last); return their paths."""
     from exucable.plots.route import plot_route
-    from exucable.report import plan_report_html
+    from exucable.plan.report import plan_report_html
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -95,8 +95,8 @@ def _print_table(header, rows) -> None:
 
 
 def main(args) -> int:
-    from exucable.report.plan_html import check_in_units, section_rows
-    from exucable.units import display_unit, from_si
+    from exucable.plan.report import check_in_units, section_rows
+    from exucable.scenario.units import display_unit, from_si
 
     scenario, spec = load_plan_scenario(args.scenario, units=args.units)
     plan = plan_pull(scenario, spec, engine=args.engine, progress=True)

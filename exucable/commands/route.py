@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..plots.route import plot_route, route_table
-from ..scenario import load_scenario
+from ..scenario.specs import load_scenario
 
 __all__ = ["add_arguments", "main"]
 

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..run import run_scenario
-from ..scenario import load_scenario
-from ..trust import TRUSTED_STATUSES
+from ..scenario.specs import load_scenario
+from ..post.trust import TRUSTED_STATUSES
 
 __all__ = ["add_arguments", "main"]
 

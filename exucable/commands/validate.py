@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..validate import CASES, MODES, format_table, validate
+from ..validation.paper import CASES, MODES, format_table, validate
 
 __all__ = ["add_arguments", "main", "SUITES"]
 
@@ -60,7 +60,7 @@ def _paper(args) -> int:
 
 
 def _industry(args) -> int:
-    from ..validate_industry import format_industry_table, load_industry_examples, validate_industry
+    from ..validation.industry import format_industry_table, load_industry_examples, validate_industry
     if args.levels < 1:
         print(f"exucable validate: error: --levels: at least 1 (3 for an extrapolation), got {args.levels}",
               file=sys.stderr)

@@ -7,13 +7,7 @@ fast path (:mod:`.fast`, the default; its per-point profiles in :mod:`.profiles`
 """
 
 from .checkpoints import check_points
-from .kernel import (
-    CheckPointState,
-    ContactKernel,
-    ContactResult,
-    assemble_blocks_dense,
-    block_sparsity,
-)
+from .kernel import CheckPointState, ContactKernel, ContactResult, assemble_blocks_dense, block_sparsity
 from .law import ContactLaw
 
 __all__ = [

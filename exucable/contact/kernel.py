@@ -2,7 +2,7 @@
 
 This module holds the public :class:`ContactKernel`, a facade over two backends chosen by ONE
 switch (its ``backend`` argument) for every call: forces, Jacobians, candidate lists and the
-per-point profiles of :meth:`ContactKernel.points` alike. :mod:`exucable.contact.reference` is the
+per-point profiles of :meth:`ContactKernel.points` alike. :mod:`exucable.contact.numpy_kernel` is the
 numpy backend, the tested definition; :mod:`exucable.contact.fast` the compiled one (the default),
 tested against it.
 
@@ -33,10 +33,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.segments import Segments
-from ..scenario_fields import default_of
+from ..scenario.fields import default_of
 from .checkpoints import check_points, hermite_unit
 from .law import ContactLaw, damping_onset
-from .reference import ReferenceKernel
+from .numpy_kernel import ReferenceKernel
 from .smooth import SmoothWall, closest_point_angles
 
 __all__ = [

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..scenario_fields import default_of
+from ..scenario.fields import default_of
 
 import numpy as np
 

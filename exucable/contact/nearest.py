@@ -1,6 +1,6 @@
 """The nearest of many fixed sample points along a curve, exactly, for batches of query points.
 
-Used by :class:`exucable.trust.AxisGauge` (the cable axis's distance from the conduit's axis, at
+Used by :class:`exucable.post.trust.AxisGauge` (the cable axis's distance from the conduit's axis, at
 every record) in place of ``scipy.spatial.cKDTree``, whose import alone (scipy.spatial with the
 scipy.sparse and scipy.special it loads) was a tenth of a second of every ``exucable run``
 (issue 15, fixed cost); numba is loaded by the contact kernel anyway.

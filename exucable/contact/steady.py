@@ -34,10 +34,35 @@ from .jitcache import njit
 
 from .checkpoints import hermite_unit
 from .kernel import ContactKernel
-from .reference import ReferenceKernel
-from .fast import (_JIT, _PAIRS, _J0, _PX, _PY, _PZ, _BEST, _RX, _RY, _RZ, _AX, _AY, _AZ, _BEYOND,
-                   _VX, _VY, _VZ, _add_generalized_force, _exponent_mode, _friction, _nearest_segments,
-                   _normal_force, _normals, _point_jacobians, _positions, _refine_smooth)
+from .numpy_kernel import ReferenceKernel
+from .fast import (
+    _JIT,
+    _PAIRS,
+    _J0,
+    _PX,
+    _PY,
+    _PZ,
+    _BEST,
+    _RX,
+    _RY,
+    _RZ,
+    _AX,
+    _AY,
+    _AZ,
+    _BEYOND,
+    _VX,
+    _VY,
+    _VZ,
+    _add_generalized_force,
+    _exponent_mode,
+    _friction,
+    _nearest_segments,
+    _normal_force,
+    _normals,
+    _point_jacobians,
+    _positions,
+    _refine_smooth,
+)
 from .smooth import NEWTON_ITERATIONS
 
 __all__ = ["SteadySlidingKernel", "hermite_unit_derivative"]

@@ -17,19 +17,28 @@ import exudyn as exu
 from exudyn.itemInterface import MarkerNodePosition, ObjectJointSpherical
 
 from ..errors import ModelError, ScenarioError
-from ..mesh import MeshPlan
-from ..references import reference_drift_N_per_s
-from ..tension import tension_at
+from ..scenario.mesh import MeshPlan
+from ..quasistatic.extent import reference_drift_N_per_s
+from ..post.tension import tension_at
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, InitialLayout, initial_layout
 from .recorder import Recorder, earliest_steady_s
-from .rig import Drive, Guide, add_drive, add_end_force, add_guide, add_reel, add_tangential_drive, smooth_ramp
+from .rig import (
+    Drive,
+    Guide,
+    add_drive,
+    add_end_force,
+    add_guide,
+    add_reel,
+    add_tangential_drive,
+    smooth_ramp,
+)
 
 if TYPE_CHECKING:  # names for the annotations only
     from ..contact import ContactKernel
     from ..geometry import Conduit
-    from ..rope import RopeSolution
-    from ..scenario import Scenario
+    from ..quasistatic.rope import RopeSolution
+    from ..scenario.specs import Scenario
     from .coupling import ContactCoupling
     from .rig import TangentialDrive
     from .startup import StartupDamper
@@ -67,7 +76,7 @@ class CableInConduit:
 
     Attributes
     ----------
-    scenario : exucable.scenario.Scenario
+    scenario : exucable.scenario.specs.Scenario
     mbs : exudyn.MainSystem
     conduit : exucable.geometry.Conduit
         Pull-oriented: the leading end is at the end of its centreline.
@@ -85,7 +94,7 @@ class CableInConduit:
         The prescribed pulling force of a force-controlled pull [N].
     back_tension_N : float
         Tension applied at the trailing end [N].
-    rope : exucable.rope.RopeSolution
+    rope : exucable.quasistatic.rope.RopeSolution
         The quasi-static reference the start is pre-tensioned to.
     coupling, kernel
         The contact coupling (an ObjectGenericODE2 over the cable nodes) and its kernel.
@@ -150,7 +159,7 @@ class CableInConduit:
         """Exudyn simulation settings from the scenario's ``[solver]`` table, to start from:
         generalized-α with adaptive steps, full Newton on the exact contact Jacobian, the end time
         and step of ``solver`` (see scenarios/README.md for why each)."""
-        from ..solve import solver_settings
+        from .settings import solver_settings
         return solver_settings(self.scenario.solver)
 
     def load_factor(self, t: float) -> float:
@@ -188,7 +197,7 @@ class CableInConduit:
 
 class LoadScale:
     """Scale factors [-] of the loads of a steady (static) solve, the continuation parameters of
-    :func:`exucable.solve_steady.solve_steady`: gravity and the end forces (back tension or the
+    :func:`exucable.solve.steady.solve_steady`: gravity and the end forces (back tension or the
     applied pull). All 1 = the scenario's loads. The loads carry no user function (Exudyn would
     call it once per element and residual); :meth:`apply` rewrites their load vectors instead."""
 
@@ -228,7 +237,7 @@ def pull_oriented_conduit(scenario):
 
 
 def _scenario_from(scenario, parts: dict):
-    from ..scenario import Scenario, SolverSpec
+    from ..scenario.specs import Scenario, SolverSpec
     if scenario is not None:
         if parts:
             raise TypeError(f"give a scenario or its parts, not both (got {sorted(parts)})")
@@ -253,7 +262,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
     Parameters
     ----------
     mbs : exudyn.MainSystem
-    scenario : exucable.scenario.Scenario, optional
+    scenario : exucable.scenario.specs.Scenario, optional
         Or its parts as keywords: ``route=``, ``cable=``, ``contact=``, ``pull=``, ``gravity=``,
         ``solver=`` (as for :class:`exucable.Scenario`; ``solver`` defaults to ``Solver(end_time=1)``).
     leading : {"rig", "force", "free"}, JoinToMarker or ReelOnto, optional
@@ -317,7 +326,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
 
     # steady mode: a static solve of the steady sliding state; the rig holds the leading end
     # (or, for a force-controlled pull, the trailing end) where the start put it, and the loads'
-    # scale is the continuation parameter of exucable.solve_steady, not time
+    # scale is the continuation parameter of exucable.solve.steady, not time
     steady = sc.solver.mode == "steady"
     if steady and not sc.solver.pretension:
         raise ModelError("solver.pretension", 'solver.mode = "steady" starts from the rope solution near the '
@@ -412,10 +421,10 @@ def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
     """Build and assemble the Exudyn system of ``scenario`` in a SystemContainer of its own.
 
     A thin wrapper of :func:`add_cable_in_conduit` with the scenario's rig and loads. The mesh is
-    :func:`exucable.model.layout.plan_cable_mesh`'s: the rule of :mod:`exucable.mesh` or the
+    :func:`exucable.model.layout.plan_cable_mesh`'s: the rule of :mod:`exucable.scenario.mesh` or the
     scenario's override, with the element length divided by ``refine`` and the check points per
     element overridden by ``check_points_per_element`` (``exucable converge``). ``start`` replaces
-    the start state (:func:`exucable.solve_start.steady_start`: the steady solve's state).
+    the start state (:func:`exucable.solve.start.steady_start`: the steady solve's state).
     """
     if start is None:
         start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)

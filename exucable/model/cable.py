@@ -14,7 +14,7 @@ import numpy as np
 import exudyn as exu
 from exudyn.itemInterface import MarkerBodyMass, NodePointSlope1, ObjectANCFCable, LoadMassProportional
 
-from ..scenario_fields import default_of
+from ..scenario.fields import default_of
 
 __all__ = ["CableProperties", "CableHandles", "add_cable", "add_gravity", "INTEGRATION"]
 

@@ -127,7 +127,7 @@ def contact_offsets(
         Smoothing length [m].
     path_offset_m, path_pressure_N_per_m : ndarray (m, 3) and (m,), optional
         The path and wall pressure of the rope with clearance on the grid
-        (:mod:`exucable.rope_clearance`); when given, the cable starts on that path (free spans
+        (:mod:`exucable.quasistatic.clearance`); when given, the cable starts on that path (free spans
         included) instead of on the wall the centreline rope's load points to.
 
     Returns
@@ -348,7 +348,7 @@ class InitialLayout:
     ----------
     conduit : exucable.geometry.Conduit
         The conduit oriented so that the leading (pulled) end is at the end of its centreline.
-    rope : exucable.rope.RopeSolution
+    rope : exucable.quasistatic.rope.RopeSolution
         The quasi-static rope solution the start is pre-tensioned to (also the reference).
     cable : CableLayout
         Nodal coordinates and rates, nodes numbered from the trailing end.
@@ -356,13 +356,13 @@ class InitialLayout:
         ρA·g [N/m].
     exit_tangent, entry_tangent : ndarray (3,)
         Unit tangents of the centreline at the leading end and at the trailing end's start position.
-    mesh : exucable.mesh.MeshPlan or None
-        The cable mesh (elements, check points per element) by the rule of :mod:`exucable.mesh`
+    mesh : exucable.scenario.mesh.MeshPlan or None
+        The cable mesh (elements, check points per element) by the rule of :mod:`exucable.scenario.mesh`
         or the scenario's override, with its warnings.
     lead_out_m : float
         Cable laid beyond the exit along the exit tangent at the start [m] (steady mode,
         :func:`steady_lead_out_m`; 0 otherwise): the start is the cable pulled out that far.
-    rope_clearance : exucable.rope_clearance.ClearanceRopeSolution or None
+    rope_clearance : exucable.quasistatic.clearance.ClearanceRopeSolution or None
         The rope with clearance whose path the start follows, for the cable inside the conduit at
         the start (None where it is not used: a force-controlled pull, no clearance, no
         pretension, or a cable that runs slack).
@@ -434,7 +434,7 @@ def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: f
     """The rope with clearance for the start of a velocity-controlled pull, or None (force-controlled,
     no clearance, or a cable that runs slack somewhere)."""
     from ..errors import ModelError
-    from ..rope_clearance import solve_rope_with_clearance
+    from ..quasistatic.clearance import solve_rope_with_clearance
 
     if scenario.pull.force_N is not None or clearance_m <= 0.0:
         return None
@@ -446,11 +446,11 @@ def _clearance_rope_start(scenario, centreline, w_N_per_m: float, clearance_m: f
 
 
 def plan_cable_mesh(scenario, conduit, rope, refine: float = 1.0, check_points_per_element: int | None = None):
-    """The scenario's cable mesh by the rule of :mod:`exucable.mesh` (or its override, checked).
+    """The scenario's cable mesh by the rule of :mod:`exucable.scenario.mesh` (or its override, checked).
 
     ``refine`` divides the element length (``exucable converge``); ``check_points_per_element``
     overrides the scenario's ``contact.check_points_per_element``."""
-    from ..mesh import plan_mesh
+    from ..scenario.mesh import plan_mesh
 
     c = scenario.cable
     k = check_points_per_element if check_points_per_element is not None else scenario.contact.check_points_per_element
@@ -471,7 +471,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
 
     Parameters
     ----------
-    scenario : exucable.scenario.Scenario
+    scenario : exucable.scenario.specs.Scenario
     with_contact : bool
         False: on the centreline even when pre-tensioned (no wall to bear on).
     refine : float
@@ -484,7 +484,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     InitialLayout
     """
     from ..errors import ModelError
-    from ..rope import rope_pull_force_N, solve_rope, solve_rope_for_pull_force
+    from ..quasistatic.rope import rope_pull_force_N, solve_rope, solve_rope_for_pull_force
 
     sc = scenario
     conduit = sc.build_conduit()

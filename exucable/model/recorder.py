@@ -1,6 +1,6 @@
 """Recording a cable's pulling force and tensions as a simulation runs (paper Sect. 2.6, Eq. 24).
 
-A :class:`Recorder` is a post-step callable: exucable's own :func:`exucable.solve.simulate` calls
+A :class:`Recorder` is a post-step callable: exucable's own :func:`exucable.solve.dynamic.simulate` calls
 it, and so can a user's post-step function or sensor user function in their own Exudyn model.
 """
 
@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..tension import detect_steady_state, tension_at, tension_profile
-from ..trust import AxisGauge, cable_sample_points
+from ..post.tension import detect_steady_state, tension_at, tension_profile
+from ..post.trust import AxisGauge, cable_sample_points
 
 __all__ = ["History", "Recorder", "earliest_steady_s", "expected_drift_N_per_s", "record_state", "steady_quantity"]
 
@@ -61,7 +61,7 @@ def record_state(cable, t: float, history: History, gauge: AxisGauge | None = No
     """Append the current pulling force, trailing tension and maximum tension to ``history``, and
     (with a contact kernel) the largest penetration [m] and the cable axis's largest distance from
     the conduit's axis [m] with its place s [m] along the scenario's conduit (``gauge``:
-    :class:`exucable.trust.AxisGauge` of the pull-oriented conduit)."""
+    :class:`exucable.post.trust.AxisGauge` of the pull-oriented conduit)."""
     q, v = cable.coordinates()
     EA = cable.axial_stiffness_N
     _, N = tension_profile(q, cable.layout.element_length_m, EA, points_per_element=2)

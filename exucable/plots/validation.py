@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..io import new_figure, save_figure
-from ..reference import load_reference
+from ..data.reference_values import load_reference
 
 __all__ = ["plot_validation_figures"]
 
@@ -25,12 +25,12 @@ def plot_validation_figures(vr, out, ref: dict | None = None) -> list:
 
     Parameters
     ----------
-    vr : exucable.validate.ValidationRun
+    vr : exucable.validation.paper.ValidationRun
         Its ``runs`` (case → result) and ``sweep_rows`` (Fig. 12).
     out : pathlib.Path
         Directory to write into.
     ref : dict, optional
-        Reference values as :func:`exucable.reference.load_reference` returns them (read if not given).
+        Reference values as :func:`exucable.data.reference_values.load_reference` returns them (read if not given).
     """
     ref = load_reference() if ref is None else ref
     written = []

@@ -7,7 +7,7 @@ Dask distributed cluster (``--scheduler tcp://HOST:PORT``), each case in its own
 ``DIR/sweep.png``. Re-running the same command skips finished cases; failed ones are rerun with
 ``--retry-failed``.
 
-Modules: :mod:`~exucable.sweep.dotted` (dotted keys), :mod:`~exucable.sweep.spec` (sweep files),
+Modules: :mod:`~exucable.scenario.dotted` (dotted keys), :mod:`~exucable.sweep.spec` (sweep files),
 :mod:`~exucable.sweep.store` (the directory), :mod:`~exucable.sweep.worker` (one case),
 :mod:`~exucable.sweep.execute` (pool/Dask), :mod:`~exucable.sweep.plot`,
 :mod:`~exucable.sweep.progress`; the command line is :mod:`exucable.commands.sweep`.

@@ -36,8 +36,20 @@ from pathlib import Path
 from ..errors import ExucableError
 from .pool import run_local
 from .progress import SweepProgress
-from .store import (CASES_DIR, TABLE, SweepLock, _extra_columns, case_dir, is_finished, make_row,
-                    read_record, remove_stale, table_columns, write_manifest, write_table)
+from .store import (
+    CASES_DIR,
+    TABLE,
+    SweepLock,
+    _extra_columns,
+    case_dir,
+    is_finished,
+    make_row,
+    read_record,
+    remove_stale,
+    table_columns,
+    write_manifest,
+    write_table,
+)
 from .worker import install_packed, record_failure, run_case_packed
 
 __all__ = ["run_sweep", "default_workers", "worker_context", "plan"]

@@ -20,7 +20,7 @@ Each case's scenario is the base file's tables with, in this order, the ``unset`
 the ``[set]`` values and then the case's ``[vary]`` values written in (missing tables such as
 ``[gravity]`` are created; array indices must exist; nested TOML tables under ``[set]``/``[vary]``
 are read as dotted keys and merged key by key). Every case is then validated by
-:func:`~exucable.scenario.parse_scenario` before anything runs; a refusal is re-raised as a
+:func:`~exucable.scenario.specs.parse_scenario` before anything runs; a refusal is re-raised as a
 :class:`~exucable.errors.ScenarioError` that names the sweep key that caused it, e.g.
 ``vary."contact.friction"[2]: contact.friction: must be >= 0, got -0.1``.
 
@@ -41,8 +41,8 @@ from pathlib import Path
 from typing import NamedTuple
 
 from ..errors import ScenarioError
-from ..scenario import Scenario, parse_scenario, read_toml
-from .dotted import keys_overlap, parse_key, set_value, unset_value
+from ..scenario.specs import Scenario, parse_scenario, read_toml
+from ..scenario.dotted import keys_overlap, parse_key, set_value, unset_value
 
 __all__ = ["Case", "Sweep", "MODES", "OUTPUTS", "load_sweep", "parse_sweep", "scenario_hash",
            "canonical_json", "format_params"]

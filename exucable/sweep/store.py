@@ -41,7 +41,7 @@ TABLE = "sweep.csv"
 LOCK = ".sweep.lock"
 
 # A case is finished (never re-run) when its record has one of these statuses: trusted, or
-# completed but flagged as untrustworthy (exucable.trust; re-running would give the same answer).
+# completed but flagged as untrustworthy (exucable.post.trust; re-running would give the same answer).
 FINISHED = ("ok", "steady", "outside_conduit", "penetration", "dynamic", "not_steady")
 
 # sweep.csv columns after the varied keys, in order; "message" is kept last (free text).

@@ -29,9 +29,8 @@ from pathlib import Path
 
 from ..version import __version__
 from ..io import atomic_write_bytes, atomic_write_text
-from ..scenario import parse_scenario
-from .store import (CASE_JSON, RECORD_OUTPUTS, install_case, is_finished, read_record, temp_dir,
-                    write_record)
+from ..scenario.specs import parse_scenario
+from .store import CASE_JSON, RECORD_OUTPUTS, install_case, is_finished, read_record, temp_dir, write_record
 
 __all__ = ["default_runner", "execute_case", "run_case", "run_case_packed", "install_packed",
            "record_failure"]

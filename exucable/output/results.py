@@ -1,0 +1,106 @@
+"""Results of one run and their files (the documented results format, see README).
+
+Every file is written atomically (a temporary file in the same directory, then ``os.replace``),
+so a crash or a kill never leaves a half-written file, and ``summary.json`` is written after the
+data files: its presence marks complete results. The figures (optional) follow it.
+
+Files
+-----
+``summary.json``          scalars (forces [N], times [s]), status, scenario echoed back, versions
+``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N`` and, with contact,
+                          ``max_penetration_m,max_axis_offset_m,max_axis_offset_s_conduit_m``
+``tension_profile.csv``   ``x_m,tension_N`` at the final time (x: material coordinate from the trailing end)
+``contact_profile.csv``   ``s_conduit_m,normal_force_per_length_N_per_m,penetration_m`` (along the
+                          scenario's conduit from its start)
+``rope_profile.csv``      ``s_conduit_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
+``snapshot_*.csv``        the state at ``[output] snapshots`` times (see :mod:`exucable.output.snapshots`)
+``bends.csv``             one row per bend: tensions in/out, windowed pressure mean/peak, point loads
+                          (columns ``exucable.post.pressure.BEND_COLUMNS``)
+``pressure_profile.csv``  ``s_conduit_m,windowed_pressure_N_per_m,rope_windowed_pressure_N_per_m``
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+# The writers live in io.py (one atomic writer); re-exported here, where callers have found them.
+from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, read_csv, write_csv, write_json
+from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
+from ..post.pressure import BEND_COLUMNS, PRESSURE_COLUMNS
+
+__all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
+           "read_summary", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
+
+HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N", "max_penetration_m",
+                   "max_axis_offset_m", "max_axis_offset_s_conduit_m")
+# Arc lengths, one convention in every file: x_m = material coordinate along the cable from its
+# trailing end; s_conduit_m = along the scenario's conduit from its start (whatever the pull direction)
+PROFILE_COLUMNS = ("x_m", "tension_N")
+CONTACT_COLUMNS = ("s_conduit_m", "normal_force_per_length_N_per_m", "penetration_m")
+ROPE_COLUMNS = ("s_conduit_m", "tension_N", "sidewall_pressure_N_per_m")
+# (the old name s_m is still read by ``compare`` for one release: exucable.output.compare.FAMILIES)
+
+
+@dataclass
+class RunResult:
+    """Everything a run produced, ready to be written or post-processed."""
+
+    summary: dict
+    history: dict                     # HISTORY_COLUMNS -> arrays
+    tension_profile: dict             # PROFILE_COLUMNS -> arrays
+    contact_profile: dict | None = None
+    rope_profile: dict | None = None
+    extras: dict = field(default_factory=dict)
+    bends: list | None = None                # BEND_COLUMNS rows (exucable.post.pressure)
+    pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
+    snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.output.snapshots)
+    model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
+
+
+def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
+    """Write ``result`` into ``out_dir`` (created if needed): the CSV files, then ``summary.json``,
+    then (unless ``plots`` is false) the figures. Returns the paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    # one batch: the files are flushed to disk together and renamed in this order, summary.json
+    # last; an error on the way still puts the files before it in place (io.AtomicBatch)
+    with AtomicBatch() as batch:
+        def add_csv(name, columns, data):
+            written.append(write_csv(out / name, columns, data, batch=batch))
+
+        add_csv("history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
+        if result.tension_profile is not None:
+            add_csv("tension_profile.csv", PROFILE_COLUMNS, result.tension_profile)
+        if result.contact_profile is not None:
+            add_csv("contact_profile.csv", CONTACT_COLUMNS, result.contact_profile)
+        if result.rope_profile is not None:
+            add_csv("rope_profile.csv", ROPE_COLUMNS, result.rope_profile)
+        if result.bends:
+            add_csv("bends.csv", BEND_COLUMNS, {c: [row[c] for row in result.bends] for c in BEND_COLUMNS})
+        if result.pressure_profile is not None:
+            add_csv("pressure_profile.csv", PRESSURE_COLUMNS, result.pressure_profile)
+        if result.snapshots:
+            from .formats import SNAPSHOT_FILES
+            for name, data in result.snapshots.items():
+                add_csv(name, SNAPSHOT_FILES[name], data)
+        written.append(write_json(out / "summary.json", result.summary, batch=batch))
+    # the figures come after the numbers: they cost about half a second of matplotlib, and a
+    # failure to draw must not hold back (or lose) a result already computed
+    if plots:
+        plot_pull_force(out / "pull_force.png", result)
+        written.append(out / "pull_force.png")
+        if result.tension_profile is not None:
+            plot_tension_profile(out / "tension_profile.png", result)
+            written.append(out / "tension_profile.png")
+        if result.pressure_profile is not None:
+            plot_pressure(out / "pressure.png", result)
+            written.append(out / "pressure.png")
+    return written
+
+
+def read_summary(out_dir) -> dict:
+    with open(Path(out_dir) / "summary.json") as f:
+        return json.load(f)

@@ -1,0 +1,428 @@
+"""Pull planning: both pull directions, section by section, with the limits checked.
+
+What the installation calculators (Polywater Pull-Planner, Southwire SIMpull, Cableizer, the CommScope
+and Southwire manuals' hand calculations) give for a route and a cable set, from exucable's rope
+reference (:mod:`exucable.quasistatic.rope`): for each direction the tension entering and leaving every section,
+the sidewall bearing pressure (SWBP) in every bend, the limit checks with margins, and the recommended
+direction (the lower maximum tension among the directions that violate no limit). With ``engine =
+"steady"`` or ``"dynamic"`` each direction is also run on the multibody model of one cable
+(:func:`exucable.run.run_scenario`), whose section tensions and windowed SWBP replace the rope's, the rope's
+kept beside them.
+
+Several cables per duct enter as the calculators have them (:mod:`exucable.quasistatic.engineering`): the weight of
+all cables W = n·w, and friction multiplied by the weight correction factor w_c, so that the rope
+equation gives T_out = T_in + w_c μ W L on a level straight and T_out = T_in e^{w_c μ θ} in a bend
+without weight (Polywater, "Weight Correction Factor in Pulling Tension Calculations"; with
+``cable.weight_correction_in_bends = false``, T_in e^{μ θ} as in SEC TES-P-104.05). The rope keeps
+gravity exactly on slopes and vertical bends, where the calculators use approximations.
+
+The scenario keys used here beyond the simulation's: ``cable.count``, ``cable.arrangement``,
+``[limits]``, ``pull.feed_from_reel`` and ``[display] units`` (rows of
+:data:`exucable.scenario.fields.FIELDS`; quantities may be ``"value unit"`` strings, and bare numbers are
+imperial with ``display.units = "imperial"``, converted to SI when the file is read).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from exucable.quasistatic import engineering as eng
+from exucable.errors import ExucableError, ScenarioError
+from exucable.geometry.centreline import Centreline
+from exucable.quasistatic.rope import sidewall_pressure_N_per_m, solve_rope
+from exucable.scenario.specs import Scenario, load_scenario, parse_scenario
+from exucable.post.trust import TRUSTED_STATUSES
+from exucable.scenario.units import SYSTEMS
+
+__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES"]
+
+ENGINES = ("rope", "steady", "dynamic")
+
+
+@dataclass(frozen=True)
+class PlanLimits:
+    """The limits in force, SI (None: not given). See :class:`exucable.scenario.specs.LimitsSpec`.
+
+    ``conductor_tension_N`` is computed from ``limits.conductor_*`` by
+    :func:`exucable.quasistatic.engineering.max_tension_from_conductors_N`.
+    """
+
+    max_tension_N: float | None = None
+    grip_limit_N: float | None = None
+    conductor_tension_N: float | None = None
+    max_sidewall_pressure_N_per_m: float | None = None
+    min_bend_radius_multiple: float | None = None
+    min_clearance_m: float | None = None
+
+
+@dataclass(frozen=True)
+class PlanSpec:
+    """Planning inputs taken from a scenario.
+
+    Attributes
+    ----------
+    count : int
+        Cables of the described kind in the duct (``cable.count``).
+    arrangement : str
+        ``cable.arrangement`` (``"auto"`` or an arrangement).
+    units : str
+        ``"si"`` or ``"imperial"``: units of the printed tables and the report.
+    limits : PlanLimits
+    feed_from_reel : bool
+        Also compute the pull-in history (``pull.feed_from_reel``).
+    weight_correction_in_bends : bool
+        The weight correction factor multiplies the friction in bends too (``cable.weight_correction_in_bends``).
+    """
+
+    count: int = 1
+    arrangement: str = "auto"
+    units: str = "si"
+    limits: PlanLimits = field(default_factory=PlanLimits)
+    feed_from_reel: bool = False
+    weight_correction_in_bends: bool = True
+
+
+def plan_spec(scenario: Scenario, units: str | None = None) -> PlanSpec:
+    """The planning inputs of a scenario; ``units`` overrides the display units of the output only."""
+    lim = scenario.limits
+    conductor = None
+    if lim.conductor_material is not None:
+        rule = lim.conductor_rule or ("us" if scenario.display.units == "imperial" else "iec")
+        conductor = eng.max_tension_from_conductors_N(lim.conductor_material, lim.conductor_area_m2,
+                                                      lim.conductors, rule)
+    limits = PlanLimits(max_tension_N=lim.max_tension_N, grip_limit_N=lim.grip_limit_N,
+                        conductor_tension_N=conductor,
+                        max_sidewall_pressure_N_per_m=lim.max_sidewall_pressure_N_per_m,
+                        min_bend_radius_multiple=lim.min_bend_radius_multiple, min_clearance_m=lim.min_clearance_m)
+    if units is not None and units not in SYSTEMS:
+        raise ExucableError(f"--units: must be one of {', '.join(SYSTEMS)}, got {units!r}")
+    return PlanSpec(count=scenario.cable.count, arrangement=scenario.cable.arrangement,
+                    units=units or scenario.display.units, limits=limits,
+                    feed_from_reel=scenario.pull.feed_from_reel,
+                    weight_correction_in_bends=scenario.cable.weight_correction_in_bends)
+
+
+def parse_plan_scenario(data: dict, base_dir: Path, default_name: str = "scenario",
+                        units: str | None = None) -> tuple[Scenario, PlanSpec]:
+    """A scenario dict (as read from TOML) and its planning inputs; ``units``: display units of the output."""
+    scenario = parse_scenario(data, base_dir, default_name)
+    return scenario, plan_spec(scenario, units)
+
+
+def load_plan_scenario(path, units: str | None = None) -> tuple[Scenario, PlanSpec]:
+    """Read a scenario file and its planning inputs (``units`` overrides the output's display units)."""
+    scenario = load_scenario(path)
+    return scenario, plan_spec(scenario, units)
+
+
+# ------------------------------------------------------------------------------------------ sections
+
+def _slope_deg(direction) -> float:
+    return math.degrees(math.asin(max(-1.0, min(1.0, float(direction[2]))))) + 0.0  # no "-0"
+
+
+def _bend_plane(piece) -> str:
+    """horizontal / vertical up / vertical down / 3D, from the bend's axis and its change of height."""
+    if piece.kind == "helix":
+        return "helix"
+    axis_z = abs(float(piece.axis[2]))
+    if axis_z > 1.0 - 1e-9:
+        return "horizontal"
+    if axis_z < 1e-9:
+        dz = float(piece.end_tangent[2] - piece.direction[2])
+        return "vertical up" if dz > 0 else "vertical down"
+    return "3D"
+
+
+def _piece_samples(piece, n: int = 65) -> np.ndarray:
+    """Arc lengths inside a piece (kept off its ends, where the curvature of the neighbour begins)."""
+    eps = 1e-9 * piece.length_m
+    return np.linspace(piece.s_start_m + eps, piece.s_end_m - eps, n)
+
+
+def _sections(curve, rope, w_N_per_m: float, swbp_factor: float) -> list[dict]:
+    """Section table of one direction, in pull order, from the rope solution on ``curve``."""
+    rows = []
+    running_max = float(rope.trailing_tension_N)
+    for i, p in enumerate(curve.pieces):
+        s = _piece_samples(p)
+        tension = np.asarray(rope.tension_at(s - 0.0), dtype=float)
+        running_max = max(running_max, float(np.max(tension)))
+        row = {
+            "index": i + 1,
+            "kind": p.kind,
+            "length_m": float(p.length_m),
+            "tension_in_N": float(rope.tension_at(p.s_start_m)),
+            "tension_out_N": float(rope.tension_at(min(p.s_end_m, rope.cable_length_m))),
+            "sidewall_pressure_N_per_m": None,
+            "max_tension_so_far_N": running_max,
+            "s_start_m": float(p.s_start_m),
+        }
+        if p.is_curved:
+            pressure = sidewall_pressure_N_per_m(curve, s, tension, w_N_per_m)
+            row["sidewall_pressure_N_per_m"] = float(np.max(pressure)) * swbp_factor
+            row["plane"] = _bend_plane(p)
+            row["radius_m"] = float(p.coil_radius_m)
+            row["angle_deg"] = math.degrees(p.turning_angle_rad)
+        else:
+            row["plane"] = None
+            row["slope_deg"] = _slope_deg(p.direction)
+        rows.append(row)
+    return rows
+
+
+def _pull_in_history(curve: Centreline, rope, n: int = 201) -> dict:
+    """Tension at the cable's head while it advances from the entrance to the exit (rope, quasi-static).
+
+    While the head is at distance x along the route, the cable fills [0, x] with the reel's back tension
+    at its tail; the rope equation integrates from the tail, so the head's tension is the full pull's
+    tension profile T(x): one solution gives the whole history. The pulling line from the head to the rig
+    is taken as free of friction, so the rig's force is the head's tension. Grid: ``n`` uniform head
+    positions plus every piece boundary.
+    """
+    L = curve.length_m
+    grid = np.unique(np.concatenate([np.linspace(0.0, L, n), [p.s_end_m for p in curve.pieces]]))
+    grid = np.clip(grid, 0.0, rope.cable_length_m)
+    return {"pulled_length_m": grid.tolist(), "pull_force_N": np.asarray(rope.tension_at(grid)).tolist()}
+
+
+def _check(name, value, limit, where, quantity, lower_is_better=True) -> dict:
+    if lower_is_better:
+        passed = value <= limit
+        margin = (limit - value) / limit
+    else:
+        passed = value >= limit
+        margin = (value - limit) / limit
+    return {"name": name, "passed": bool(passed), "value": float(value), "limit": float(limit),
+            "margin": float(margin), "where": where, "quantity": quantity}
+
+
+def _label(row) -> str:
+    return f"section {row['index']} ({row['kind']})"
+
+
+def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: float, jam) -> list[dict]:
+    lim = spec.limits
+    rows = direction["sections"]
+    worst_t = max(rows, key=lambda r: r["max_tension_so_far_N"])
+    where_t = f"{_label(worst_t)} leaving end" if worst_t["tension_out_N"] >= worst_t["tension_in_N"] \
+        else f"{_label(worst_t)}"
+    t_max = direction["max_tension_N"]
+    out = []
+    for name, limit in (("max_tension", lim.max_tension_N), ("conductor_tension", lim.conductor_tension_N),
+                        ("grip_tension", lim.grip_limit_N)):
+        if limit is not None:
+            out.append(_check(name, t_max, limit, where_t, "force"))
+    bends = [r for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+    if lim.max_sidewall_pressure_N_per_m is not None and bends:
+        b = max(bends, key=lambda r: r["sidewall_pressure_N_per_m"])
+        out.append(_check("max_sidewall_pressure", b["sidewall_pressure_N_per_m"], lim.max_sidewall_pressure_N_per_m,
+                          _label(b), "force_per_length"))
+    if lim.min_bend_radius_multiple is not None and bends:
+        b = min(bends, key=lambda r: r["radius_m"])
+        out.append(_check("min_bend_radius", b["radius_m"],
+                          lim.min_bend_radius_multiple * 2.0 * scenario.cable.radius_m, _label(b),
+                          "length", lower_is_better=False))
+    if lim.min_clearance_m is not None:
+        out.append(_check("min_clearance", clearance, lim.min_clearance_m, "duct cross-section", "small_length",
+                          lower_is_better=False))
+    if jam.risk != "not applicable":
+        # A number to compare with: the jam band 2.6 ≤ JR < 2.9 is "significant" (Cableizer JR_p).
+        passed = jam.risk != "significant"
+        out.append({"name": "jam_ratio", "passed": passed, "value": jam.jam_ratio, "limit": None,
+                    "margin": None, "quantity": None, "where": f"jam risk {jam.risk} (significant for 2.6 <= 1.05 D/d < 2.9)"})
+    return out
+
+
+def _finite_or_none(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry: dict, progress: bool) -> dict:
+    """One direction's plan entry from the multibody model, the rope's values kept beside.
+
+    The scenario is run in ``engine``'s solver mode with ``pull.direction = name`` (the reverse pull is
+    the reversed route). Section tensions are the cable's tension (EA·ε at its nodes) interpolated at
+    the section boundaries along the conduit (``s_conduit_m``); a bend's SWBP is the peak of the
+    windowed sidewall pressure over the bend (:mod:`exucable.post.pressure`: the contact forces of the check
+    points within ±w/2, over w), with the bend body's mean windowed pressure and the point loads at
+    its ends beside it. A dynamic run's tensions are those of its last state; its pulling force is the
+    mean over its steady window.
+    """
+    from exucable.run import cable_tension_along_conduit, run_scenario  # builds an Exudyn model
+
+    sc = dataclasses.replace(scenario, pull=dataclasses.replace(scenario.pull, direction=name))
+    result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine)
+    summary = result.summary
+    s_c, T_c = cable_tension_along_conduit(result.model)
+    order = np.argsort(s_c)
+    s_c, T_c = np.asarray(s_c, dtype=float)[order], np.asarray(T_c, dtype=float)[order]
+    L = scenario.build_conduit().centreline.length_m
+    to_conduit = (lambda s: s) if name == "forward" else (lambda s: L - s)
+
+    def tension(s_pull):
+        return float(np.interp(to_conduit(s_pull), s_c, T_c))
+
+    bends = iter(summary["bends"] if name == "forward" else summary["bends"][::-1])
+    rows = []
+    running = tension(0.0)
+    for r in rope_entry["sections"]:
+        a, b = r["s_start_m"], r["s_start_m"] + r["length_m"]
+        lo, hi = sorted((to_conduit(a), to_conduit(b)))
+        inside = T_c[(s_c >= lo) & (s_c <= hi)]
+        t_in, t_out = tension(a), tension(b)
+        running = max(running, t_in, t_out, float(np.max(inside)) if inside.size else t_out)
+        row = dict(r, tension_in_N=t_in, tension_out_N=t_out, max_tension_so_far_N=running,
+                   rope_tension_in_N=r["tension_in_N"], rope_tension_out_N=r["tension_out_N"],
+                   rope_sidewall_pressure_N_per_m=r["sidewall_pressure_N_per_m"])
+        if r["sidewall_pressure_N_per_m"] is not None:
+            bend = next(bends)
+            row.update(sidewall_pressure_N_per_m=float(bend["peak_pressure_N_per_m"]),
+                       mean_sidewall_pressure_N_per_m=_finite_or_none(bend["mean_pressure_N_per_m"]),
+                       rope_windowed_sidewall_pressure_N_per_m=float(bend["rope_peak_pressure_N_per_m"]),
+                       entry_point_load_N=float(bend["entry_point_load_N"]),
+                       entry_s_conduit_m=float(bend["entry_s_conduit_m"]),
+                       exit_point_load_N=float(bend["exit_point_load_N"]),
+                       exit_s_conduit_m=float(bend["exit_s_conduit_m"]))
+        rows.append(row)
+    s_pull = np.clip(np.array([to_conduit(s) for s in s_c]), 0.0, L)
+    back = np.argsort(s_pull)
+    pressures = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+    return {
+        # a run that failed before its first converged state has no pulling force
+        "pull_force_N": float("nan") if summary["pull_force_N"] is None else summary["pull_force_N"],
+        "max_tension_N": max(r["max_tension_so_far_N"] for r in rows),
+        "max_sidewall_pressure_N_per_m": max(pressures) if pressures else None,
+        "slack": rope_entry["slack"],
+        "sections": rows,
+        "profile": {"s_m": s_pull[back].tolist(), "tension_N": T_c[back].tolist()},
+        "rope_pull_force_N": rope_entry["pull_force_N"],
+        "rope_max_tension_N": rope_entry["max_tension_N"],
+        "rope_max_sidewall_pressure_N_per_m": rope_entry["max_sidewall_pressure_N_per_m"],
+        "rope_profile": rope_entry["profile"],
+        "status": summary["status"],
+        "message": summary["message"],
+        "flags": summary.get("flags", []),
+        "pull_force_std_N": summary.get("pull_force_std_N"),
+        "pressure_window_m": summary.get("pressure_window_m"),
+        "elements": int(result.model.layout.element_length_m.size),
+        "wall_time_s": summary["wall_time_s"],
+    }
+
+
+def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress: bool = False) -> dict:
+    """Plan a pull in both directions.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Route, cable (one of the ``spec.count`` identical cables), friction, back tension, gravity.
+    spec : PlanSpec
+    engine : {"rope", "steady", "dynamic"}
+        ``"rope"``: the quasi-static rope (instant). ``"steady"`` / ``"dynamic"``: the multibody model of
+        one cable (:func:`exucable.run.run_scenario` in that solver mode, one run per direction, the
+        reverse run on the reversed route); the rope's values stay beside each section's
+        (``rope_*`` keys), see :func:`_multibody_direction`.
+    progress : bool
+        Show the multibody runs' progress bars on a terminal (stderr).
+
+    Returns
+    -------
+    dict
+        The content of ``plan.json`` (SI): ``engine``, ``directions.forward`` / ``.reverse`` (each with
+        ``pull_force_N``, ``max_tension_N``, ``max_sidewall_pressure_N_per_m``, ``sections``, ``checks``,
+        ``passed`` and, if asked, ``pull_in``), ``recommended_direction``, ``weight_correction_factor``,
+        ``jam_ratio``, ``jam_risk``, ``clearance_m``, ``arrangement``, ``count``, ``checks`` (those of the
+        recommended direction), ``passed``, ``inputs``.
+
+    Raises
+    ------
+    ExucableError
+        An unknown ``engine``; ``cable.count`` > 1 with a multibody engine (it simulates one cable).
+    """
+    if engine not in ENGINES:
+        raise ExucableError(f"--engine: must be one of {', '.join(ENGINES)}, got {engine!r}")
+    if engine != "rope" and spec.count != 1:
+        raise ScenarioError("cable.count", f"--engine {engine} simulates one cable, got {spec.count}; plan "
+                                           "several cables per duct with --engine rope (weight correction "
+                                           "factor), or set cable.count = 1")
+    if scenario.pull.force_N is not None:
+        raise ScenarioError("pull.force", "exucable plan computes the pulling force from the back tension; give "
+                                          "pull.back_tension (the reel's) instead of a prescribed pull.force")
+    d = 2.0 * scenario.cable.radius_m
+    D = 2.0 * scenario.conduit.inner_radius_m
+    arrangement = eng.auto_arrangement(spec.count, D, d) if spec.arrangement == "auto" else spec.arrangement
+    wc = eng.weight_correction_factor(spec.count, arrangement, D, d)
+    swbp_factor = eng.sidewall_pressure_factor(spec.count, arrangement, wc)
+    jam = eng.jam_risk(spec.count, D, d)
+    clearance = eng.clearance_m(spec.count, arrangement, D, d)
+    g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
+    w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
+    mu_eff = wc * scenario.contact.friction
+    # in bends: w_c μ (IEEE 1185, AEIC CG5, Polywater) or μ (SEC TES-P-104.05's worked example)
+    mu_bend = None if spec.weight_correction_in_bends else scenario.contact.friction
+    back = scenario.pull.back_tension_N
+    centreline = scenario.build_conduit().centreline
+
+    directions = {}
+    for name in ("forward", "reverse"):
+        curve = centreline if name == "forward" else centreline.reversed()
+        rope = solve_rope(centreline, mu_eff, w_total, back, name, bend_friction=mu_bend)
+        rows = _sections(curve, rope, w_total, swbp_factor)
+        bends = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+        entry = {
+            "pull_force_N": rope.pull_force_N,
+            "max_tension_N": max(rope.max_tension_N, max(r["max_tension_so_far_N"] for r in rows)),
+            "max_sidewall_pressure_N_per_m": max(bends) if bends else None,
+            "slack": rope.slack,
+            "sections": rows,
+            "profile": {"s_m": (rope.s_cable_m).tolist(), "tension_N": rope.tension_N.tolist()},
+        }
+        if engine != "rope":
+            entry = _multibody_direction(scenario, name, engine, entry, progress)
+        entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
+        if engine != "rope":
+            # a run that failed or is flagged (exucable.post.trust) gives numbers no check should pass on
+            entry["checks"].append({"name": "multibody_run", "passed": entry["status"] in TRUSTED_STATUSES,
+                                    "value": None, "limit": None, "margin": None, "quantity": None,
+                                    "where": f"status {entry['status']}" + (f": {entry['message']}" if entry["message"] else "")})
+        entry["passed"] = all(c["passed"] for c in entry["checks"])
+        if spec.feed_from_reel:
+            entry["pull_in"] = _pull_in_history(curve, rope)
+        directions[name] = entry
+
+    ok = [n for n in directions if directions[n]["passed"]]
+    pool = ok or list(directions)
+    recommended = min(pool, key=lambda n: directions[n]["max_tension_N"])
+    return {
+        "engine": engine,
+        "directions": directions,
+        "recommended_direction": recommended,
+        "weight_correction_factor": wc,
+        "weight_correction_in_bends": spec.weight_correction_in_bends,
+        "sidewall_pressure_factor": swbp_factor,
+        "jam_ratio": jam.jam_ratio,
+        "jam_risk": jam.risk,
+        "clearance_m": clearance,
+        "arrangement": arrangement,
+        "count": spec.count,
+        "checks": directions[recommended]["checks"],
+        "passed": bool(ok),
+        "inputs": {
+            "scenario": scenario.name,
+            "cable_diameter_m": d,
+            "duct_inner_diameter_m": D,
+            "weight_per_length_one_cable_N_per_m": scenario.cable.mass_per_length_kg_per_m * g,
+            "friction": scenario.contact.friction,
+            "back_tension_N": back,
+            "route_length_m": centreline.length_m,
+            "units": spec.units,
+            "limits": scenario.limits.to_dict(),
+        },
+    }

@@ -1,0 +1,3 @@
+"""The two ways of solving one model: ``dynamic`` (the paper's generalized-α integration), ``steady``
+(the steady sliding state in one static solve) and ``start`` (a dynamic run started in the steady
+state)."""
