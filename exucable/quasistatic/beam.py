@@ -54,6 +54,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solve_banded
 
+from .newton import armijo_step, banded_jacobian
+
 __all__ = ["PlanarBeamSolution", "solve_planar_beam", "stiff_route_difference", "route_pieces"]
 
 # Wall penalty per node = _PENALTY · T_ref / h: node loads of a bend end (~√(EJ T)/ρ) penetrate
@@ -131,7 +133,11 @@ class PlanarBeamSolution:
 
 class _Chain:
     space_dim = 2          # node positions' dimension (the frozen friction forces' shape)
+    dofs = 1               # unknowns per node: the offset along n
     pull_tol = _TOL_PULL
+    shape_tol = 1e-8       # lateral residual / T_ref at which the shape is converged
+    stall_move = 1e-12     # a step below this fraction of c is a stall
+    residual_name = "lateral"
 
     def __init__(self, pieces, clearance_m, friction, weight_N_per_m, bending_stiffness_N_m2, back_tension_N,
                  spacing_m, head_offset_m=None, trough_weight_N_per_m=None, tension_scale_N=None):
@@ -197,49 +203,51 @@ class _Chain:
         tension, bending, wall, _ = self.forces(d, T)
         return np.einsum("ij,ij->i", tension + bending + wall + G, self.n)
 
+    def offsets(self, flat):
+        """The flat vector of unknowns as offsets: (N,) in the plane, (N, 2) in 3D."""
+        return flat if self.dofs == 1 else flat.reshape(-1, self.dofs)
+
     def solve_shape(self, d, T, G, maxit=300):
-        free = np.ones(self.N, bool)
+        """Damped Newton on the offsets (the head's pinned): the lateral balance's banded Jacobian by
+        finite differences (:func:`.newton.banded_jacobian`), an energy line search."""
+        free = np.ones(d.shape, bool)
         if self.head is not None:
             free[-1] = False
             d[-1] = self.head
-        idx = np.nonzero(free)[0]
-        m = idx.size
+        idx = np.flatnonzero(free)
+        half_band = 3 * self.dofs - 1          # a node couples with the nodes ±2 (bending)
+        flat = d.reshape(-1)
+
+        def residual(x):
+            return self.lateral_residual(self.offsets(x), T, G).reshape(-1)[idx]
+
+        def moved(x, step, alpha):
+            trial = x.copy()
+            trial[idx] += alpha * step
+            return trial
+
         for it in range(maxit):
-            r = self.lateral_residual(d, T, G)[idx]
+            r = residual(flat)
             nr = float(np.max(np.abs(r)))
-            if nr < 1e-8 * self.Tref:
-                return d, it
-            eps = 1e-7 * self.c
-            ab = np.zeros((5, m))
-            for colour in range(5):
-                cols = np.arange(colour, m, 5)
-                trial = d.copy()
-                trial[idx[cols]] += eps
-                dr = (self.lateral_residual(trial, T, G)[idx] - r) / eps
-                for off in range(-2, 3):
-                    rows = cols + off
-                    ok = (rows >= 0) & (rows < m)
-                    ab[2 + off, cols[ok]] = dr[rows[ok]]
-            step = solve_banded((2, 2), ab, -r)
-            E0 = self.energy(d, T, G)
+            if nr < self.shape_tol * self.Tref:
+                return self.offsets(flat), it
+            ab = banded_jacobian(residual, flat, idx, half_band, 1e-7 * self.c, r)
+            step = solve_banded((half_band, half_band), ab, -r)
+            E0 = self.energy(self.offsets(flat), T, G)
             slope = -float(r @ step)
             if slope > 0.0:      # not a descent direction: fall back to a scaled gradient step
-                step = r / np.max(np.abs(ab[2]))
+                step = r / np.max(np.abs(ab[half_band]))
                 slope = -float(r @ step)
-            lam = 1.0
-            while True:
-                trial = d.copy()
-                trial[idx] += lam * step
-                if self.energy(trial, T, G) <= E0 + 1e-4 * lam * slope + 1e-12 * abs(E0) or lam < 1e-9:
-                    break
-                lam *= 0.5
-            if (lam < 1e-9 or np.max(np.abs(trial - d)) < 1e-12 * self.c) and nr < _SHAPE_STALL_3D * self.Tref:
-                return d, it   # stalled on the penalty's kink, at a residual far below what matters
-            d = trial
+            lam = armijo_step(lambda a: self.energy(self.offsets(moved(flat, step, a)), T, G), E0, slope,
+                              slack=1e-12 * abs(E0))
+            trial = moved(flat, step, lam)
+            if (lam < 1e-9 or np.max(np.abs(trial - flat)) < self.stall_move * self.c) and nr < _SHAPE_STALL_3D * self.Tref:
+                return self.offsets(flat), it   # stalled on the penalty's kink, at a residual far below what matters
+            flat = trial
         if nr < _SHAPE_STALL_3D * self.Tref:
-            return d, maxit
+            return self.offsets(flat), maxit
         raise BeamConduitError(f"shape Newton did not converge in {maxit} iterations at EJ = {self.EJ:.4g} N m^2 "
-                               f"(lateral residual {nr:.3g} N)")
+                               f"({self.residual_name} residual {nr:.3g} N)")
 
     def march(self, d, T):
         """Tensions from the trailing end, and the frozen friction forces."""
@@ -448,7 +456,11 @@ class _Chain3D(_Chain):
     Offsets are (N, 2) arrays: along n and up."""
 
     space_dim = 3
+    dofs = 2
     pull_tol = _TOL_PULL_3D
+    shape_tol = _SHAPE_TOL_3D
+    stall_move = 1e-9
+    residual_name = "normal-plane"
 
     def pos(self, d):
         x = np.zeros((self.N, 3))
@@ -514,52 +526,6 @@ class _Chain3D(_Chain):
         total = tension + bending + wall + G
         n3, up = self._normal_frames()
         return np.stack([np.einsum("ij,ij->i", total, n3), total[:, 2]], 1)
-
-    def solve_shape(self, d, T, G, maxit=300):
-        free = np.ones((self.N, 2), bool)
-        if self.head is not None:
-            free[-1] = False
-            d[-1] = self.head
-        idx = np.flatnonzero(free)
-        m = idx.size
-        flat = d.reshape(-1)
-        for it in range(maxit):
-            r = self.lateral_residual(flat.reshape(-1, 2), T, G).reshape(-1)[idx]
-            nr = float(np.max(np.abs(r)))
-            if nr < _SHAPE_TOL_3D * self.Tref:
-                return flat.reshape(-1, 2), it
-            eps = 1e-7 * self.c
-            band = 5
-            ab = np.zeros((2 * band + 1, m))
-            for colour in range(2 * band + 1):
-                cols = np.arange(colour, m, 2 * band + 1)
-                trial = flat.copy()
-                trial[idx[cols]] += eps
-                dr = (self.lateral_residual(trial.reshape(-1, 2), T, G).reshape(-1)[idx] - r) / eps
-                for off in range(-band, band + 1):
-                    rows = cols + off
-                    ok = (rows >= 0) & (rows < m)
-                    ab[band + off, cols[ok]] = dr[rows[ok]]
-            step = solve_banded((band, band), ab, -r)
-            E0 = self.energy(flat.reshape(-1, 2), T, G)
-            slope = -float(r @ step)
-            if slope > 0.0:
-                step = r / np.max(np.abs(ab[band]))
-                slope = -float(r @ step)
-            lam = 1.0
-            while True:
-                trial = flat.copy()
-                trial[idx] += lam * step
-                if self.energy(trial.reshape(-1, 2), T, G) <= E0 + 1e-4 * lam * slope + 1e-12 * abs(E0) or lam < 1e-9:
-                    break
-                lam *= 0.5
-            if (lam < 1e-9 or np.max(np.abs(trial - flat)) < 1e-9 * self.c) and nr < _SHAPE_STALL_3D * self.Tref:
-                return flat.reshape(-1, 2), it   # stalled on the penalty's kinks, at a residual far below what matters
-            flat = trial
-        if nr < _SHAPE_STALL_3D * self.Tref:
-            return flat.reshape(-1, 2), maxit
-        raise BeamConduitError(f"shape Newton did not converge in {maxit} iterations at EJ = {self.EJ:.4g} N m^2 "
-                               f"(normal-plane residual {nr:.3g} N)")
 
     def march(self, d, T):
         _, bending, wall, t = self.forces(d, T)

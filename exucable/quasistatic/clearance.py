@@ -45,6 +45,8 @@ from scipy.linalg import solve_banded
 
 from exucable.errors import ModelError
 
+from .newton import armijo_step
+
 __all__ = ["ClearanceRopeSolution", "solve_rope_with_clearance", "default_node_spacing_m"]
 
 _E_Z = np.array([0.0, 0.0, 1.0])
@@ -265,8 +267,9 @@ class _Chain:
             ephi = np.stack([-er[:, 1], er[:, 0]], axis=1)
             dr = np.sum(step * er, axis=1)
             dt = np.sum(step * ephi, axis=1)
-            alpha = 1.0
-            while True:
+            tried = {}
+
+            def energy_at(alpha):
                 d_new = d + alpha * step
                 if np.any(wall):
                     ang = alpha * dt[wall] / r[wall]
@@ -277,10 +280,11 @@ class _Chain:
                 r_new = np.linalg.norm(d_new, axis=1)
                 hit = ~wall & (r_new > self.c)
                 d_new[hit] *= (self.c * (1.0 + _ON_WALL) / r_new[hit])[:, None]
-                E_new = self.energy(d_new, T, G)
-                if E_new <= E + 1e-4 * alpha * slope or alpha < 1e-10:
-                    break
-                alpha *= 0.5
+                tried[alpha] = d_new, self.energy(d_new, T, G)
+                return tried[alpha][1]
+
+            alpha = armijo_step(energy_at, E, slope, min_step=1e-10)
+            d_new, E_new = tried[alpha]
             moved = alpha * float(np.max(np.abs(step)))
             d, E = d_new, E_new
             if moved < tol_m:

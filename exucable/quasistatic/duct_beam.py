@@ -46,6 +46,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import solveh_banded
 
+from .newton import armijo_step
+
 __all__ = ["DuctBeamSolution", "duct_route", "solve_duct_beam", "gravity_change_of_stiffness"]
 
 # Wall penalty k = _PENALTY · T_ref / (h c): a bend's load T/R then sinks the cable ~h/(R _PENALTY)·c,
@@ -261,9 +263,7 @@ def solve_duct_beam(path, clearance_m: float, friction: float, weight_N_per_m: f
                 d = d + step
                 break
             slope = float(np.sum(grad * step))
-            e0, t = energy(d), 1.0
-            while t > 1e-6 and energy(d + t * step) > e0 + 1e-4 * t * slope:
-                t *= 0.5
+            t = armijo_step(lambda a: energy(d + a * step), energy(d), slope, min_step=1e-6)
             d = d + t * step
         r = np.linalg.norm(d, axis=1)
         wall = k_wall * cell * np.clip(r - c, 0.0, None)
