@@ -6,10 +6,8 @@
 
 Each command creates ./.venv and installs exucable with its test extras into it when needed
 (again only when pyproject.toml changes), so both are idempotent. Extra arguments are passed on
-(``python3 dev.py test -m slow``). Both also compile the contact kernels ahead of time when the
-sources changed (``exucable compile``: about half a minute, a minute on a fresh machine where numba
-compiles them first), so that runs skip numba's start-up; without a C compiler, runs use numba's
-JIT kernels and this only prints why. The main job validates the paper's examples at the paper's
+(``python3 dev.py test -m slow``). Both also compile the contact kernels into numba's cache when the
+sources changed (``exucable compile``: 1-2 minutes on a fresh machine), so that no test or run pays it. The main job validates the paper's examples at the paper's
 fidelity (about 90 s); ``python3 dev.py main --fast`` runs the coarse variants (about 15 s).
 """
 
@@ -43,9 +41,10 @@ def ensure_environment() -> None:
 
 
 def ensure_compiled_kernels() -> None:
-    """Build the ahead-of-time kernels if they are missing or stale; a failure is not fatal."""
+    """Compile the contact kernels into numba's cache if they are not; a failure is not fatal (the
+    first run that needs them compiles them)."""
     if subprocess.call([str(PY), "-m", "exucable", "compile", "--quiet"], cwd=ROOT) != 0:
-        print("dev.py: continuing without the compiled kernels (runs use numba's JIT kernels)", flush=True)
+        print("dev.py: continuing; the first run that needs the contact kernels compiles them", flush=True)
 
 
 def main(argv: list[str]) -> int:

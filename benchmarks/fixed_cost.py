@@ -1,21 +1,19 @@
-"""Fixed cost of ``exucable run`` (issue 15, part 3), measured in one run.
+"""Fixed cost of ``exucable run``, measured in one run.
 
 A trivial scenario (the fast Example 2 over one 1 ms step) is run as a whole process, with and
 without figures, interleaved with ``python -c "import exudyn"`` (the floor: interpreter + Exudyn)
 and with the numba floor (Exudyn, numba and numba's CPU target initialised, which any process
-running a cached numba kernel pays), and ``exucable run --no-plots`` with the JIT kernels forced
-(``EXUCABLE_KERNELS=jit``: numba's cached kernels, as before ``exucable compile``) beside the
-default, which uses the ahead-of-time compiled kernels when they are built (``exucable compile``,
-done here first unless ``--no-compile``), ``--repeat`` times each; medians of wall time and of CPU time
-(user + system, less disturbed by the other jobs on a shared machine) are compared. Then one
-``-X importtime`` run says which imports the rest is made of.
+running a cached numba kernel pays), ``--repeat`` times each, after one warm-up that fills numba's
+cache (``exucable compile``); medians of wall time and of CPU time (user + system, less disturbed by
+the other jobs on a shared machine) are compared. Then one ``-X importtime`` run says which imports
+the rest is made of.
 
     nice .venv/bin/python benchmarks/fixed_cost.py             # ~30 s
     nice .venv/bin/python benchmarks/fixed_cost.py --repeat 9
     nice .venv/bin/python benchmarks/fixed_cost.py --before /path/to/main-tree   # before/after
-    nice .venv/bin/python benchmarks/fixed_cost.py --no-compile    # as it is (AOT kernels if built)
+    nice .venv/bin/python benchmarks/fixed_cost.py --quick     # one repeat, no import table
 
-Target: ``exucable run --no-plots`` within 0.6 s of ``import exudyn``.
+Target: ``exucable run --no-plots`` within 1.0 s of ``import exudyn``.
 """
 
 from __future__ import annotations
@@ -34,7 +32,6 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 FLOOR_CASE = "numba floor: import exudyn, numba + target init"
 RUN_CASE = "exucable run --no-plots"
-JIT_CASE = "exucable run --no-plots, JIT kernels (EXUCABLE_KERNELS=jit)"
 NUMBA_FLOOR = "import exudyn, numba; from numba.core.registry import cpu_target; cpu_target.target_context.refresh()"
 
 
@@ -81,15 +78,13 @@ def main(argv=None) -> int:
     ap.add_argument("--before", type=Path, default=None,
                     help="another exucable source tree (e.g. `git archive main` unpacked) to run interleaved "
                          "with this one, through PYTHONPATH; warm its numba cache first")
-    ap.add_argument("--no-compile", action="store_true",
-                    help="do not build the ahead-of-time kernels first (`exucable compile`)")
+    ap.add_argument("--quick", action="store_true", help="one repeat and no import table (a smoke run)")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.repeat = 1
     exe = Path(sys.executable).with_name("exucable")
-    if not args.no_compile:
-        subprocess.run([str(exe), "compile", "--quiet"], check=False)
-    env_jit = dict(os.environ, EXUCABLE_KERNELS="jit")
-    env_default = {k: v for k, v in os.environ.items() if k != "EXUCABLE_KERNELS"}
-    compiled = subprocess.run([str(exe), "compile", "--check"], capture_output=True, text=True, env=env_default)
+    subprocess.run([str(exe), "compile", "--quiet"], check=False)
+    env_default = dict(os.environ)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         sc = trivial_scenario(tmp)
@@ -99,19 +94,17 @@ def main(argv=None) -> int:
             # its CPU target's registries (numba.np.linalg, which imports scipy.linalg for BLAS, ...)
             FLOOR_CASE: [sys.executable, "-c", NUMBA_FLOOR],
             RUN_CASE: [str(exe), "run", str(sc), "-o", str(tmp / "a"), "-q", "--no-plots"],
-            JIT_CASE: [str(exe), "run", str(sc), "-o", str(tmp / "j"), "-q", "--no-plots"],
             "exucable run (figures)": [str(exe), "run", str(sc), "-o", str(tmp / "b"), "-q"],
         }
-        outs = {RUN_CASE: tmp / "a", JIT_CASE: tmp / "j", "exucable run (figures)": tmp / "b"}
-        envs = {RUN_CASE: env_default, JIT_CASE: env_jit, "exucable run (figures)": env_default}
+        outs = {RUN_CASE: tmp / "a", "exucable run (figures)": tmp / "b"}
+        envs = {RUN_CASE: env_default, "exucable run (figures)": env_default}
         if args.before is not None:
             before = f"exucable run --no-plots ({args.before.name})"
             cases[before] = [str(exe), "run", str(sc), "-o", str(tmp / "c"), "-q", "--no-plots"]
             outs[before] = tmp / "c"
             envs[before] = dict(os.environ, PYTHONPATH=str(args.before.resolve()))
             timed(cases[before], outs[before], envs[before])
-        for k in (RUN_CASE, JIT_CASE):
-            timed(cases[k], outs[k], envs[k])                  # warm the disk and kernel caches
+        timed(cases[RUN_CASE], outs[RUN_CASE], envs[RUN_CASE])      # warm the disk and kernel caches
         times = {k: [] for k in cases}
         load0 = os.getloadavg()[0]
         for _ in range(args.repeat):
@@ -122,17 +115,16 @@ def main(argv=None) -> int:
         floor, cpu_floor = med["python -c 'import exudyn'"], cpu["python -c 'import exudyn'"]
         print(f"# Fixed cost of exucable run — load average {load0:.1f} -> {os.getloadavg()[0]:.1f} "
               f"on {os.cpu_count()} cores, median of {args.repeat} interleaved runs\n")
-        print(f"ahead-of-time kernels: {compiled.stdout.strip()}\n")
         print("| command | wall, median [s] | above import exudyn [s] | CPU, median [s] | CPU above import exudyn [s] "
               "| all runs, wall [s] |\n|---|---|---|---|---|---|")
         for k, v in times.items():
             print(f"| {k} | {med[k]:.3f} | {med[k] - floor:+.3f} | {cpu[k]:.2f} | {cpu[k] - cpu_floor:+.2f} | "
                   f"{', '.join(f'{w:.2f}' for w, _ in v)} |")
-        print(f"\ntarget: exucable run --no-plots within 0.6 s of import exudyn: "
-              f"{med[RUN_CASE] - floor:.2f} s wall, {cpu[RUN_CASE] - cpu_floor:.2f} s CPU "
-              f"(JIT kernels forced: {med[JIT_CASE] - floor:.2f} s wall, {cpu[JIT_CASE] - cpu_floor:.2f} s CPU; "
-              f"ratio AOT/JIT above the floor {(med[RUN_CASE] - floor) / (med[JIT_CASE] - floor):.2f} wall); "
+        print(f"\ntarget: exucable run --no-plots within 1.0 s of import exudyn: "
+              f"{med[RUN_CASE] - floor:.2f} s wall, {cpu[RUN_CASE] - cpu_floor:.2f} s CPU; "
               f"the numba floor alone: {med[FLOOR_CASE] - floor:.2f} s wall, {cpu[FLOOR_CASE] - cpu_floor:.2f} s CPU")
+        if args.quick:
+            return 0
         print("\nslowest top-level imports of `exucable run --no-plots` (-X importtime, cumulative):\n")
         for seconds, name in top_imports(["-m", "exucable", *cases[RUN_CASE][1:]]):
             print(f"- {name}: {seconds:.3f} s")

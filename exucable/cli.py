@@ -24,7 +24,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "converge": ("exucable.commands.converge", "run a scenario on refined meshes and extrapolate its result"),
     "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
     "plan": ("exucable.commands.plan", "plan a pull: both directions, section tables, limit checks, HTML report"),
-    "compile": ("exucable.commands.compile", "compile the contact kernels ahead of time (runs then skip numba's 0.7 s start-up)"),
+    "compile": ("exucable.commands.compile", "compile the contact kernels into numba's cache now (the first run would do it)"),
 }
 
 

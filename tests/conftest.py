@@ -1,5 +1,8 @@
-"""Shared helpers for the tests: scenarios built from dicts (the TOML contract), the ahead-of-time
-kernel module."""
+"""Shared helpers for the tests: scenarios built from dicts (the TOML contract), and the test tiers.
+
+Tiers: ``python3 dev.py test`` runs everything but ``slow`` (full-fidelity runs); ``-m quick`` the
+quick tier for the edit–test loop: every test outside :data:`HEAVY_MODULES`, the modules whose tests
+run whole simulations, sweeps, installs or subprocesses (measured with ``pytest --durations=0``)."""
 
 from __future__ import annotations
 
@@ -11,6 +14,17 @@ import pytest
 from exucable.scenario.specs import parse_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
+
+# test modules left out of the quick tier (each takes ten seconds or more of the full run)
+HEAVY_MODULES = frozenset()
+
+
+def pytest_collection_modifyitems(config, items):
+    quick = pytest.mark.quick
+    for item in items:
+        if item.get_closest_marker("slow") is None and Path(str(item.fspath)).stem not in HEAVY_MODULES:
+            item.add_marker(quick)
+
 
 PAPER_CABLE = {"radius": 0.0025, "density": 1000.0, "youngs_modulus": 1.0e9}
 
@@ -37,19 +51,3 @@ def make_scenario(**tables):
 @pytest.fixture
 def scenario_factory():
     return make_scenario
-
-
-@pytest.fixture(scope="session")
-def aot_module():
-    """The valid ahead-of-time kernel module for this checkout and machine (tests/test_aot.py), built
-    here if ``python3 dev.py`` or ``exucable compile`` has not built it (about 10-40 s)."""
-    from exucable.contact import aot, aot_build
-
-    path = aot.find()
-    if path is None:
-        try:
-            path, _ = aot_build.build()
-        except aot_build.CompilerUnavailable as exc:     # a kernel that does not compile fails the test
-            pytest.skip(f"cannot build the ahead-of-time kernels: {exc}")
-    aot.reset()
-    return path

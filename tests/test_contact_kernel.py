@@ -666,7 +666,7 @@ def test_kernel_imports_and_runs_when_no_cache_directory_is_writable():
                                   0.01, lo, hi)
         print(type(broadphase._element_boxes.dispatcher._cache).__name__, np.allclose(lo[0], [-0.01] * 3))
     """)
-    env = dict(os.environ, NUMBA_CACHE_LOCATOR_CLASSES="IPythonCacheLocator", EXUCABLE_KERNELS="jit")
+    env = dict(os.environ, NUMBA_CACHE_LOCATOR_CLASSES="IPythonCacheLocator")
     env.pop("NUMBA_CACHE_DIR", None)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=300, env=env)

@@ -1,6 +1,6 @@
 """What `exucable run` loads (issue 15, fixed cost): a run of a route of straights and horizontal
-bends imports no scipy subpackage but scipy.linalg (which numba loads for its BLAS anyway), with
-plots=False neither matplotlib nor dask, and with the ahead-of-time kernels no numba. Checked in a fresh interpreter, by module name, not by time."""
+bends imports no scipy subpackage but scipy.linalg (which numba loads for its BLAS anyway), and with
+plots=False neither matplotlib nor dask. Checked in a fresh interpreter, by module name, not by time."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import os
 import re
 import subprocess
 import sys
+import textwrap
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -46,8 +47,21 @@ def test_a_run_of_a_planar_route_imports_only_what_it_uses(tmp_path):
     assert not modules & {"matplotlib", "dask", "distributed"}, modules & {"matplotlib", "dask", "distributed"}
 
 
-def test_a_run_with_the_compiled_kernels_imports_no_numba(aot_module, tmp_path):
-    """With the ahead-of-time kernels (tests/test_aot.py) a run never imports numba; forced to the
-    JIT kernels it does (so the first check can fail)."""
-    assert not modules_after_a_trivial_run(tmp_path / "aot", EXUCABLE_KERNELS=None) & {"numba", "llvmlite"}
-    assert "numba" in modules_after_a_trivial_run(tmp_path / "jit", EXUCABLE_KERNELS="jit")
+def test_a_kernel_says_whether_numba_has_it_cached(tmp_path):
+    """``Kernel.is_cached`` (behind the first-run announcement and ``exucable compile --check``): False
+    in an empty cache, True once a call compiled it there, and False again after a source changed."""
+    code = textwrap.dedent("""
+        import numpy as np
+        from exucable.contact import jitcache, nearest
+        k = nearest._nearest
+        before = k.is_cached()
+        nearest.NearestSample(np.random.default_rng(0).random((50, 3)))(np.zeros((2, 3)))
+        after = k.is_cached()
+        jitcache.sources_key = lambda sources=None: "changed"     # as after an edit of a kernel's source
+        k._dispatcher = None
+        print(before, after, k.is_cached())
+    """)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["False", "True", "False"]

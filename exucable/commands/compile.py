@@ -1,41 +1,66 @@
-"""``exucable compile``: build the ahead-of-time compiled contact kernels for this machine.
+"""``exucable compile``: compile the contact kernels for this machine now, into numba's disk cache.
 
-A run that finds them does not import numba (0.7 s less fixed cost per process); without them it
-uses numba's JIT kernels, cached on disk. See :mod:`exucable.contact.aot`.
+The first run after an install or an update of exucable compiles them anyway (once; later processes
+load the machine code from numba's cache, see :mod:`exucable.contact.jitcache`); this command does it
+up front by running a tiny built-in case in each solver mode, so that every kernel a run calls is
+compiled with the argument types a run uses (no hand-kept list of signatures). Commands that run a
+model say when a run is about to compile (:func:`announce_compiling`).
 """
 
 from __future__ import annotations
 
-from ..contact import aot, aot_build
-from ..errors import ExucableError
+import sys
+import time
 
-__all__ = ["add_arguments", "main"]
+__all__ = ["add_arguments", "main", "announce_compiling"]
+
+# what the first compile costs on a 2-core machine (docs/performance.md, "Fixed cost")
+COMPILE_ESTIMATE = "about 1 to 2 minutes"
 
 
 def add_arguments(p) -> None:
-    p.add_argument("--force", action="store_true", help="rebuild even if a valid module exists")
     p.add_argument("--check", action="store_true",
-                   help="only say whether a valid module exists (exit status 0 if so, 1 if not)")
-    p.add_argument("-q", "--quiet", action="store_true", help="say nothing when the module is up to date")
+                   help="only say whether the kernels are compiled (exit status 0 if so, 1 if not)")
+    p.add_argument("-q", "--quiet", action="store_true", help="say nothing when the kernels are compiled")
+
+
+def announce_compiling(stream=None) -> None:
+    """Say on ``stream`` (stderr) that the coming run compiles the contact kernels, when it will."""
+    from ..contact.jitcache import kernels_to_compile
+
+    if kernels_to_compile():
+        print(f"exucable: compiling the contact kernels for this machine ({COMPILE_ESTIMATE}, once after an "
+              "install or an update; `exucable compile` does it ahead) ...", file=stream or sys.stderr, flush=True)
+
+
+def _warm_up() -> None:
+    """Run the coarse Example 2 over a few steps in dynamic mode and once in steady mode: every kernel
+    a run calls is compiled and cached."""
+    from ..data import data_path
+    from ..run import run_scenario
+    from ..scenario.specs import load_scenario
+
+    sc = load_scenario(data_path("scenarios", "fast", "paper_ex2_bend90.toml"))
+    run_scenario(sc.replace(**{"solver.mode": "dynamic", "solver.end_time": 0.003}), plots=False)
+    run_scenario(sc.replace(**{"solver.mode": "steady"}), plots=False)
 
 
 def main(args) -> int:
-    state = aot.status()
-    where = ", ".join(map(str, state["directories"]))
-    if state["valid"] and not args.force:
+    from ..contact.jitcache import kernels_to_compile
+
+    pending = kernels_to_compile()
+    if pending == []:
         if not args.quiet:
-            print(f"compiled kernels up to date: {state['path']}")
+            print("contact kernels compiled and cached for this machine")
         return 0
     if args.check:
-        print(f"no compiled kernels for these sources and this machine (key {state['key']}) in {where}; "
-              "runs use numba's JIT kernels. Build them with `exucable compile`.")
+        print("the contact kernels are not compiled for these sources and this machine: the next run "
+              f"compiles them ({COMPILE_ESTIMATE}); `exucable compile` does it now")
         return 1
-    print(f"compiling the contact kernels ahead of time (key {state['key']}; about a minute) ...", flush=True)
-    try:
-        path, seconds = aot_build.build()
-    except RuntimeError as exc:
-        raise ExucableError(f"{exc}. Runs still work, with numba's JIT kernels.") from exc
-    print(f"compiled kernels written to {path} in {seconds:.0f} s")
-    if state["forced_jit"]:
-        print(f"note: {aot.MODE_VARIABLE}=jit is set: runs in this environment ignore them")
+    print(f"compiling the contact kernels for this machine ({COMPILE_ESTIMATE}) ...", flush=True)
+    t0 = time.perf_counter()
+    _warm_up()
+    left = kernels_to_compile()
+    print(f"compiled in {time.perf_counter() - t0:.0f} s" + ("" if not left else
+          f"; not cached (numba cannot write its cache, see the warning above): {', '.join(left)}"))
     return 0

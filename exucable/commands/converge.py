@@ -102,6 +102,9 @@ def main(args) -> int:
         print(f"exucable converge: error: --ratio: must be > 1, got {args.ratio}", file=sys.stderr)
         return 2
     out = Path(args.out) if args.out else Path("out") / f"{sc.name}-converge"
+    from .compile import announce_compiling
+
+    announce_compiling()
 
     def progress(level, s):
         m = s["mesh"]

@@ -99,6 +99,10 @@ def main(args) -> int:
     from exucable.scenario.units import display_unit, from_si
 
     scenario, spec = load_plan_scenario(args.scenario, units=args.units)
+    if args.engine != "rope":
+        from .compile import announce_compiling
+
+        announce_compiling()
     plan = plan_pull(scenario, spec, engine=args.engine, progress=True)
     units = spec.units
     f = display_unit("force", units)

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..run import run_scenario
+from .compile import announce_compiling
 from ..scenario.specs import load_scenario
 from ..post.trust import TRUSTED_STATUSES
 
@@ -28,17 +29,6 @@ def add_arguments(p) -> None:
                    help="run to solver.end_time whatever the pulling force does")
 
 
-def _used_jit_kernels_without_need() -> bool:
-    """Whether this process ran numba's JIT kernels only because no ahead-of-time module is built
-    (not when ``EXUCABLE_KERNELS=jit`` asked for them)."""
-    if "numba" not in sys.modules:
-        return False
-    from ..contact import aot
-
-    state = aot.status()
-    return not state["valid"] and not state["forced_jit"]
-
-
 def _f(value, fmt=".6g") -> str:
     return "n/a" if value is None or not np.isfinite(value) else format(value, fmt)
 
@@ -46,6 +36,7 @@ def _f(value, fmt=".6g") -> str:
 def main(args) -> int:
     sc = load_scenario(args.scenario)
     out_dir = Path(args.out) if args.out else Path("out") / sc.name
+    announce_compiling()
     res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
                        mode=args.mode)
     s = res.summary
@@ -70,9 +61,6 @@ def main(args) -> int:
         print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
               f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
-    if not args.quiet and _used_jit_kernels_without_need():
-        print("  note: this run compiled or loaded numba's JIT kernels (~0.7 s of start-up a process); "
-              "`exucable compile` builds ahead-of-time kernels that later runs load instead")
     m = s.get("mesh") or {}
     if m:
         print(f"  mesh: {m['elements']} elements of {m['element_length_m']:.4g} m ({m['source']}; rule "

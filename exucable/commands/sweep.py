@@ -108,6 +108,10 @@ def main(args) -> int:
         print(f"{sweep.name}: {n} case(s), {len(todo)} to run on the {where}, "
               f"{n - len(todo)} already on disk", file=sys.stderr)
     runner = load_runner(args.runner)
+    if todo and args.runner is None:
+        from .compile import announce_compiling
+
+        announce_compiling()
     # SIGTERM like Ctrl-C: stop the case processes and write the table before leaving
     previous = signal.signal(signal.SIGTERM, _terminated)
     try:

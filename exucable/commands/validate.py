@@ -88,6 +88,9 @@ def _industry(args) -> int:
 
 
 def main(args) -> int:
+    from .compile import announce_compiling
+
+    announce_compiling()
     status = 0
     if args.suite in ("paper", "all"):
         status = max(status, _paper(args))

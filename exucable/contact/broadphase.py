@@ -36,7 +36,7 @@ __all__ = [
 ]
 
 def _jit(func):
-    """Compiled by numba (or ahead of time, see .jitcache); runs as Python when numba is missing,
+    """Compiled by numba (see .jitcache); runs as Python when numba is missing,
     so that the numpy reference never needs it."""
     return njit(nogil=True)(func)
 

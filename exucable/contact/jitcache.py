@@ -2,16 +2,17 @@
 
 The kernels (:mod:`.fast`, the broad phase :mod:`.broadphase`, the steady-mode kernel :mod:`.steady`,
 the trust gauge's nearest-sample search :mod:`.nearest`) are decorated with :func:`njit` from here,
-not numba's: it records the function and its numba options and imports nothing. A call then goes
+not numba's: it records the function and its numba options and imports nothing until the first call
+(``import exucable`` stays light). A call goes to numba's JIT dispatcher, created on first use with
+``cache=True``: the first call in a fresh environment compiles (tens of seconds for :mod:`.fast`; 
+``exucable compile`` does it up front, and :func:`kernels_to_compile` lets a command say so before a
+run), later processes load the machine code from disk (a tenth of a second, plus numba's own start-up).
+Numba would load a kernel's machine code even after a helper it inlined from another file changed;
+:func:`forget_stale_machine_code` compiles it again then.
 
-1. to the ahead-of-time compiled extension module (:mod:`.aot`, built by ``exucable compile``) when
-   a valid one exists and the arguments have the types it was compiled for: numba is not imported
-   at all, which saves its import and CPU-target initialisation (0.7 s, issue 15, fixed cost);
-2. else to numba's JIT dispatcher, created on first use with ``cache=True``: the first call in a
-   fresh environment compiles (tens of seconds for :mod:`.fast`), later processes load the machine
-   code from disk (a tenth of a second). Numba would load a kernel's machine code even after a
-   helper it inlined from another file changed; :func:`forget_stale_machine_code` compiles it
-   again then.
+Why no ahead-of-time module: numba's ``pycc`` is deprecated, and keeping it took private patches of
+numba and a hand-kept table of signatures, for about half a second per process
+(``docs/decisions/0001-numba-cache-instead-of-pycc.md``).
 
 Nothing here sets ``NUMBA_*`` options: a process that imports exucable keeps numba's configuration
 as the user set it. Numba looks for a writable cache directory in this order
@@ -26,19 +27,42 @@ A directory counts only if numba can write a file into it: a read-only ``__pycac
 even if it holds a valid cache. When none is writable, ``njit(cache=True)`` would raise and make
 exucable unusable; :func:`jit_cache_available` sees this beforehand and the kernel is then compiled
 in memory in every process (correct, only slower to start), with one warning saying how to fix it.
-The ahead-of-time module follows the same places (:func:`exucable.contact.aot.directories`).
 """
 
 from __future__ import annotations
 
 import functools
+import hashlib
+import sys
 import warnings
+from importlib import metadata
 from pathlib import Path
 
 from ..io import atomic_write_text
-from .aot import exported, key as sources_key
 
-__all__ = ["njit", "Kernel", "forget_stale_machine_code", "jit_cache_available"]
+__all__ = ["njit", "Kernel", "SLOW_TO_COMPILE", "forget_stale_machine_code", "jit_cache_available",
+           "kernels_to_compile", "sources_key"]
+
+# The kernels whose compilation takes long enough to announce (tens of seconds each; the others
+# take about a second): the dynamic and the steady contact kernel, as "module.function".
+SLOW_TO_COMPILE = ("fast._contact_kernel", "steady._steady_kernel")
+
+
+def sources_key(sources: Path | None = None) -> str:
+    """Hash of what a kernel's machine code depends on beyond its own file: the sources of every
+    module of this package (``sources``, default this package's directory: the kernels and the helpers
+    they inline) and the numpy, numba and llvmlite versions. Numba's own index adds the CPU."""
+    h = hashlib.sha256()
+    for path in sorted(Path(sources or Path(__file__).resolve().parent).glob("*.py")):
+        h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    versions = [sys.version]
+    for dist in ("numpy", "numba", "llvmlite"):
+        try:
+            versions.append(metadata.version(dist))
+        except metadata.PackageNotFoundError:
+            versions.append("-")
+    h.update("\0".join(versions).encode())
+    return h.hexdigest()[:24]
 
 
 def jit_cache_available(func) -> bool:
@@ -75,15 +99,14 @@ def forget_stale_machine_code(dispatcher, name: str) -> bool:
     machine code that inlined a function from another file (the steady kernel inlines
     :mod:`.fast`'s closest-point and contact-law helpers) is loaded unchanged after that other file
     changes, i.e. the old code runs. A marker file beside the cache holds the hash of all this
-    package's sources (:func:`exucable.contact.aot.key`, which keys the ahead-of-time module too);
+    package's sources (:func:`sources_key`);
     a different or missing marker flushes the cache index, so the kernel is compiled again.
     Returns whether it flushed. A cache it cannot write is left alone (numba then compiles in memory).
     """
-    cache = getattr(dispatcher, "_cache", None)
-    path = getattr(cache, "cache_path", None)
-    if path is None:
+    marker = _marker_path(dispatcher, f"{name}.sources")
+    if marker is None:
         return False
-    marker = Path(path) / f"{name}.sources"
+    cache = dispatcher._cache
     current = sources_key()
     try:
         if marker.read_text() == current:
@@ -101,8 +124,7 @@ def forget_stale_machine_code(dispatcher, name: str) -> bool:
 class Kernel:
     """A numba-compiled function that imports numba only when it has to.
 
-    Calling it runs the ahead-of-time compiled version (:mod:`.aot`) when one is loaded and accepts
-    the arguments' types, else numba's JIT dispatcher (:attr:`dispatcher`). Inside other compiled
+    Calling it runs numba's JIT dispatcher (:attr:`dispatcher`), made on the first call. Inside other compiled
     functions it behaves as the dispatcher: numba's inliner reads :attr:`targetoptions` and
     :attr:`py_func`, its typing :attr:`_numba_type_`.
     """
@@ -113,6 +135,7 @@ class Kernel:
         self.targetoptions = dict(options)
         self.name = f"{py_func.__module__.rsplit('.', 1)[-1]}.{py_func.__name__}"  # e.g. "fast._contact_kernel"
         self._dispatcher = None
+        self._note_compiled = False     # the first call's machine code is not yet marked as cached
 
     @property
     def dispatcher(self):
@@ -129,6 +152,7 @@ class Kernel:
                 self._dispatcher = numba_njit(**options)(self.py_func)
                 if options["cache"]:
                     forget_stale_machine_code(self._dispatcher, self.name)
+                    self._note_compiled = not self.is_cached()
         return self._dispatcher
 
     @property
@@ -136,13 +160,39 @@ class Kernel:
         return self.dispatcher._numba_type_
 
     def __call__(self, *args, **kwargs):
-        compiled = exported(self.name) if not kwargs else None   # the exports take positional arguments
-        if compiled is not None and compiled.accepts(args):
-            return compiled.function(*args)
-        return self.dispatcher(*args, **kwargs)
+        dispatcher = self.dispatcher
+        if self._note_compiled:          # the first call compiles and caches: say so beside the cache
+            result = dispatcher(*args, **kwargs)
+            self._note_compiled = False
+            marker = _marker_path(dispatcher, f"{self.name}.compiled")
+            if marker is not None:
+                try:
+                    atomic_write_text(marker, sources_key())
+                except OSError:
+                    pass
+            return result
+        return dispatcher(*args, **kwargs)
+
+    def is_cached(self) -> bool | None:
+        """Whether numba's disk cache holds machine code of this kernel for the current sources
+        (True), holds none (False: the first call compiles), or cannot tell (None: no disk cache).
+        Read from a marker written beside the cache after the first call; imports numba."""
+        marker = _marker_path(self.dispatcher, f"{self.name}.compiled")
+        if marker is None:
+            return None
+        try:
+            return marker.read_text() == sources_key()
+        except OSError:
+            return False
 
     def __repr__(self):
         return f"<exucable kernel {self.name}>"
+
+
+def _marker_path(dispatcher, name: str) -> Path | None:
+    """``name`` in the directory of ``dispatcher``'s disk cache, or None without one."""
+    path = getattr(getattr(dispatcher, "_cache", None), "cache_path", None)
+    return None if path is None else Path(path) / name
 
 
 def njit(func=None, **options):
@@ -150,3 +200,20 @@ def njit(func=None, **options):
     if func is not None:
         return Kernel(func, options)
     return lambda f: Kernel(f, options)
+
+
+def kernels_to_compile(names=SLOW_TO_COMPILE) -> list[str] | None:
+    """Those of the kernels ``names`` ("module.function" in this package) whose first call in this
+    environment will compile them (numba's cache holds no machine code for the current sources):
+    ``[]`` when all are cached, None when numba cannot tell. Imports numba; compiles nothing."""
+    import importlib
+
+    pending = []
+    for name in names:
+        module, function = name.split(".")
+        cached = getattr(importlib.import_module(f"{__package__}.{module}"), function).is_cached()
+        if cached is None:
+            return None
+        if not cached:
+            pending.append(name)
+    return pending

@@ -1,6 +1,6 @@
 """Imported once by the forkserver of the local pool, so that every case's process, forked
-from it, starts with numpy, scipy, Exudyn, the compiled contact kernels (ahead of time, else numba's
-initialised CPU target) and matplotlib already loaded (about 1.7 s per case otherwise). Nothing
+from it, starts with numpy, scipy, Exudyn,
+numba's initialised CPU target and matplotlib already loaded (about 1.7 s per case otherwise). Nothing
 here *uses* Exudyn: a process is forked only from this clean, import-only state, never from one
 that has run a model.
 """
@@ -14,14 +14,10 @@ try:  # a failed import only costs start-up time in the workers; it must not kil
     import exucable.run  # noqa: F401
     import exucable.sweep.worker  # noqa: F401
     import exucable.contact.nearest  # noqa: F401  (the axis gauge's search)
-    from exucable.contact import aot
+    from numba.core.registry import cpu_target
 
-    # the ahead-of-time kernels (exucable compile), loaded once here; without them numba's JIT
-    # kernels, whose CPU target (its registries, numba.np.linalg and scipy.linalg for BLAS) is
-    # otherwise set up on the first compiled call of every case: about a fifth of a second each
-    if aot.exported("fast._contact_kernel") is None:
-        from numba.core.registry import cpu_target
-
-        cpu_target.target_context.refresh()
+    # numba's CPU target (its registries, numba.np.linalg and scipy.linalg for BLAS) set up once
+    # here: otherwise on the first compiled call of every case, about a fifth of a second each
+    cpu_target.target_context.refresh()
 except Exception:  # pragma: no cover
     pass
