@@ -650,8 +650,7 @@ def test_kernel_imports_and_runs_when_no_cache_directory_is_writable():
     """Numba finds no writable cache directory (simulated by offering it only a locator that
     never applies: IPython's): exucable warns once per compiled module, with the fix, instead of
     failing, and compiles in memory (checked on the broad phase, which compiles in a second; the
-    kernel's own compilation takes tens of seconds and is the same code path). The JIT path is
-    forced: the ahead-of-time module (tests/test_aot.py) would serve the call without numba."""
+    kernel's own compilation takes tens of seconds and is the same code path)."""
     code = textwrap.dedent("""
         import warnings
         warnings.simplefilter("always")

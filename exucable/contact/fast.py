@@ -13,9 +13,8 @@ One pass per element, each step a loop over the element's check points over cont
   products N_a N_b tabulated once (unit element length, scaled by L afterwards);
 - nothing is allocated inside the loops.
 
-Run ahead-of-time compiled when ``exucable compile`` built them (numba is then not imported),
-else compiled by numba with ``cache=True``: the first call in a fresh environment compiles (a few
-seconds), later processes load the machine code from disk (where, and the choice: :mod:`.jitcache`).
+Compiled by numba with ``cache=True``: the first call in a fresh environment compiles (tens of
+seconds; ``exucable compile`` does it ahead), later processes load the machine code from disk (where, and the choice: :mod:`.jitcache`).
 A :class:`FastKernel` owns its work buffers: use one per thread.
 """
 

@@ -256,7 +256,7 @@ class ContactKernel:
         self._seg_hi = np.ascontiguousarray(segments.aabb_max_m)
 
         if backend == "auto":
-            # found, not imported: with the ahead-of-time kernels a run never imports numba (.jitcache)
+            # found, not imported: numba is imported by the first kernel call (.jitcache)
             backend = "numba" if importlib.util.find_spec("numba") is not None else "numpy"
         self.backend = backend
         # the one switch: every call below goes to this object

@@ -237,8 +237,8 @@ def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, basis, pair
 
     ``basis`` (7, n_k): Bernstein values B_m(ξ_k) (:func:`bernstein`); ``coeff`` (26, 7): the
     products' coefficients (:func:`block_coefficients`); ``acc`` (≥ 7, 18): the moments.
-    ``scratch`` and ``acc16`` are not used (left in so that the compiled signature, which the
-    ahead-of-time build lists, stays that of the former product sums)."""
+    ``scratch`` and ``acc16`` are not used (kept so that the call signature stays that of the former
+    product sums)."""
     n_k = n1.shape[0]
     n_contact = 0
     max_d2 = -1.0
