@@ -250,7 +250,7 @@ class Result:
     history : History
     tension_profile : TensionProfile
     summary : dict
-        Everything ``summary.json`` holds (see the README's results format).
+        Everything ``summary.json`` holds (docs/results-format.md).
     model : exucable.model.build.Model
         The solved model: final coordinates (``model.coordinates()``), ``kernel``, ``mbs``.
     scenario : Scenario

@@ -13,7 +13,7 @@ __all__ = ["solver_settings", "quiet_sparse"]
 
 
 def solver_settings(solver_spec) -> exu.SimulationSettings:
-    """Simulation settings from a scenario's ``[solver]`` table (see the README for why each)."""
+    """Simulation settings from a scenario's ``[solver]`` table (docs/theory.md and scenarios/README.md say why each)."""
     s = exu.SimulationSettings()
     ti = s.timeIntegration
     ti.endTime = solver_spec.end_time_s
