@@ -301,7 +301,7 @@ def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False) -
     ----------
     scenario : Scenario, or path of a scenario file
     out_dir : path, optional
-        Write the result files there (README "Results format"); by default nothing is written.
+        Write the result files there (docs/results-format.md); by default nothing is written.
     progress : bool
         Show a progress bar on stderr (only when it is a terminal).
 

@@ -1,4 +1,4 @@
-"""Results of one run and their files (the documented results format, see README).
+"""Results of one run and their files (the documented results format, docs/results-format.md).
 
 Every file is written atomically (a temporary file in the same directory, then ``os.replace``),
 so a crash or a kill never leaves a half-written file, and ``summary.json`` is written after the
