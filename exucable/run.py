@@ -262,10 +262,6 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         if first.layout is None:
             summary["warnings"].append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
                                        "started from the rope instead")
-    if sp.mode == "steady" and N.size:
-        # one state: its largest tension is the tension profile's (4 stations per element), not the
-        # pseudo-time history's coarser stations
-        summary["max_tension_N"] = float(np.max(N))
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
     summary["status"], summary["flags"] = _assess(model, out, st, h, summary["pull_force_N"])
