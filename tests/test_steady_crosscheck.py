@@ -15,6 +15,7 @@ from exucable.model.cable import CableProperties, add_cable
 from exucable.output.export import elastic_quadrature, export_problem
 from exucable.output.compare import compare_results
 from exucable.run import run_scenario
+from exucable.solve.steady import static_settings
 from exucable.scenario.specs import load_scenario
 
 from conftest import ROOT
@@ -112,7 +113,7 @@ def test_exudyn_cable_forces_are_the_stated_formulas(integration):
     add_cable(mbs, q, np.full(n_el, L), CableProperties(1.0, EA, EJ, integration=integration))
     mbs.Assemble()
     solver = exu.MainSolverStatic()
-    settings = exu.SimulationSettings()
+    settings = static_settings()         # exucable's steady solve's: quiet, no solution/ files in the cwd
     solver.InitializeSolver(mbs, settings)
     solver.ComputeNewtonResidual(mbs, settings)
     exudyn_lhs = -np.asarray(solver.GetSystemResidual())[:6 * (n_el + 1)]
