@@ -137,3 +137,40 @@ def test_snapshot_times_are_refused_in_steady_mode():
         run_scenario(sc, None)
     with pytest.raises(ModelError, match=r"^output\.snapshot_interval: "):
         run_scenario(sc.replace(**{"output.snapshots": [], "output.snapshot_interval": 0.1}), None)
+
+
+def _undocumented(problem: dict) -> list[str]:
+    """problem.json's fields (dotted, below scenario/versions/conventions' own contents) that the
+    problem.json table of docs/results-format.md does not name in backticks, as `a.b` or in a
+    `a.{b, c}` group; an object counts as named when one of its fields is."""
+    import re
+
+    doc = (ROOT / "docs" / "results-format.md").read_text(encoding="utf-8")
+    table = doc[doc.index("### `problem.json`"):doc.index("### CSV tables")]
+    named = set()
+    for cell in re.findall(r"`([^`]+)`", table):
+        head, _, group = cell.partition(".{")
+        named.update([cell] + [f"{head}.{g.strip()}" for g in group.rstrip("}").split(",")] if group else [cell])
+    missing = []
+
+    def walk(d, prefix):
+        for key, value in d.items():
+            name = prefix + key
+            if name not in named and not any(n.startswith(name + ".") for n in named):
+                missing.append(name)
+            if isinstance(value, dict) and key not in ("scenario", "versions", "conventions"):
+                walk(value, name + ".")
+
+    walk(problem, "")
+    return missing
+
+
+def test_every_problem_field_is_documented(steady_dir, tmp_path):
+    out, _ = steady_dir
+    assert _undocumented(json.loads((out / "problem.json").read_text())) == []
+    # the dynamic problem, with the exit-span damper that only it has
+    sc = load_scenario(ROOT / "scenarios/fast/paper_ex2_bend90.toml").replace(**{"solver.exit_span_damping": 10.0})
+    export_problem(sc, tmp_path)
+    dynamic = json.loads((tmp_path / "problem.json").read_text())
+    assert dynamic["mode"] == "dynamic" and dynamic["exit_span_damper"] is not None
+    assert _undocumented(dynamic) == []

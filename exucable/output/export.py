@@ -169,8 +169,6 @@ def problem_description(model) -> dict:
                        + ("" if steady else ", times ramp(t)")
                        + ("; force-controlled pull: applied_pull_force_N * exit_tangent on the leading node's position"
                           if model.lead_drive is None else "")),
-        "rig": "see rig",
-        "contact": None if contact is None else "see contact",
     }
     return {
         "format_version": FORMAT_VERSION,
