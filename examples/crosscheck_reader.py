@@ -1,19 +1,26 @@
-"""An independent reader of an ``exucable export``: the contact law of Yang et al. (2013), Eqs. 14-23,
-from the exported files alone, with plain numpy (no exucable import).
+"""An independent reader of an ``exucable export``: the discrete problem of Yang et al. (2013) from the
+exported files alone, with plain numpy (no exucable import).
 
 This is the pattern a solver author follows: load the discrete problem (``problem.json`` and the CSV
-tables, see ``docs/results-format.md``), rebuild the state (the initial one from
-``nodes_initial.csv``, or a snapshot's from ``snapshot_nodes.csv``), evaluate one's own contact
-forces and compare them with exucable's (``snapshot_contact.csv``).
+tables, see ``docs/results-format.md``), rebuild a state (the initial one from ``nodes_initial.csv``,
+or a snapshot's from ``snapshot_nodes.csv``), evaluate one's own forces there and compare them with
+exucable's: the contact forces per element (``snapshot_contact.csv``, Eqs. 14-23) and, for a steady
+solve, the whole static equilibrium — elastic forces of the ANCF cable with Exudyn's quadrature,
+contact with friction against the steady flow V·r', gravity's consistent load, back tension —
+whose residual must vanish everywhere but at the rig's held node, where it is the rig's reaction,
+the pulling force along the exit tangent.
 
-Usage::
+Usage (a steady solve; its state is the one snapshot, time 0)::
 
-    exucable export scenarios/fast/paper_ex2_bend90.toml out/ex2-export
-    exucable run scenarios/fast/paper_ex2_bend90.toml --out out/ex2-export   # with [output] snapshots
-    python examples/crosscheck_reader.py out/ex2-export
+    exucable export scenarios/fast/paper_ex2_bend90.toml out/ex2 --mode steady
+    exucable run scenarios/fast/paper_ex2_bend90.toml --mode steady --out out/ex2 --no-plots
+    python examples/crosscheck_reader.py out/ex2
 
-prints, for the first snapshot, the largest difference of the per-element normal and friction
-forces [N] between this reader and exucable, relative to the largest force.
+prints the largest difference of the per-element normal and friction forces between this reader and
+exucable at the first snapshot, relative to the largest force, and for a steady solve the
+equilibrium residual relative to the pulling force and the rig's reaction against the pulling force.
+A dynamic run needs ``[output] snapshots`` in its scenario for the contact check (and has no
+static equilibrium to check).
 """
 
 from __future__ import annotations
@@ -63,6 +70,80 @@ def hermite(xi, length_m):
 
 def _xyz(table, prefix, unit=""):
     return np.stack([table[f"{prefix}_{c}{unit}"] for c in "xyz"], 1)
+
+
+def hermite_x(xi, length_m):
+    """dN/dx of the Hermite functions (x the material coordinate, x = ξ L_e), shape (m, 4)."""
+    x = np.asarray(xi, dtype=float)
+    L = np.asarray(length_m, dtype=float)
+    return np.stack([(-6 * x + 6 * x**2) / L, 1 - 4 * x + 3 * x**2, (6 * x - 6 * x**2) / L, 3 * x**2 - 2 * x], 1)
+
+
+def hermite_xx(xi, length_m):
+    """d²N/dx² of the Hermite functions, shape (m, 4)."""
+    x = np.asarray(xi, dtype=float)
+    L = np.asarray(length_m, dtype=float)
+    return np.stack([(-6 + 12 * x) / L**2, (-4 + 6 * x) / L, (6 - 12 * x) / L**2, (6 * x - 2) / L], 1)
+
+
+def _interpolate(S, q, ni, nj):
+    """Σ_a S_a q_a at points: S (m, 4), q (n_nodes, 6), element node indices ni, nj (m,) → (m, 3)."""
+    return S[:, 0, None] * q[ni, :3] + S[:, 1, None] * q[ni, 3:] + S[:, 2, None] * q[nj, :3] + S[:, 3, None] * q[nj, 3:]
+
+
+def _scatter(Q, S, F, ni, nj):
+    """Add the point forces F (m, 3) as Σ Sᵀ F into Q (n_nodes, 6)."""
+    for col, node in ((0, ni), (2, nj)):
+        np.add.at(Q, (node, slice(0, 3)), S[:, col, None] * F)
+        np.add.at(Q, (node, slice(3, 6)), S[:, col + 1, None] * F)
+
+
+def elastic_forces(ex, q) -> np.ndarray:
+    """Exudyn's ANCF cable elastic forces Q_el(q), shape (n_nodes, 6), as ``problem.json``'s
+    ``equations`` state them: the axial term EA(|r'| − 1) and the bending term EJ κ·∂κ/∂q with
+    κ = r'×r''/|r'|², each with its own quadrature (points ξ_g and weights w_g, times L_e)."""
+    pr, el = ex["problem"], ex["elements"]
+    EA, EJ = pr["cable"]["axial_stiffness_N"], pr["cable"]["bending_stiffness_N_m2"]
+    Q = np.zeros((q.shape[0], 6))
+    n_el = len(el["element"])
+    for term in ("axial", "bending"):
+        rule = pr["equations"][term]
+        xi, w = np.asarray(rule["xi"]), np.asarray(rule["weight"])
+        e = np.repeat(np.arange(n_el), xi.size)
+        L = el["reference_length_m"][e]
+        ni, nj = el["node_i"].astype(int)[e], el["node_j"].astype(int)[e]
+        xg, wL = np.tile(xi, n_el), np.tile(w, n_el) * L
+        Sx = hermite_x(xg, L)
+        r1 = _interpolate(Sx, q, ni, nj)
+        if term == "axial":
+            norm = np.linalg.norm(r1, axis=1)
+            _scatter(Q, Sx, (wL * EA * (norm - 1.0) / norm)[:, None] * r1, ni, nj)
+            continue
+        Sxx = hermite_xx(xg, L)
+        r2 = _interpolate(Sxx, q, ni, nj)
+        g = np.sum(r1 * r1, axis=1)[:, None]
+        f = np.cross(r1, r2)
+        kappa = f / g
+        # δκ = δf/g − f δg/g², δf = δr'×r'' + r'×δr'', δg = 2 r'·δr': κ·δκ per unit δr' and δr''
+        along_r1 = np.cross(r2, kappa) / g - 2.0 * np.sum(kappa * f, axis=1)[:, None] / g**2 * r1
+        along_r2 = np.cross(kappa, r1) / g
+        _scatter(Q, Sx, (wL * EJ)[:, None] * along_r1, ni, nj)
+        _scatter(Q, Sxx, (wL * EJ)[:, None] * along_r2, ni, nj)
+    return Q
+
+
+def gravity_forces(ex) -> np.ndarray:
+    """The consistent load of gravity, ρA L_e [g/2, L_e g/12, g/2, −L_e g/12] per element, shape (n_nodes, 6)."""
+    pr, el = ex["problem"], ex["elements"]
+    g = np.asarray(pr["gravity_m_per_s2"], dtype=float) * pr["cable"]["mass_per_length_kg_per_m"]
+    Q = np.zeros((len(el["element"]) + 1, 6))
+    for e, L in enumerate(el["reference_length_m"]):
+        i, j = int(el["node_i"][e]), int(el["node_j"][e])
+        Q[i, :3] += g * L / 2
+        Q[i, 3:] += g * L * L / 12
+        Q[j, :3] += g * L / 2
+        Q[j, 3:] -= g * L * L / 12
+    return Q
 
 
 def closest_residual(P, ex) -> np.ndarray:
@@ -116,9 +197,11 @@ def closest_residual(P, ex) -> np.ndarray:
     return r
 
 
-def contact_forces(ex, q, v) -> dict:
+def contact_forces(ex, q, v=None) -> dict:
     """Eqs. 14-23 at every exported check point for nodal state (q, q̇) of shape (n_nodes, 6).
 
+    The check point's velocity is the nodal rates' interpolation (dynamic mode) or, for a steady
+    solve (``problem["mode"] == "steady"``), the steady flow's V·∂r/∂x (``v`` unused).
     Returns per check point the weighted normal force f [N] and friction force magnitude [N],
     the penetration δ [m], and the generalized force Q = Σ Sᵀ F, shape (n_nodes·6,).
     """
@@ -129,8 +212,11 @@ def contact_forces(ex, q, v) -> dict:
     Le = el["reference_length_m"][e]
     S = hermite(cp["xi"], Le)                                         # (m, 4)
     ni, nj = el["node_i"].astype(int)[e], el["node_j"].astype(int)[e]
-    P = S[:, 0, None] * q[ni, :3] + S[:, 1, None] * q[ni, 3:] + S[:, 2, None] * q[nj, :3] + S[:, 3, None] * q[nj, 3:]
-    V = S[:, 0, None] * v[ni, :3] + S[:, 1, None] * v[ni, 3:] + S[:, 2, None] * v[nj, :3] + S[:, 3, None] * v[nj, 3:]
+    P = _interpolate(S, q, ni, nj)
+    if pr.get("mode") == "steady":
+        V = pr["rig"]["speed_m_per_s"] * _interpolate(hermite_x(cp["xi"], Le), q, ni, nj)
+    else:
+        V = _interpolate(S, v, ni, nj)
     r = closest_residual(P, ex)
     dist = np.linalg.norm(r, axis=1)
     delta = dist - law["gap_m"]                                      # Eq. 14
@@ -151,9 +237,7 @@ def contact_forces(ex, q, v) -> dict:
     sr = np.sqrt(g + law["regularisation_velocity_m_per_s"] ** 2)
     F = -f[:, None] * n - (mu * f / sr)[:, None] * tau               # Eqs. 19-23
     Q = np.zeros((q.shape[0], 6))
-    for col, node in ((0, ni), (2, nj)):
-        np.add.at(Q, (node, slice(0, 3)), S[:, col, None] * F)
-        np.add.at(Q, (node, slice(3, 6)), S[:, col + 1, None] * F)
+    _scatter(Q, S, F, ni, nj)
     return {"element": e, "normal_force_N": f, "friction_force_N": mu * f * np.sqrt(g) / sr,
             "penetration_m": delta, "generalized_force": Q.reshape(-1)}
 
@@ -166,17 +250,66 @@ def per_element(ex, forces) -> dict[str, np.ndarray]:
             "friction_force_N": np.bincount(e, forces["friction_force_N"], n_el)}
 
 
+def steady_equilibrium(ex, q) -> dict:
+    """The static equilibrium of a steady solve at nodal coordinates q (n_nodes, 6): the residual
+    R = Q_contact + Q_gravity + Q_end − Q_elastic, zero at equilibrium but on the held node's
+    positions, where −R is the rig's force on the cable.
+
+    Returns ``residual`` (n_nodes, 6) with the held node's positions zeroed [N, N·m],
+    ``rig_force_N`` (3,) and ``pull_force_N``, the rig's force along the exit tangent [N].
+    A velocity-controlled pull (the rig holds the leading node; back tension at the trailing one).
+    """
+    pr = ex["problem"]
+    rig = pr["rig"]
+    if pr.get("mode") != "steady" or rig["controlled"] != "speed":
+        raise ValueError("steady_equilibrium: needs the export of a velocity-controlled steady solve "
+                         "(problem.json mode = 'steady', rig.controlled = 'speed')")
+    R = gravity_forces(ex) - elastic_forces(ex, q)
+    if pr["contact"] is not None:
+        R += contact_forces(ex, q)["generalized_force"].reshape(-1, 6)
+    R[0, :3] -= rig["back_tension_N"] * np.asarray(rig["entry_tangent"])
+    held = int(rig["held_node"])
+    rig_force = -R[held, :3].copy()
+    R[held, :3] = 0.0
+    return {"residual": R, "rig_force_N": rig_force,
+            "pull_force_N": float(rig_force @ np.asarray(rig["exit_tangent"]))}
+
+
+def snapshot_state(directory, time_s=None) -> tuple[float, np.ndarray, np.ndarray]:
+    """(time, q, q̇) of a snapshot in ``directory`` (the first one by default)."""
+    path = Path(directory) / "snapshot_nodes.csv"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no snapshot; a steady run always writes its state, a dynamic one "
+                                "needs [output] snapshots in its scenario")
+    nodes = read_table(path)
+    t = nodes["time_s"].min() if time_s is None else time_s
+    rows = np.nonzero(nodes["time_s"] == t)[0]
+    rows = rows[np.argsort(nodes["node"][rows])]
+    q, v = node_state(nodes, rows)
+    return float(t), q, v
+
+
+def steady_check(directory) -> dict[str, float]:
+    """The steady state of ``directory`` (an export and a steady run's results in one directory)
+    against this reader's equilibrium: the largest residual entry and the rig's force along the
+    exit tangent against exucable's pulling force, both relative to that force."""
+    d = Path(directory)
+    ex = load_export(d)
+    _, q, _ = snapshot_state(d)
+    eq = steady_equilibrium(ex, q)
+    pull = float(read_table(d / "snapshot_times.csv")["pull_force_N"][0])
+    return {"pull_force_N": pull, "reader_pull_force_N": eq["pull_force_N"],
+            "residual": float(np.max(np.abs(eq["residual"]))) / abs(pull),
+            "rig_force": abs(eq["pull_force_N"] - pull) / abs(pull)}
+
+
 def first_snapshot_check(directory) -> dict[str, float]:
     """Largest |reader − exucable| of the per-element forces at the first snapshot, relative to the
     largest force of that kind."""
     d = Path(directory)
     ex = load_export(d)
-    nodes = read_table(d / "snapshot_nodes.csv")
+    t0, q, v = snapshot_state(d)
     contact = read_table(d / "snapshot_contact.csv")
-    t0 = nodes["time_s"].min()
-    rows = np.nonzero(nodes["time_s"] == t0)[0]
-    rows = rows[np.argsort(nodes["node"][rows])]
-    q, v = node_state(nodes, rows)
     mine = per_element(ex, contact_forces(ex, q, v))
     sel = np.nonzero(contact["time_s"] == t0)[0]
     sel = sel[np.argsort(contact["element"][sel])]
@@ -193,3 +326,8 @@ if __name__ == "__main__":
     res = first_snapshot_check(sys.argv[1])
     print(f"first snapshot t = {res['time_s']:.12g} s: max relative difference of the per-element "
           f"normal forces {res['normal_force_N']:.2e}, friction forces {res['friction_force_N']:.2e}")
+    if load_export(sys.argv[1])["problem"].get("mode") == "steady":
+        eq = steady_check(sys.argv[1])
+        print(f"steady equilibrium: largest residual {eq['residual']:.2e} of the pulling force "
+              f"{eq['pull_force_N']:.6g} N; the rig's force along the exit tangent {eq['reader_pull_force_N']:.6g} N "
+              f"(relative difference {eq['rig_force']:.2e})")

@@ -156,6 +156,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
                                         "plan several cables per duct with `exucable plan`")
     _refuse_pulling_the_cable_out(sc)
+    _refuse_snapshot_times_in_steady_mode(sc)
     t_start = time.perf_counter()
     from .solve.start import steady_start
     first = None
@@ -167,9 +168,15 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     sp = sc.solver
     recorder = None
     if sp.mode == "steady":
+        from .output.snapshots import SnapshotRecorder
         from .solve.steady import solve_steady
-        out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
+        out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet),
+                           tolerance=sp.steady_residual)
         h = out.history.arrays()
+        # the steady state is the result: written as the one snapshot, so that a cross-check
+        # needs the files only
+        recorder = SnapshotRecorder(model, [])
+        recorder.record_steady_state(float(h["pull_force_N"][-1]) if len(h["time_s"]) else float("nan"))
         # one static state, the start's extent of cable in the conduit (laid out past the exit by
         # the steady lead-out, model.layout.steady_lead_out_m): the result is the last (converged)
         # pseudo-time step's; no time history, no scatter
@@ -283,6 +290,17 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result
+
+
+def _refuse_snapshot_times_in_steady_mode(sc) -> None:
+    """A steady solve has no time to take snapshots at: it always writes its state as the one
+    snapshot (time 0). Refuse the times rather than ignore them."""
+    out = sc.output
+    if sc.solver.mode != "steady" or not (out.snapshots_s or out.snapshot_interval_s is not None):
+        return
+    key = "output.snapshots" if out.snapshots_s else "output.snapshot_interval"
+    raise ModelError(key, 'solver.mode = "steady" has no time: it always writes its steady state as the one '
+                          "snapshot (snapshot_*.csv, time_s = 0); remove the key or use the dynamic mode")
 
 
 def _refuse_pulling_the_cable_out(sc) -> None:

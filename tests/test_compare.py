@@ -214,3 +214,33 @@ def test_old_column_names_are_read_with_a_note_and_new_ones_directly(tmp_path, s
     contact_old = write_csv(tmp_path / "c_old.csv", "s_m,normal_force_per_length_N_per_m", [s, s])
     contact_new = write_csv(tmp_path / "c_new.csv", "s_conduit_m,normal_force_per_length_N_per_m", [s, s])
     assert compare_results(contact_new, contact_old)["comparisons"][0]["kind"] == "contact_profile"
+
+
+def _result_dir(path: Path, mode: str, history_rows: int, times) -> Path:
+    """A minimal result directory: summary.json with its mode, history.csv, snapshot_tension.csv
+    with the profile 100 + x at each snapshot time."""
+    path.mkdir()
+    (path / "summary.json").write_text('{"mode": "%s"}' % mode)
+    t = np.arange(1.0, history_rows + 1.0)
+    history(path / "history.csv", t, 100.0 + t)
+    x = np.linspace(0.0, 2.0, 9)
+    rows = [np.column_stack([np.full_like(x, ti), np.arange(x.size), x, 100.0 + x]) for ti in times]
+    np.savetxt(path / "snapshot_tension.csv", np.vstack(rows), delimiter=",",
+               header="time_s,element,x_m,tension_N", comments="", fmt="%.17g")
+    return path
+
+
+def test_a_steady_result_is_compared_by_state_not_by_pseudo_time(tmp_path):
+    """A steady result's one-row pseudo-time history is neither read nor compared; its state (t = 0)
+    is compared with a dynamic run's last snapshot, and the note says which times."""
+    steady = _result_dir(tmp_path / "steady", "steady", 1, [0.0])
+    dynamic = _result_dir(tmp_path / "dynamic", "dynamic", 5, [0.1, 0.3])
+    result = compare_results(steady, dynamic)
+    (c,) = result["comparisons"]
+    assert c["kind"] == "snapshot_tension" and c["times"] == [0.0] and c["times_b"] == [0.3]
+    assert c["max_abs"] == 0.0 and result["passed"]
+    assert any(k == "history" and "pseudo-time" in why for k, _, why in result["skipped"])
+    assert any("latest state" in n for n in result["notes"])
+    # two dynamic runs still align on their times, and a one-row history there is an error
+    with pytest.raises(ExucableError, match="at least two data rows"):
+        compare_results(_result_dir(tmp_path / "short", "dynamic", 1, [0.3]), dynamic)

@@ -10,11 +10,13 @@ __all__ = ["add_arguments", "main"]
 def add_arguments(p) -> None:
     p.add_argument("scenario", help="scenario file (TOML)")
     p.add_argument("out", help="directory to write problem.json and the CSV tables into")
+    p.add_argument("--mode", choices=("dynamic", "steady"), default=None,
+                   help="override solver.mode: the problem of that mode (as exucable run --mode)")
 
 
 def main(args) -> int:
     from ..output.export import export_problem
 
-    written = export_problem(args.scenario, Path(args.out))
+    written = export_problem(args.scenario, Path(args.out), mode=args.mode)
     print(f"exported {len(written)} files to {args.out}/: " + ", ".join(p.name for p in written))
     return 0

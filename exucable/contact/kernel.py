@@ -329,6 +329,26 @@ class ContactKernel:
                              f"{(self.n_elements, self.n_check_points)}")
         return ContactResult(*self._impl.evaluate(q, q_t, jacobian, held))
 
+    def law_statement(self) -> dict:
+        """The contact force as this kernel evaluates it, in words and values (for ``problem.json``):
+        ``sliding_velocity`` (what v is), ``normal_law`` with its ``damping`` rule, and
+        ``friction_law``, the friction force as a function of the tangential velocity v_τ with
+        ``regularisation_velocity_m_per_s`` the ε it uses [m/s]."""
+        law = self.law
+        return {
+            "sliding_velocity": "v = N1 dr_i/dt + N2 dr'_i/dt + N3 dr_j/dt + N4 dr'_j/dt at the check point "
+                                "(the nodal rates)",
+            "normal_law": "f_n = contact_weight * max(0, K * delta**e + C * g * delta_dot), delta_dot = n . v "
+                          "(paper Eq. 18)",
+            "damping": "g = min(delta/delta_d, 1) (1 when delta_d = 0), held within a time step at its value "
+                       "in the step's start state (Exudyn's generalized-alpha step)",
+            "friction_law": "F_t = -mu(|v_t|) * f_n * v_t / sqrt(|v_t|**2 + eps**2), v_t = v - (n . v) n, "
+                            "mu(s) = mu_k + (mu_s - mu_k) * exp(-s**2 / v_s**2) (mu_s null: mu_k) "
+                            "(paper Eqs. 19-23)",
+            "regularisation_velocity_m_per_s": law.regularisation_velocity_m_per_s,
+            "force_on_cable": "F = -f_n n + F_t at the check point; generalized force sum_k S(xi_k)^T F_k",
+        }
+
     def damping_onset(self, penetration_m) -> np.ndarray:
         """The damping onset g(δ) [-] of penetrations δ [m] (e.g. ContactResult.penetration_m):
         min(δ/δ_d, 1) in contact, 0 out of contact (1 everywhere for the paper's δ_d = 0)."""

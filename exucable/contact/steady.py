@@ -102,6 +102,17 @@ class SteadySlidingKernel(ContactKernel):
         else:
             self._impl = _SteadyReference(self)
 
+    def law_statement(self) -> dict:
+        """:meth:`ContactKernel.law_statement` of steady sliding: v from the coordinates."""
+        out = super().law_statement()
+        out["sliding_velocity"] = ("v = V * dr/dx = (V / L_e) * (dN1/dxi r_i + dN2/dxi r'_i + dN3/dxi r_j + "
+                                   "dN4/dxi r'_j) at the check point (N2, N4 with their L_e), V = "
+                                   f"{self.speed_m_per_s!r} m/s the pull speed: the material flows along the "
+                                   "fixed curve; not normalised by |r'|")
+        out["damping"] = ("g = min(delta/delta_d, 1) (1 when delta_d = 0) at the current delta; delta_dot = n . v "
+                          "with the steady v above (a point entering or leaving the wall moves through it)")
+        return out
+
     def set_friction_scale(self, scale: float) -> None:
         """Scale μ_k and μ_s by ``scale`` [-] (a continuation parameter; 1 = the scenario's law)."""
         base = self._base_law

@@ -307,12 +307,16 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
                          f"({centre.length_m:.6g} m); shorten it or extend the route")
     c = sc.cable
     layout = start.cable
+    # Steady mode drops the cable's Kelvin–Voigt damping: it acts on the nodal rates, which a static
+    # solve never updates (they would stay the start's), and it exists to damp vibrations; in steady
+    # flow its axial force would be τ·V·∂N/∂x (τ·V = 1e-4 m at 1 ms, 0.1 m/s), negligible.
+    internal_damping = sc.solver.mode != "steady"
     props = CableProperties(
         mass_per_length_kg_per_m=c.mass_per_length_kg_per_m,
         axial_stiffness_N=c.axial_stiffness_N,
         bending_stiffness_N_m2=c.bending_stiffness_N_m2,
-        axial_damping_N_s=c.axial_damping_N_s,
-        bending_damping_N_m2_s=c.bending_damping_N_m2_s,
+        axial_damping_N_s=c.axial_damping_N_s if internal_damping else 0.0,
+        bending_damping_N_m2_s=c.bending_damping_N_m2_s if internal_damping else 0.0,
         integration=c.integration,
     )
     cable = add_cable(mbs, layout.coordinates, layout.element_length_m, props, layout.velocities,

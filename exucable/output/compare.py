@@ -21,7 +21,14 @@ one arc-length convention (``s_m`` in the three profiles) are still read, with a
 release.
 
 B is interpolated linearly onto A's abscissa over the range both cover; snapshot families are
-compared time by time at the times both have (to 1e-9 s). For every quantity the maximum and RMS
+compared time by time at the times both have (to 1e-9 s).
+
+A steady result (a directory whose ``summary.json`` has ``"mode": "steady"``) is one state, not a
+time history: its ``history.csv`` holds the solve's pseudo-time steps, so ``history`` is not
+compared when either side is steady (a note says so); its state is the one snapshot at
+``time_s = 0``, compared with the other side's state at time 0 when it has one, else with its last
+snapshot (a dynamic run's latest state, the nearest to steady sliding; a note names both times).
+The profiles are compared as always. For every quantity the maximum and RMS
 differences are reported, absolute (in the column's unit) and relative to max |A|. A quantity
 passes when ``max |B − A| <= atol + rtol · max |A|``; ``rtol`` and ``atol`` come from a tolerance
 file (``--tolerances tol.toml``: a ``[default]`` table and tables named by column, or by
@@ -35,6 +42,7 @@ Use :func:`compare_results` from Python; :mod:`exucable.commands.compare` is the
 from __future__ import annotations
 
 import csv
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -45,7 +53,7 @@ import numpy as np
 from ..errors import ExucableError
 from ..io import new_figure, save_figure
 
-__all__ = ["compare_results", "write_overlay_plot", "write_overlay_plots", "format_report", "load_tolerances",
+__all__ = ["compare_results", "is_steady_result", "write_overlay_plot", "write_overlay_plots", "format_report", "load_tolerances",
            "DEFAULT_RTOL", "FAMILIES", "unit_of"]
 
 #: Default threshold on the relative maximum difference [-] (1 %: the paper's own agreement with its closed forms
@@ -169,11 +177,26 @@ def _read_csv(path: Path) -> _Table:
     return _Table(path, kind, groups, notes)
 
 
+def is_steady_result(source) -> bool:
+    """True when ``source`` is a result directory of a steady solve (its ``summary.json`` says
+    ``"mode": "steady"``)."""
+    summary = Path(source) / "summary.json"
+    if not summary.is_file():
+        return False
+    try:
+        return json.loads(summary.read_text()).get("mode") == "steady"
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def _load(source) -> dict:
     """Tables of a result directory or a single CSV, keyed by family."""
     path = Path(source)
     if path.is_dir():
-        tables = {kind: _read_csv(path / fam.file) for kind, fam in FAMILIES.items() if (path / fam.file).is_file()}
+        # a steady result's history.csv is its pseudo-time steps (possibly one row): not read
+        skip = {"history"} if is_steady_result(path) else set()
+        tables = {kind: _read_csv(path / fam.file) for kind, fam in FAMILIES.items()
+                  if kind not in skip and (path / fam.file).is_file()}
         if not tables:
             raise ExucableError(f"{path}: result directory has none of "
                                 + ", ".join(f.file for f in FAMILIES.values()))
@@ -259,7 +282,15 @@ def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, toleran
     tolerances = tolerances or {}
     comparisons, skipped = [], []
     notes = [n for t in (*tables_a.values(), *tables_b.values()) for n in t.notes]
+    steady = {side: is_steady_result(src) for side, src in (("A", a), ("B", b))}
     kinds = [k for k in FAMILIES if k in tables_a and k in tables_b]
+    if any(steady.values()):
+        # a steady solve's history rows are pseudo-time steps: nothing to align in time
+        if "history" in kinds:
+            kinds.remove("history")
+        which = " and ".join(side for side, st in steady.items() if st)
+        skipped.append(("history", "*", f"{which}: steady result, its history.csv holds pseudo-time steps "
+                                        "(time_s = step number), not a time history"))
     if not kinds:
         raise ExucableError(f"nothing to compare: {a} has {', '.join(tables_a)} and {b} has {', '.join(tables_b)}")
     for kind in kinds:
@@ -274,8 +305,15 @@ def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, toleran
                 j = int(np.argmin(np.abs(times_b - t)))
                 if abs(times_b[j] - t) <= _TIME_MATCH_S:
                     pairs.append((t, ta.groups[t], tb.groups[float(times_b[j])]))
-                else:
+                elif not any(steady.values()):
                     skipped.append((kind, "*", f"snapshot t = {t:.12g} s only in A"))
+            if not pairs and any(steady.values()):
+                # a steady state against the other side's latest state
+                t_a, t_b = max(ta.groups), float(times_b[-1])
+                pairs.append((t_a, ta.groups[t_a], tb.groups[t_b]))
+                note = f"{kind}: steady state compared with the latest state (A t = {t_a:.12g} s, B t = {t_b:.12g} s)"
+                if note not in notes:
+                    notes.append(note)
             if not pairs:
                 raise ExucableError(f"{kind}: A and B have no snapshot time in common")
         for column in fam.values:
@@ -308,12 +346,18 @@ def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, toleran
                 "kind": kind, "abscissa": fam.abscissa, "column": column, "unit": unit_of(column),
                 "range": (float(x.min()), float(x.max())), "n_points": int(x.size),
                 "times": None if fam.group is None else [p[0] for p in pairs],
+                "times_b": None if fam.group is None else [_group_time(tb, p[2]) for p in pairs],
                 "max_abs": max_abs, "rms_abs": rms_abs, "scale": scale, "max_rel": max_rel, "rms_rel": rms_rel,
                 "rtol": r, "atol": at, "worst_at": (float(x[k]), None if fam.group is None else float(tt[k])),
                 "passed": bool(max_abs <= at + r * scale),
             })
     return {"a": str(a), "b": str(b), "comparisons": comparisons, "skipped": skipped, "notes": notes,
             "passed": all(c["passed"] for c in comparisons)}
+
+
+def _group_time(table: _Table, group) -> float:
+    """The snapshot time [s] of one of ``table``'s groups."""
+    return next(float(t) for t, g in table.groups.items() if g is group)
 
 
 def format_report(result: dict) -> str:
@@ -345,9 +389,10 @@ def _draw(c, ta, tb, top, bottom) -> None:
     """A and B (solid, dashed; one pair per snapshot time) above, B − A below."""
     col = c["column"]
     times = c["times"] or [None]
-    for i, t in enumerate(times):
+    times_b = c.get("times_b") or times
+    for i, (t, t_b) in enumerate(zip(times, times_b)):
         xa, ca = ta.groups[t]
-        tb_key = None if t is None else min(tb.groups, key=lambda k: abs(k - t))
+        tb_key = None if t_b is None else min(tb.groups, key=lambda k: abs(k - t_b))
         xb, cb = tb.groups[tb_key]
         suffix = "" if t is None else f" t={t:.4g} s"
         line, = top.plot(xa, ca[col], lw=1.6, label=f"A{suffix}" if i < 6 else None)

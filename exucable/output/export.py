@@ -4,9 +4,12 @@
 solver of one's own needs to start from exactly exucable's state (field by field, with units, in
 ``docs/results-format.md``; a JSON Schema for each file in ``exucable/output/schemas/``):
 
-``problem.json``          every parameter used: cable section (EA, EJ, damping coefficients),
-                          contact law and its weights, rig, start-up damper, solver settings,
-                          exucable's and Exudyn's versions
+``problem.json``          the mode and every parameter used, each force term with its formula as
+                          the code evaluates it (``equations``: elastic terms and their quadrature,
+                          internal damping, gravity's load vector, end forces, the rig's constraint
+                          and what the pulling force is; ``contact``: the law, its damping and the
+                          friction law of the mode), the held node and the lead-out, solver
+                          settings, exucable's and Exudyn's versions
 ``nodes_initial.csv``     initial nodal coordinates and rates (ANCF ``[r, r']``), node 0 trailing
 ``elements.csv``          element → nodes, reference length, pre-strain
 ``check_points.csv``      element, ξ, quadrature weight ω, contact weight w = L_e ω / h_ref
@@ -29,7 +32,25 @@ from .formats import EXPORT_FILES, FORMAT_VERSION, PIECE_COLUMNS
 from ..io import write_csv, write_json
 from ..post.tension import axial_strain
 
-__all__ = ["export_problem", "problem_description", "problem_tables", "conduit_s"]
+__all__ = ["export_problem", "problem_description", "problem_tables", "conduit_s", "elastic_quadrature"]
+
+# Exudyn's ObjectANCFCable (useReducedOrderIntegration 0, 1, 2): the rules of its axial and bending
+# virtual work on [0, 1] as (points, weights); Gauss orders 9/5, 7/3, and Lobatto order 3 / Gauss 3
+_GAUSS = {n: np.polynomial.legendre.leggauss(n) for n in (2, 3, 4, 5)}
+_LOBATTO3 = (np.array([-1.0, 0.0, 1.0]), np.array([1.0, 4.0, 1.0]) / 3.0)
+_RULES = {"full": (("gauss", 5), ("gauss", 3)), "reduced": (("gauss", 4), ("gauss", 2)),
+          "lobatto": (("lobatto", 3), ("gauss", 2))}
+
+
+def elastic_quadrature(integration: str) -> dict:
+    """The points ξ ∈ [0, 1] and weights (summing to 1, times L_e) of Exudyn's ANCF cable's axial and
+    bending terms for ``cable.integration`` (``full``, ``reduced``, ``lobatto``)."""
+    out = {}
+    for term, (kind, n) in zip(("axial", "bending"), _RULES[integration]):
+        x, w = _LOBATTO3 if kind == "lobatto" else _GAUSS[n]
+        out[term] = {"rule": f"{kind} {n} points", "xi": [float(v) for v in 0.5 * (x + 1.0)],
+                     "weight": [float(v) for v in 0.5 * w]}
+    return out
 
 def conduit_s(model, s_pull_m):
     """Arc length along the scenario's conduit [m] from one along the model's pull-oriented conduit."""
@@ -81,6 +102,8 @@ def problem_description(model) -> dict:
                              "or the last one's end: no contact; surface 'smooth': refined onto that "
                              "segment's piece, continued along the piece's end tangent beyond its ends",
         }
+        contact.update(model.kernel.law_statement())
+    steady = sc.solver.mode == "steady"
     damper = model.startup_damper
     guide = model.guide
     rig = {
@@ -103,9 +126,54 @@ def problem_description(model) -> dict:
             "node": guide.node_index, "stiffness_N_per_m": guide.k, "damping_N_s_per_m": guide.c,
             "law": "-k (I - d d^T) u - c (I - d d^T) v on the leading node, d = exit_tangent"},
     }
+    if steady:
+        held = model.layout.n_elements if model.lead_drive is not None else 0
+        rig.update({
+            "held_node": held,
+            "lead": ("the held node's three position coordinates fixed at nodes_initial.csv's (its slopes free); "
+                     "the static solve's multipliers are the force the rig exerts on it, Q_rig"),
+            "pull_force": ("pull_force_N = Q_rig . exit_tangent, the rig's reaction along the exit tangent"
+                           if model.lead_drive is not None else
+                           "applied_pull_force_N along exit_tangent; the trailing node is held and its "
+                           "reaction along -entry_tangent is the trailing tension"),
+            "ramp": "none (a static solve: every load at full scale)",
+        })
+    else:
+        rig["pull_force"] = ("pull_force_N = the drive's reaction on the leading node along exit_tangent"
+                             if model.lead_drive is not None else "applied_pull_force_N * ramp")
+    lead_out = float(getattr(model.start, "lead_out_m", 0.0) or 0.0)
+    quad = elastic_quadrature(props.integration)
+    equations = {
+        "equilibrium": ("Q_elastic(q) = Q_contact(q) + Q_gravity + Q_end + Q_rig (static: the steady sliding state)"
+                        if steady else
+                        "M q'' + Q_elastic(q, q') = Q_contact(q, q') + Q_gravity(t) + Q_end(t) + Q_rig + Q_dampers"),
+        "generalized_force": "element e's 12 coordinates [r_i, r'_i, r_j, r'_j]; the point force F at xi "
+                             "contributes S(xi)^T F, S = [N1 I, N2 I, N3 I, N4 I]",
+        "axial": {"formula": "Q_a = L_e sum_g w_g EA (|r'| - 1) (dS/dx)^T r'/|r'| at xi_g "
+                             "(Exudyn ObjectANCFCable: eps = |r'| - 1, no reference strain)",
+                  **quad["axial"]},
+        "bending": {"formula": "Q_b = L_e sum_g w_g EJ (d kappa/dq)^T kappa at xi_g, kappa = (r' x r'') / |r'|^2, a vector "
+                               "(Exudyn ObjectANCFCable's material measure of curvature; its magnitude is "
+                               "|r' x r''| / |r'|^2, not the geometric |r' x r''| / |r'|^3)",
+                    **quad["bending"]},
+        "internal_damping": (None if steady else
+                             "Kelvin-Voigt: axial_damping_N_s * d|r'|/dt added to EA (|r'| - 1) at the axial points, "
+                             "bending_damping_N_m2_s * d kappa/dt to EJ kappa at the bending points"),
+        "internal_damping_rule": ("steady mode: none (it acts on the nodal rates, which a static solve does not "
+                                  "have; in steady flow its axial force tau V dN/dx is negligible)" if steady else
+                                  "dynamic mode: on the nodal rates"),
+        "gravity": ("consistent load of rho A g on element e: rho A L_e [g/2, L_e g/12, g/2, -L_e g/12] on "
+                    "[r_i, r'_i, r_j, r'_j] (Exudyn LoadMassProportional: the integral of rho A S^T g, exact)"
+                    + ("" if steady else ", times ramp(t)")),
+        "end_forces": ("back tension: -back_tension_N * entry_tangent on the trailing node's position"
+                       + ("" if steady else ", times ramp(t)")
+                       + ("; force-controlled pull: applied_pull_force_N * exit_tangent on the leading node's position"
+                          if model.lead_drive is None else "")),
+    }
     return {
         "format_version": FORMAT_VERSION,
         "name": sc.name,
+        "mode": sc.solver.mode,
         "units": "SI: m, s, kg, N; angles in rad",
         "conventions": {
             "x_m": "material (unstretched) coordinate along the cable from its trailing end",
@@ -129,9 +197,13 @@ def problem_description(model) -> dict:
             "axial_damping_N_s": props.axial_damping_N_s,
             "bending_damping_N_m2_s": props.bending_damping_N_m2_s,
             "integration": props.integration,
-            "strain": "absolute: eps = |r'| - 1, curvature |r' x r''| / |r'|^3 (Exudyn ObjectANCFCable, "
-                      "strainIsRelativeToReference = 0)",
+            "strain": "absolute: eps = |r'| - 1, curvature vector kappa = (r' x r'') / |r'|^2 (Exudyn "
+                      "ObjectANCFCable, strainIsRelativeToReference = 0)",
+            "lead_out_m": lead_out,
+            "lead_out": "cable laid out past the conduit's exit at the start, along the exit tangent (steady mode "
+                        "and solver.start_from = 'steady': the rig sits that far out; 0: flush with the exit)",
         },
+        "equations": equations,
         "gravity_m_per_s2": [0.0, 0.0, -g if g else 0.0],
         "contact": contact,
         "rig": rig,
@@ -146,7 +218,12 @@ def problem_description(model) -> dict:
                    "w_k = smoothstep(((r_k - exit point) . exit_tangent) / ramp_length_m), clipped to [0, 1]",
         },
         "solver": {
-            "method": "Exudyn MainSolverImplicitSecondOrder (generalized-alpha), adaptive step, full Newton",
+            "method": ("Exudyn MainSolverStatic: pseudo-transient continuation to the static equilibrium "
+                       "(exucable/solve/steady.py); no time, no inertia" if steady else
+                       "Exudyn MainSolverImplicitSecondOrder (generalized-alpha), adaptive step, full Newton"),
+            "steady_residual": sp.steady_residual,
+            "steady_residual_rule": ("steady mode: stop when |residual| <= steady_residual * the rope "
+                                     "solution's largest tension"),
             "end_time_s": sp.end_time_s,
             "step_s": sp.step_s,
             "min_step_s": sp.min_step_s,
@@ -218,13 +295,18 @@ def problem_tables(model) -> dict[str, dict]:
     return tables
 
 
-def export_problem(scenario, out_dir) -> list[Path]:
+def export_problem(scenario, out_dir, mode: str | None = None) -> list[Path]:
     """Build ``scenario``'s model and write its discrete problem into ``out_dir``; ``problem.json``
-    last (its presence marks a complete export). Returns the paths written."""
+    last (its presence marks a complete export). ``mode`` (``"dynamic"`` or ``"steady"``) overrides
+    ``solver.mode``, as for ``exucable run``. Returns the paths written."""
+    import dataclasses
+
     from ..model.build import build_model
     from ..scenario.specs import Scenario, load_scenario
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if mode is not None and mode != sc.solver.mode:
+        sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
     model = build_model(sc)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

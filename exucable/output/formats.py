@@ -15,7 +15,7 @@ __all__ = ["FORMAT_VERSION", "SCHEMA_DIR", "NODE_COLUMNS", "ELEMENT_COLUMNS", "C
            "schema_of"]
 
 #: Bumped when a file's columns or problem.json's fields change meaning.
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 SCHEMA_DIR = Path(__file__).with_name("schemas")
 

@@ -15,6 +15,11 @@ own error, is visible), the contact forces by the kernel (Eqs. 14-23), so a read
 evaluates the contact law at the snapshot's nodal state gets the same forces to round-off.
 The pulling force (a Lagrange multiplier, known only at step ends) is interpolated linearly.
 
+A steady solve (``solver.mode = "steady"``) has no time: its one state is written as one snapshot
+at ``time_s = 0`` (:meth:`SnapshotRecorder.record_steady_state`), whose ``vel_*`` columns are the
+steady flow's material velocity V·r' of each node and whose ``slope_rate_*`` are ``nan`` (V·r''
+jumps at a node); the contact forces are the steady kernel's (friction against V·r').
+
 Files (long format: one row per time and element or node):
 
 ``snapshot_times.csv``    ``time_s,step_start_s,step_end_s,pull_force_N``
@@ -93,6 +98,14 @@ class SnapshotRecorder:
             self._record(tk, qk, vk, (t0, t), f)
         self._prev = (t, q, v, pull_force_N)
 
+    def record_steady_state(self, pull_force_N: float) -> None:
+        """Record the model's current state as the steady state: one snapshot at time 0 [s] with
+        the steady flow's nodal velocities V·r' [m/s] and the pulling force ``pull_force_N`` [N]."""
+        q, _ = self.model.coordinates()
+        v = np.full_like(q, np.nan)
+        v[:, :3] = self.model.scenario.pull.speed_m_per_s * q[:, 3:]
+        self._record(0.0, q, v, (0.0, 0.0), pull_force_N)
+
     def _append(self, name, **columns):
         n = max(np.size(v) for v in columns.values())
         for c, v in columns.items():
@@ -123,7 +136,8 @@ class SnapshotRecorder:
                      tension_N=N.ravel())
         if m.kernel is None:
             return
-        pts = m.kernel.points(q.reshape(-1), v.reshape(-1))
+        # the steady kernel takes its velocities from q; nan rates must not reach the dynamic one
+        pts = m.kernel.points(q.reshape(-1), np.nan_to_num(v).reshape(-1))
         e = pts.element
         pen = np.nan_to_num(np.asarray(pts.penetration_m, dtype=float), nan=-np.inf)
         max_pen = np.full(n_el, -np.inf)

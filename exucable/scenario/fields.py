@@ -292,6 +292,11 @@ FIELDS: tuple[Field, ...] = (
            "sliding: no start misfit to ring in the axial mode, no bending boundary layer at the rig to pull out of "
            "(reference/README.md, \"Why the force wandered\"); falls back to `\"rope\"` with a warning if that "
            "solve fails"),
+    F("solver.steady_residual", "steady_residual", "float", "", 1.0e-6, gt=0.0, lt=1.0, ours=True,
+      rule="0 < tol < 1; steady mode: the static solve stops once its equilibrium residual (N, the norm over "
+           "every coordinate) is below this times the rope solution's largest tension; at 1e-6 Example 4's pulling "
+           "force is 1e-9 from a 1000× tighter solve's (reference/README.md, \"Speed\"); a cross-check of the "
+           "equilibrium itself wants it tighter"),
     F("solver.steady_lead_out", "steady_lead_out_m", "float", "m", None, ge=0.0, ours=True,
       default_doc="the rule in `solver.mode`",
       rule="≥ 0; steady mode and `solver.start_from = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "

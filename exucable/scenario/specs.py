@@ -576,6 +576,9 @@ class SolverSpec(_Spec):
     start_from : {"rope", "steady"}
         Dynamic mode: start from the rope's tension (``"rope"``) or from the steady solve's state
         (``"steady"``, :func:`exucable.solve.start.steady_start`).
+    steady_residual : float
+        Steady mode: equilibrium residual at which the static solve stops, relative to the rope
+        solution's largest tension [-].
     steady_lead_out_m : float or None
         Steady mode: cable laid out past the conduit's exit at the start [m] (None: the rule of
         :func:`exucable.model.layout.steady_lead_out_m`, 10 bending lengths past the last bend).
@@ -599,6 +602,7 @@ class SolverSpec(_Spec):
     pretension: bool = _default("solver.pretension")
     mode: str = _default("solver.mode")
     steady_lead_out_m: float | None = _default("solver.steady_lead_out")
+    steady_residual: float = _default("solver.steady_residual")
     start_from: str = _default("solver.start_from")
 
     def _check(self) -> None:
