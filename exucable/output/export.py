@@ -220,14 +220,23 @@ def problem_tables(model) -> dict[str, dict]:
 
 def export_problem(scenario, out_dir) -> list[Path]:
     """Build ``scenario``'s model and write its discrete problem into ``out_dir``; ``problem.json``
-    last (its presence marks a complete export). Returns the paths written."""
+    last (its presence marks a complete export). Returns the paths written.
+
+    ``out_dir`` is checked and owned before the model is built
+    (:func:`exucable.output.outdir.owned_out_dir`)."""
     from ..model.build import build_model
     from ..scenario.specs import Scenario, load_scenario
+    from .outdir import owned_out_dir
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-    model = build_model(sc)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    with owned_out_dir(out_dir) as out:
+        return _export(sc, build_model(sc), out)
+
+
+def _export(sc, model, out: Path) -> list[Path]:
+    """Write the tables, then ``problem.json``; an earlier export's ``problem.json`` goes first, so
+    it never vouches for tables of this one that a failed write left out."""
+    (out / "problem.json").unlink(missing_ok=True)
     written = []
     for name, data in problem_tables(model).items():
         write_csv(out / name, EXPORT_FILES[name], data)
