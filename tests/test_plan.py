@@ -303,3 +303,28 @@ def test_readme_links_an_industry_report_and_shows_its_picture():
     scenario = ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml"
     assert plan["inputs"]["scenario"] == parse_plan_scenario(tomllib.loads(scenario.read_text()), ROOT)[0].name
 
+
+
+def test_without_limits_the_plan_says_not_checked(tmp_path, capsys):
+    """No [limits]: nothing to pass or fail, and the plan says so instead of 'all checks pass'."""
+    plan = _plan()
+    assert plan["limits_checked"] is False and plan["passed"] is True
+    assert _plan(limits={"max_tension": 1e6})["limits_checked"] is True
+    path = _toml(tmp_path / "s.toml", "")
+    path.write_text(path.read_text().replace("[limits]", ""))
+    assert cli_main(["plan", str(path), "--out", str(tmp_path / "out")]) == 0
+    printed = capsys.readouterr().out
+    assert "limits: not checked" in printed and "limits not checked: no [limits]" in printed
+    assert "Limits not checked" in (tmp_path / "out" / "report.html").read_text()
+
+
+def test_an_infinite_tension_fails_with_or_without_limits():
+    """A tension past what a float holds (a back tension of 1.79e308 N grown by friction) is infinite,
+    and that fails a check of its own instead of passing unchecked."""
+    plan = _plan(pull__back_tension=1.79e308)
+    for name in ("forward", "reverse"):
+        d = plan["directions"][name]
+        assert not math.isfinite(d["max_tension_N"])
+        check = next(c for c in d["checks"] if c["name"] == "finite_tension")
+        assert check["passed"] is False
+    assert plan["passed"] is False

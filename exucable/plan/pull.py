@@ -214,6 +214,11 @@ def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: floa
         else f"{_label(worst_t)}"
     t_max = direction["max_tension_N"]
     out = []
+    if not math.isfinite(t_max):
+        # e^(mu theta) past any float: no limit passes this, given or not
+        out.append({"name": "finite_tension", "passed": False, "value": t_max, "limit": None, "margin": None,
+                    "quantity": "force", "where": f"{where_t}: the tension grows beyond any number "
+                                                  "(friction times the angles turned is too large to pull)"})
     for name, limit in (("max_tension", lim.max_tension_N), ("conductor_tension", lim.conductor_tension_N),
                         ("grip_tension", lim.grip_limit_N)):
         if limit is not None:
@@ -414,6 +419,8 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
         "count": spec.count,
         "checks": directions[recommended]["checks"],
         "passed": bool(ok),
+        # without [limits] only the plan's own checks ran (finiteness, jam, the multibody run)
+        "limits_checked": any(getattr(spec.limits, f.name) is not None for f in dataclasses.fields(spec.limits)),
         "inputs": {
             "scenario": scenario.name,
             "cable_diameter_m": d,
