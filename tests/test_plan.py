@@ -328,3 +328,16 @@ def test_an_infinite_tension_fails_with_or_without_limits():
         check = next(c for c in d["checks"] if c["name"] == "finite_tension")
         assert check["passed"] is False
     assert plan["passed"] is False
+
+
+def test_a_rope_that_cannot_be_solved_names_the_scenario_key(monkeypatch):
+    """The rope solver's own argument names are not keys a user can set: they are translated."""
+    import exucable.plan.pull as pull
+    from exucable.errors import ModelError
+
+    def refuse(*args, **kwargs):
+        raise ModelError("weight_per_length_N_per_m", "weight per length must be finite and >= 0, got nan")
+
+    monkeypatch.setattr(pull, "solve_rope", refuse)
+    with pytest.raises(ModelError, match=r"^cable\.mass_per_length: weight per length"):
+        _plan()

@@ -151,3 +151,15 @@ def test_the_shipped_fast_examples_3_and_4_end_steady(name, tmp_path):
         assert abs(s["trailing_tension_N"] / s["rope_trailing_tension_N"] - 1) < 1e-2
     else:
         assert abs(s["pull_force_N"] / s["rope_pull_force_N"] - 1) < 2e-2
+
+
+def test_a_rope_start_that_cannot_be_solved_names_the_scenario_key():
+    """The rope solver's own argument names (pull_force_N, ...) are not keys a user can set: a
+    prescribed pull too small to move the cable is refused naming pull.force."""
+    bend = {"inner_radius": 0.0035, "path": [{"straight": 1.0}, {"bend": 90.0, "radius": 0.5, "turn": "left"},
+                                             {"straight": 1.0}]}
+    sc = make_scenario(cable={"radius": 0.0025, "density": 1000.0, "youngs_modulus": 1e9, "elements": 40},
+                       conduit=bend, pull={"speed": 0.1, "force": 0.01}, contact={"friction": 0.3},
+                       gravity={"g": 9.8})
+    with pytest.raises(ModelError, match=r"^pull\.force: pull force 0.01 N is below"):
+        build_model(sc)
