@@ -139,7 +139,7 @@ def test_contact_profile_groups_are_those_of_array_split():
 @pytest.mark.parametrize("name", ["paper_ex3_helix", "paper_ex4_spatial"])
 def test_the_shipped_fast_examples_3_and_4_end_steady(name, tmp_path):
     """`exucable run scenarios/fast/...` as shipped exits 0: steady within its end time (Ex. 3 with
-    the paper's 80 elements, Ex. 4 started in the steady state; the files say why), within the
+    64 elements, Ex. 4 started in the steady state; the files say why), within the
     fast validation's tolerances of their references (exucable.validation.paper.TOLERANCES)."""
     p = subprocess.run([sys.executable, "-m", "exucable", "run", str(ROOT / "scenarios" / "fast" / f"{name}.toml"),
                         "--out", str(tmp_path / "out"), "--no-plots", "-q"], capture_output=True, text=True,

@@ -31,7 +31,8 @@ from ..io import atomic_write_text, pid_alive, remove_stale_temporaries
 
 __all__ = [
     "CASES_DIR", "CASE_JSON", "MANIFEST", "TABLE", "FINISHED", "RESULT_COLUMNS", "RECORD_OUTPUTS",
-    "case_dir", "temp_dir", "read_record", "read_verified_record", "files_intact", "is_finished", "write_record", "install_case", "remove_stale",
+    "case_dir", "temp_dir", "read_record", "read_verified_record", "files_intact", "is_finished",
+    "write_record", "install_case", "remove_stale",
     "write_manifest", "read_manifest", "make_row", "rows_from_disk", "table_columns", "write_table",
     "read_table", "SweepLock",
 ]
