@@ -318,6 +318,7 @@ def test_without_limits_the_plan_says_not_checked(tmp_path, capsys):
     assert "Limits not checked" in (tmp_path / "out" / "report.html").read_text()
 
 
+@pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
 def test_an_infinite_tension_fails_with_or_without_limits():
     """A tension past what a float holds (a back tension of 1.79e308 N grown by friction) is infinite,
     and that fails a check of its own instead of passing unchecked."""
