@@ -1,7 +1,7 @@
 """Error types. User errors (bad input) derive from :class:`ExucableError`; the CLI
 prints their message without a traceback and exits with status 2."""
 
-__all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError"]
+__all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError", "OutputError"]
 
 
 class ExucableError(Exception):
@@ -54,3 +54,21 @@ class SolverError(ExucableError):
     def __init__(self, message: str, time_s: float | None = None):
         self.time_s = time_s
         super().__init__(message if time_s is None else f"{message} (at simulated time t = {time_s:.6g} s)")
+
+
+class OutputError(ExucableError):
+    """An output path cannot be used: a file where a directory should be, no permission, a
+    directory another run is writing into, or a write that failed (disk full).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output path concerned.
+    message : str
+        What is wrong and what to do.
+    """
+
+    def __init__(self, path, message: str):
+        self.path = str(path)
+        self.message = message
+        super().__init__(f"{self.path}: {message}")

@@ -19,14 +19,24 @@ import io
 import json
 import math
 import os
+import re
 import tempfile
+import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 __all__ = ["atomic_write_bytes", "atomic_write_text", "AtomicBatch", "write_csv", "csv_text", "read_csv",
-           "write_json", "json_safe", "new_figure", "save_figure"]
+           "write_json", "json_safe", "new_figure", "save_figure", "remove_stale_temporaries", "pid_alive", "probe_writable"]
+
+# A temporary file is named ".<target>.<writer's pid>.<random>.tmp": a writer killed (kill -9)
+# between creating and renaming it leaves it behind, and the pid tells whether its writer is gone.
+_TEMPORARY = re.compile(r"^\..+\.(\d+)\.[A-Za-z0-9_]+\.tmp$")
+#: A dead writer's temporary file is removed only when older than this [s]: a writer on another
+#: machine sharing the directory (whose pid means nothing here) has renamed it long before.
+STALE_TEMPORARY_AGE_S = 60.0
+_swept_dirs: set = set()
 
 
 def atomic_write_bytes(path, data: bytes) -> Path:
@@ -61,7 +71,8 @@ class AtomicBatch:
         ``path`` receives it at :meth:`commit`. Returns ``path``."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        _sweep_once(path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent)
         f = os.fdopen(fd, "wb")
         try:
             f.write(data)
@@ -122,6 +133,68 @@ def _remove(f, tmp) -> None:
         os.unlink(tmp)
     except FileNotFoundError:
         pass
+
+
+def pid_alive(pid: int) -> bool:
+    """Whether a process ``pid`` exists on this machine (one we may not signal counts as alive)."""
+    if pid <= 0 or pid >= 2**31:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True                 # exists, but is not ours to signal
+    # a zombie (dead, not yet reaped by its parent) still answers signal 0
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            return f.read().rsplit(b")", 1)[1].split()[0] not in (b"Z", b"X")
+    except (OSError, IndexError):
+        return True                 # no /proc here: signal 0 is all there is
+
+
+def remove_stale_temporaries(directory, min_age_s: float = STALE_TEMPORARY_AGE_S) -> list[Path]:
+    """Remove the temporary files that writers killed mid-write left in ``directory``.
+
+    Only files named as :class:`AtomicBatch` names them, whose writer's process no longer exists
+    and which are older than ``min_age_s`` [s]; a live writer's file is never touched. Returns the
+    paths removed.
+    """
+    removed = []
+    now = time.time()
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _TEMPORARY.match(entry.name)
+        if m is None or pid_alive(int(m.group(1))):
+            continue
+        try:
+            if not entry.is_file(follow_symlinks=False) or now - entry.stat().st_mtime < min_age_s:
+                continue
+            os.unlink(entry.path)
+            removed.append(Path(entry.path))
+        except OSError:
+            pass                            # gone already, or not ours to remove
+    return removed
+
+
+def probe_writable(directory) -> None:
+    """Create and delete a temporary file in ``directory`` as the writers here do; raises the
+    :class:`OSError` a write there would (permissions alone do not tell: root ignores them, and a
+    read-only mount does not show in them)."""
+    fd, probe = tempfile.mkstemp(prefix=f".exucable-write-check.{os.getpid()}.", suffix=".tmp", dir=directory)
+    os.close(fd)
+    os.unlink(probe)
+
+
+def _sweep_once(directory: Path) -> None:
+    """:func:`remove_stale_temporaries` the first time this process writes into ``directory``."""
+    key = os.path.abspath(directory)
+    if key not in _swept_dirs:
+        _swept_dirs.add(key)
+        remove_stale_temporaries(directory)
 
 
 def atomic_write_text(path, text: str) -> Path:

@@ -15,6 +15,7 @@ import numpy as np
 from .errors import ModelError
 from .output.versions import versions
 from .output.export import conduit_s
+from .output.outdir import owned_out_dir
 from .output.results import RunResult, write_results
 from .scenario.specs import Scenario, load_scenario
 from .post.pressure import bend_table, default_window_m, pressure_profile
@@ -141,14 +142,14 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
     message and the simulated time where it happened, and everything recorded until then is
-    written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
+    written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs,
+    and so does an ``out_dir`` that cannot be written or that another run is writing into
+    (:class:`~exucable.errors.OutputError`; :func:`exucable.output.outdir.owned_out_dir`): the
+    directory is this run's from before the solve until its files are written.
     ``refine`` divides the mesh's element length and ``check_points_per_element`` overrides the
     scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
     ``solver.mode``.
     """
-    from .model.build import build_model
-    from .solve.dynamic import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
-
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
@@ -157,6 +158,19 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                                         "plan several cables per duct with `exucable plan`")
     _refuse_pulling_the_cable_out(sc)
     _refuse_snapshot_times_in_steady_mode(sc)
+    if out_dir is None:
+        return _solve(sc, quiet, steady_stop, refine, check_points_per_element)
+    with owned_out_dir(out_dir) as out:
+        result = _solve(sc, quiet, steady_stop, refine, check_points_per_element)
+        write_results(out, result, plots=plots)
+    return result
+
+
+def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_per_element) -> RunResult:
+    """Build and solve a validated scenario and post-process it (no files)."""
+    from .model.build import build_model
+    from .solve.dynamic import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
+
     t_start = time.perf_counter()
     from .solve.start import steady_start
     first = None
@@ -287,8 +301,6 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
                        contact_profile=cprof, rope_profile=rope_profile, extras=extras,
                        snapshots=recorder.tables() if recorder is not None else None,
                        bends=bends, pressure_profile=pressure_prof, model=model)
-    if out_dir is not None:
-        write_results(out_dir, result, plots=plots)
     return result
 
 

@@ -182,8 +182,11 @@ def test_snapshots_are_compared_time_by_time(tmp_path, s, capsys):
     assert c["max_abs"] == pytest.approx(0.5, abs=EXACT) and c["worst_at"][1] == 0.2
     assert c["scale"] == pytest.approx(102.0, rel=EXACT)      # max |A| over the times compared
     assert result["skipped"] == [("snapshot_tension", "*", "snapshot t = 0.3 s only in A")]
+    # B lacks A's t = 0.3 s: within tolerances on the overlap, but it does not cover A
+    assert not result["covered"] and not result["passed"]
     assert run(a.parent, b.parent, "--atol", "0.4", "--rtol", "0") == 1
-    assert run(a.parent, b.parent, "--atol", "0.6", "--rtol", "0", "--out", tmp_path / "figs") == 0
+    assert run(a.parent, b.parent, "--atol", "0.6", "--rtol", "0") == 1
+    assert run(a.parent, b.parent, "--atol", "0.6", "--rtol", "0", "--allow-partial", "--out", tmp_path / "figs") == 0
     assert [p.name for p in (tmp_path / "figs").iterdir()] == ["compare_snapshot_tension_tension_N.png"]
 
 
@@ -216,7 +219,7 @@ def test_old_column_names_are_read_with_a_note_and_new_ones_directly(tmp_path, s
     assert compare_results(contact_new, contact_old)["comparisons"][0]["kind"] == "contact_profile"
 
 
-def _result_dir(path: Path, mode: str, history_rows: int, times) -> Path:
+def _state_result_dir(path: Path, mode: str, history_rows: int, times) -> Path:
     """A minimal result directory: summary.json with its mode, history.csv, snapshot_tension.csv
     with the profile 100 + x at each snapshot time."""
     path.mkdir()
@@ -233,8 +236,8 @@ def _result_dir(path: Path, mode: str, history_rows: int, times) -> Path:
 def test_a_steady_result_is_compared_by_state_not_by_pseudo_time(tmp_path):
     """A steady result's one-row pseudo-time history is neither read nor compared; its state (t = 0)
     is compared with a dynamic run's last snapshot, and the note says which times."""
-    steady = _result_dir(tmp_path / "steady", "steady", 1, [0.0])
-    dynamic = _result_dir(tmp_path / "dynamic", "dynamic", 5, [0.1, 0.3])
+    steady = _state_result_dir(tmp_path / "steady", "steady", 1, [0.0])
+    dynamic = _state_result_dir(tmp_path / "dynamic", "dynamic", 5, [0.1, 0.3])
     result = compare_results(steady, dynamic)
     (c,) = result["comparisons"]
     assert c["kind"] == "snapshot_tension" and c["times"] == [0.0] and c["times_b"] == [0.3]
@@ -243,4 +246,70 @@ def test_a_steady_result_is_compared_by_state_not_by_pseudo_time(tmp_path):
     assert any("latest state" in n for n in result["notes"])
     # two dynamic runs still align on their times, and a one-row history there is an error
     with pytest.raises(ExucableError, match="at least two data rows"):
-        compare_results(_result_dir(tmp_path / "short", "dynamic", 1, [0.3]), dynamic)
+        compare_results(_state_result_dir(tmp_path / "short", "dynamic", 1, [0.3]), dynamic)
+
+
+def _result_dir(path: Path, t, s) -> Path:
+    path.mkdir()
+    history(path / "history.csv", t, 20.0 + t, trailing=np.full_like(t, 5.0), maximum=21.0 + t)
+    profile(path / "tension_profile.csv", s, 5.0 + s)
+    write_csv(path / "rope_profile.csv", "s_conduit_m,tension_N,sidewall_pressure_N_per_m", [s, 5.0 + s, 0 * s])
+    return path
+
+
+def test_b_holding_a_few_of_as_rows_and_none_of_its_profiles_does_not_agree(tmp_path, s, capsys):
+    """B = A's first 3 of 42 history rows, no profile files: the overlap agrees exactly, yet B does
+    not cover A, so compare fails (exit 1) and says what is missing: rows, range, files."""
+    t = np.linspace(0.0, 0.41, 42)
+    a = _result_dir(tmp_path / "a", t, s)
+    b = tmp_path / "b"
+    b.mkdir()
+    history(b / "history.csv", t[:3], 20.0 + t[:3], trailing=np.full(3, 5.0), maximum=21.0 + t[:3])
+    result = compare_results(a, b)
+    assert all(c["max_abs"] == 0.0 for c in result["comparisons"])
+    assert not result["covered"] and not result["passed"]
+    cov = {c["file"]: c for c in result["coverage"]}
+    assert (cov["history.csv"]["rows_a"], cov["history.csv"]["rows_b"]) == (42, 3)
+    assert cov["history.csv"]["range_b"] == (0.0, pytest.approx(0.02))
+    assert cov["tension_profile.csv"]["missing"] == ["tension_profile.csv not in B"]
+    assert cov["rope_profile.csv"]["missing"] == ["rope_profile.csv not in B"]
+    assert run(a, b) == 1
+    text = capsys.readouterr().out
+    assert "INCOMPLETE: B does not cover A" in text and "agree within tolerances" not in text
+    assert "rows A     42, B      3" in text
+    assert run(a, b, "--allow-partial") == 0
+    assert "--allow-partial: B does not cover A" in capsys.readouterr().out
+
+
+def test_b_covering_a_on_its_own_grid_agrees(tmp_path, s):
+    """Another solver's output times need not be A's: B on a finer grid ending within one of A's
+    steps of A's end covers A; a single CSV B answers only for its own family."""
+    t = np.linspace(0.0, 0.41, 42)
+    a = _result_dir(tmp_path / "a", t, s)
+    b = _result_dir(tmp_path / "b", np.linspace(0.0, 0.405, 82), s)
+    result = compare_results(a, b)
+    assert result["covered"] and result["passed"]
+    one = compare_results(a, b / "history.csv")
+    assert one["covered"] and one["passed"]
+    assert {c["file"]: c["checked"] for c in one["coverage"]}["tension_profile.csv"] is False
+
+
+def test_a_byte_order_mark_is_read_and_a_binary_file_refused_in_one_line(tmp_path, s, capsys):
+    a = profile(tmp_path / "a.csv", s, 1.0 + s)
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes(b"\xef\xbb\xbf" + a.read_bytes())
+    assert compare_results(a, bom)["passed"]
+    tol = tmp_path / "tol.toml"
+    tol.write_bytes(b"\xef\xbb\xbf[default]\nrtol = 0.5\n")
+    assert load_tolerances(tol) == {"default": {"rtol": 0.5}}
+    binary = tmp_path / "history.csv"
+    binary.write_bytes(bytes(range(256)) * 4)
+    with pytest.raises(ExucableError, match="not a text CSV file"):
+        compare_results(a, binary)
+    nul = tmp_path / "nul.csv"
+    nul.write_bytes(b"x_m,tension_N\n0,\x001\n1,2\n")
+    with pytest.raises(ExucableError, match="not a text CSV file|not a number"):
+        compare_results(a, nul)
+    res = subprocess.run([sys.executable, "-m", "exucable", "compare", str(a), str(binary)],
+                         capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1 and "Traceback" not in res.stderr

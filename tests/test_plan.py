@@ -303,3 +303,42 @@ def test_readme_links_an_industry_report_and_shows_its_picture():
     scenario = ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml"
     assert plan["inputs"]["scenario"] == parse_plan_scenario(tomllib.loads(scenario.read_text()), ROOT)[0].name
 
+
+
+def test_without_limits_the_plan_says_not_checked(tmp_path, capsys):
+    """No [limits]: nothing to pass or fail, and the plan says so instead of 'all checks pass'."""
+    plan = _plan()
+    assert plan["limits_checked"] is False and plan["passed"] is True
+    assert _plan(limits={"max_tension": 1e6})["limits_checked"] is True
+    path = _toml(tmp_path / "s.toml", "")
+    path.write_text(path.read_text().replace("[limits]", ""))
+    assert cli_main(["plan", str(path), "--out", str(tmp_path / "out")]) == 0
+    printed = capsys.readouterr().out
+    assert "limits: not checked" in printed and "limits not checked: no [limits]" in printed
+    assert "Limits not checked" in (tmp_path / "out" / "report.html").read_text()
+
+
+@pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
+def test_an_infinite_tension_fails_with_or_without_limits():
+    """A tension past what a float holds (a back tension of 1.79e308 N grown by friction) is infinite,
+    and that fails a check of its own instead of passing unchecked."""
+    plan = _plan(pull__back_tension=1.79e308)
+    for name in ("forward", "reverse"):
+        d = plan["directions"][name]
+        assert not math.isfinite(d["max_tension_N"])
+        check = next(c for c in d["checks"] if c["name"] == "finite_tension")
+        assert check["passed"] is False
+    assert plan["passed"] is False
+
+
+def test_a_rope_that_cannot_be_solved_names_the_scenario_key(monkeypatch):
+    """The rope solver's own argument names are not keys a user can set: they are translated."""
+    import exucable.plan.pull as pull
+    from exucable.errors import ModelError
+
+    def refuse(*args, **kwargs):
+        raise ModelError("weight_per_length_N_per_m", "weight per length must be finite and >= 0, got nan")
+
+    monkeypatch.setattr(pull, "solve_rope", refuse)
+    with pytest.raises(ModelError, match=r"^cable\.mass_per_length: weight per length"):
+        _plan()

@@ -134,3 +134,32 @@ def test_contact_profile_groups_are_those_of_array_split():
     for key, reduce in (("s_conduit_m", np.mean), ("normal_force_per_length_N_per_m", np.mean), ("penetration_m", np.max)):
         want = np.array([reduce(pts[key][g]) for g in groups])
         assert np.allclose(prof[key], want, rtol=1e-14, atol=0.0), key
+
+
+@pytest.mark.parametrize("name", ["paper_ex3_helix", "paper_ex4_spatial"])
+def test_the_shipped_fast_examples_3_and_4_end_steady(name, tmp_path):
+    """`exucable run scenarios/fast/...` as shipped exits 0: steady within its end time (Ex. 3 with
+    64 elements, Ex. 4 started in the steady state; the files say why), within the
+    fast validation's tolerances of their references (exucable.validation.paper.TOLERANCES)."""
+    p = subprocess.run([sys.executable, "-m", "exucable", "run", str(ROOT / "scenarios" / "fast" / f"{name}.toml"),
+                        "--out", str(tmp_path / "out"), "--no-plots", "-q"], capture_output=True, text=True,
+                       timeout=600)
+    assert p.returncode == 0, p.stdout + p.stderr
+    s = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert s["status"] == "steady" and s["steady"]
+    if name == "paper_ex3_helix":
+        assert abs(s["trailing_tension_N"] / s["rope_trailing_tension_N"] - 1) < 1e-2
+    else:
+        assert abs(s["pull_force_N"] / s["rope_pull_force_N"] - 1) < 2e-2
+
+
+def test_a_rope_start_that_cannot_be_solved_names_the_scenario_key():
+    """The rope solver's own argument names (pull_force_N, ...) are not keys a user can set: a
+    prescribed pull too small to move the cable is refused naming pull.force."""
+    bend = {"inner_radius": 0.0035, "path": [{"straight": 1.0}, {"bend": 90.0, "radius": 0.5, "turn": "left"},
+                                             {"straight": 1.0}]}
+    sc = make_scenario(cable={"radius": 0.0025, "density": 1000.0, "youngs_modulus": 1e9, "elements": 40},
+                       conduit=bend, pull={"speed": 0.1, "force": 0.01}, contact={"friction": 0.3},
+                       gravity={"g": 9.8})
+    with pytest.raises(ModelError, match=r"^pull\.force: pull force 0.01 N is below"):
+        build_model(sc)

@@ -98,8 +98,8 @@ def test_pulling_force_is_the_leading_end_tension():
 def test_force_controlled_pull_holds_the_trailing_end():
     """Example 3 (the paper's 80 elements, coarse check points): the pull is given (40 N), the
     trailing tension is the result; capstan with the exact helix angle 11.3848 N, measured
-    +0.064 % (2026-11-29; 160 elements +0.073 %), bound 0.2 %. The fast variant's 40 elements
-    (0.33 m, 12 bending lengths) are not: -0.24 % with the rig 10 bending lengths out,
+    +0.064 % (2026-11-29; 160 elements +0.073 %), bound 0.2 %. The fast variant's former 40
+    elements (0.33 m, 12 bending lengths) were not: -0.24 % with the rig 10 bending lengths out,
     +0.22 % at 5 (an element straddles the exit either way)."""
     r = run_scenario(fast("paper_ex3_helix").replace(**{"cable.elements": 80}), None, plots=False,
                      mode="steady")

@@ -15,6 +15,7 @@ from ..output.compare import (
     write_overlay_plots,
 )
 from ..errors import ExucableError
+from ..output.outdir import check_out_dir, check_out_file
 
 __all__ = ["add_arguments", "main"]
 
@@ -30,6 +31,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--tolerances", default=None,
                         help="TOML of per-quantity tolerances: [default], [pull_force_N], [snapshot_contact.normal_force_N], "
                              "... each with rtol and/or atol (overrides --rtol/--atol)")
+    parser.add_argument("--allow-partial", action="store_true",
+                        help="pass on what A and B both have; by default B must cover every file, column, "
+                             "snapshot time and abscissa range of A")
     parser.add_argument("--out", default=None,
                         help="overlay figures: a directory (one PNG per quantity) or a .png path (all in one)")
 
@@ -41,7 +45,11 @@ def main(args: argparse.Namespace) -> int:
         if not (value >= 0.0 and math.isfinite(value)):
             raise ExucableError(f"--{name} must be a finite number >= 0, got {value!r}")
     tolerances = load_tolerances(args.tolerances) if args.tolerances else None
-    result = compare_results(args.a, args.b, rtol=args.rtol, atol=args.atol, tolerances=tolerances)
+    if args.out:     # checked before comparing: a bad --out is refused in one line, up front
+        out = Path(args.out)
+        check_out_file(out) if out.suffix.lower() == ".png" else check_out_dir(out)
+    result = compare_results(args.a, args.b, rtol=args.rtol, atol=args.atol, tolerances=tolerances,
+                             allow_partial=args.allow_partial)
     print(format_report(result))
     if args.out:
         out = Path(args.out)

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..post.convergence import extrapolate
 from ..io import write_csv, write_json
+from ..output.outdir import check_out_dir, default_out_dir
 from ..run import run_scenario
 from ..scenario.specs import load_scenario
 from ..post.trust import TRUSTED_STATUSES
@@ -101,7 +102,7 @@ def main(args) -> int:
     if not args.ratio > 1.0:
         print(f"exucable converge: error: --ratio: must be > 1, got {args.ratio}", file=sys.stderr)
         return 2
-    out = Path(args.out) if args.out else Path("out") / f"{sc.name}-converge"
+    out = check_out_dir(Path(args.out) if args.out else default_out_dir(sc.name, suffix="-converge"))
     from .compile import announce_compiling
 
     announce_compiling()

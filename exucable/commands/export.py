@@ -17,6 +17,6 @@ def add_arguments(p) -> None:
 def main(args) -> int:
     from ..output.export import export_problem
 
-    written = export_problem(args.scenario, Path(args.out), mode=args.mode)
+    written = export_problem(args.scenario, Path(args.out), mode=args.mode)   # checks the directory before building
     print(f"exported {len(written)} files to {args.out}/: " + ", ".join(p.name for p in written))
     return 0

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from exucable.plan.pull import ENGINES, load_plan_scenario, plan_pull
 from exucable.io import atomic_write_text, write_csv, write_json
+from exucable.output.outdir import check_out_dir, name_as_path_part
 from exucable.scenario.units import SYSTEMS
 
 __all__ = ["add_arguments", "main", "write_plan"]
@@ -57,6 +58,10 @@ def write_plan(out_dir, plan: dict, scenario, units: str) -> list[Path]:
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    # plan.json marks a complete plan: an earlier one goes first, and a pull-in table this plan
+    # does not write again with it
+    for stale in ("plan.json", "pull_in_forward.csv", "pull_in_reverse.csv"):
+        (out / stale).unlink(missing_ok=True)
     written = []
     for name in ("forward", "reverse"):
         d = plan["directions"][name]
@@ -99,6 +104,8 @@ def main(args) -> int:
     from exucable.scenario.units import display_unit, from_si
 
     scenario, spec = load_plan_scenario(args.scenario, units=args.units)
+    # checked before planning: a multibody engine's solves are not lost to a bad --out
+    out = check_out_dir(Path(args.out) if args.out else Path(f"plan_{name_as_path_part(scenario.name)}"))
     if args.engine != "rope":
         from .compile import announce_compiling
 
@@ -122,6 +129,8 @@ def main(args) -> int:
         if d["slack"]:
             print("  note: the cable runs slack somewhere (a downhill stretch steeper than the friction angle): "
                   "tension 0 there")
+        if not plan["limits_checked"]:
+            print("  limits: not checked (the scenario has no [limits])")
         for c in d["checks"]:
             value, limit, unit = check_in_units(c, units)
             margin = "" if c["margin"] is None else f", margin {100 * c['margin']:.1f} %"
@@ -129,9 +138,9 @@ def main(args) -> int:
             value = "" if value is None else f"value {value:.4g} {unit}"
             print(f"  check {c['name']}: {'pass' if c['passed'] else 'FAIL'} ({value}"
                   f"{limit}{margin}{'; ' if value else ''}{c['where']})")
-    out = Path(args.out) if args.out else Path(f"plan_{scenario.name}")
     write_plan(out, plan, scenario, units)
-    print(f"\nrecommended direction: {plan['recommended_direction']}"
-          f"{'' if plan['passed'] else ' (a check fails in both directions)'}")
+    verdict = (" (a check fails in both directions)" if not plan["passed"]
+               else "" if plan["limits_checked"] else " (limits not checked: no [limits])")
+    print(f"\nrecommended direction: {plan['recommended_direction']}{verdict}")
     print(f"written: {out}/plan.json, sections_*.csv, checks.csv, report.html")
     return 0 if plan["passed"] else 1

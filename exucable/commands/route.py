@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..output.outdir import check_out_file, name_as_path_part
 from ..plots.route import plot_route, route_table
 from ..scenario.specs import load_scenario
 
@@ -18,7 +19,7 @@ def add_arguments(p) -> None:
 def main(args) -> int:
     sc = load_scenario(args.scenario)
     conduit = sc.build_conduit()
-    out = Path(args.out) if args.out else Path(f"{sc.name}_route.png")
+    out = check_out_file(Path(args.out) if args.out else Path(f"{name_as_path_part(sc.name)}_route.png"))
     plot_route(conduit, out, title=sc.name)
     rows = route_table(conduit)
     width = max(len(k) for k, _ in rows)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..output.outdir import default_out_dir
 from ..run import run_scenario
 from .compile import announce_compiling
 from ..scenario.specs import load_scenario
@@ -17,7 +18,8 @@ __all__ = ["add_arguments", "main"]
 
 def add_arguments(p) -> None:
     p.add_argument("scenario", help="scenario file (TOML)")
-    p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>)")
+    p.add_argument("--out", "-o", default=None, help="result directory, this run's alone: an earlier run's result files in it are replaced "
+                        "(default: out/<scenario name>, the name made safe as a directory name)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     p.add_argument("--mode", choices=("dynamic", "steady"), default=None,
@@ -35,7 +37,7 @@ def _f(value, fmt=".6g") -> str:
 
 def main(args) -> int:
     sc = load_scenario(args.scenario)
-    out_dir = Path(args.out) if args.out else Path("out") / sc.name
+    out_dir = Path(args.out) if args.out else default_out_dir(sc.name)
     announce_compiling()
     res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
                        mode=args.mode)

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from ..errors import ExucableError
+from ..output.outdir import default_out_dir
 from ..sweep.execute import PLOT, plan, run_sweep
 from ..sweep.plot import plot_sweep
 from ..sweep.spec import OUTPUTS, load_sweep
@@ -19,7 +20,7 @@ __all__ = ["add_arguments", "main", "load_runner"]
 
 def add_arguments(p) -> None:
     p.add_argument("sweep", help="sweep file (TOML): base scenario, [set], unset, [vary], mode")
-    p.add_argument("--out", "-o", default=None, help="sweep directory (default: out/<sweep name>)")
+    p.add_argument("--out", "-o", default=None, help="sweep directory (default: out/<sweep name>, the name made safe as a directory name)")
     p.add_argument("--workers", "-j", type=int, default=None,
                    help="local worker processes (default: the cores available)")
     p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
@@ -78,7 +79,7 @@ def _print_table(rows, keys, output: str, rope_key: str | None) -> None:
 
 def main(args) -> int:
     sweep = load_sweep(args.sweep)
-    out_dir = Path(args.out) if args.out else Path("out") / sweep.name
+    out_dir = Path(args.out) if args.out else default_out_dir(sweep.name)
     rope_key = OUTPUTS.get(sweep.output)
     n = len(sweep.cases)
 

@@ -69,6 +69,12 @@ class CableLayout:
         return np.hstack([self.velocity_m_per_s, self.slope_rate_1_per_s])
 
 
+#: The rope solver's argument names (its errors' keys) → the scenario keys they come from.
+ROPE_ARGUMENT_KEYS = {"pull_force_N": "pull.force", "trailing_tension_N": "pull.back_tension",
+                      "friction": "contact.friction", "cable_length_m": "cable.length",
+                      "weight_per_length_N_per_m": "cable.density"}
+
+
 def extended_point(centreline, s_m: np.ndarray) -> np.ndarray:
     """Centreline point at ``s_m`` [m], continued straight along the end tangents outside [0, L]."""
     s = np.atleast_1d(np.asarray(s_m, dtype=float))
@@ -498,9 +504,15 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     common = dict(friction=sc.contact.friction, weight_per_length_N_per_m=w)
 
     def rope_for(length_m):
-        if sc.pull.force_N is not None:
-            return solve_rope_for_pull_force(centre, pull_force_N=sc.pull.force_N, **common, cable_length_m=length_m)
-        return solve_rope(centre, trailing_tension_N=sc.pull.back_tension_N, **common, cable_length_m=length_m)
+        try:
+            if sc.pull.force_N is not None:
+                return solve_rope_for_pull_force(centre, pull_force_N=sc.pull.force_N, **common,
+                                                 cable_length_m=length_m)
+            return solve_rope(centre, trailing_tension_N=sc.pull.back_tension_N, **common, cable_length_m=length_m)
+        except ModelError as exc:
+            # the rope solver names its own arguments; the user knows the scenario's keys
+            key = ROPE_ARGUMENT_KEYS.get(exc.key, exc.key)
+            raise ModelError(key, exc.message) from None
 
     full = None          # the rope of the whole cable inside, where the lead-out rule needed it
     lead_out = 0.0

@@ -42,6 +42,7 @@ Use :func:`compare_results` from Python; :mod:`exucable.commands.compare` is the
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 import tomllib
@@ -143,10 +144,14 @@ def _recognise(path: Path, header: list) -> tuple[str, list, tuple]:
 def _read_csv(path: Path) -> _Table:
     """Read one results CSV; its family is recognised by its name or header. '#' lines are skipped."""
     try:
-        with open(path, newline="") as fh:
+        # utf-8-sig: a byte-order mark (as spreadsheet programs write one) is read past
+        with open(path, newline="", encoding="utf-8-sig") as fh:
             rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
     except OSError as exc:
         raise ExucableError(f"{path}: cannot read ({exc.strerror})") from None
+    except (UnicodeDecodeError, csv.Error):
+        raise ExucableError(f"{path}: not a text CSV file (binary content or another encoding than UTF-8); "
+                            "give a results CSV") from None
     if not rows:
         raise ExucableError(f"{path}: empty file, expected a header line")
     header = [h.strip() for h in rows[0]]
@@ -220,9 +225,12 @@ def load_tolerances(path) -> dict:
     """A tolerance TOML: ``{name: {"rtol": r, "atol": a}}`` with ``default`` and column or family.column names."""
     try:
         with open(path, "rb") as fh:
-            data = tomllib.load(fh)
+            raw = fh.read()
+        data = tomllib.loads(raw.decode("utf-8-sig"))       # a byte-order mark is read past
     except OSError as exc:
         raise ExucableError(f"{path}: cannot read ({exc.strerror})") from None
+    except UnicodeDecodeError:
+        raise ExucableError(f"{path}: not a UTF-8 text file; give a TOML file of tolerances") from None
     except tomllib.TOMLDecodeError as exc:
         raise ExucableError(f"{path}: not valid TOML ({exc})") from None
     out = {}
@@ -250,7 +258,59 @@ def _tolerance(tolerances: dict, kind: str, column: str, rtol: float, atol: floa
     return t["rtol"], t["atol"]
 
 
-def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, tolerances: dict | None = None) -> dict:
+def _rows(table: _Table) -> int:
+    return sum(x.size for x, _ in table.groups.values())
+
+
+def _reaches(xa, xb) -> str | None:
+    """Why abscissa ``xb`` does not span ``xa``'s range (None when it does). One median step of A
+    is allowed at each end: another solver's output times or stations need not fall on A's."""
+    step = float(np.median(np.diff(xa))) if xa.size > 1 else 0.0
+    if xb[0] <= xa[0] + step and xb[-1] >= xa[-1] - step:
+        return None
+    return f"B spans {xb[0]:.6g}..{xb[-1]:.6g}, A {xa[0]:.6g}..{xa[-1]:.6g}"
+
+
+def _coverage(kind: str, ta: _Table, tb: _Table | None, b_is_dir: bool, steady: bool = False) -> dict:
+    """How far B covers A's table of one family: rows, range and times of each, and what B lacks
+    (``missing``; empty when B covers A). With a steady side (``steady``) a state is one state: A's
+    latest snapshot is covered by B's latest, and a time history is not asked of the steady side."""
+    fam = FAMILIES[kind]
+    xa = np.concatenate([x for x, _ in ta.groups.values()])
+    entry = {"kind": kind, "file": fam.file, "abscissa": fam.abscissa, "rows_a": _rows(ta),
+             "range_a": (float(xa.min()), float(xa.max())), "rows_b": 0, "range_b": None, "missing": [],
+             "checked": True}
+    if steady and kind == "history":
+        entry["checked"] = False      # a steady solve has no time history to cover or be covered by
+        if tb is None:
+            entry["missing"].append(f"{fam.file}: not compared (steady result)")
+        return entry
+    if steady and fam.group is not None and tb is not None and tb.groups:
+        t_a, t_b = max(ta.groups), max(tb.groups)
+        ta = dataclasses.replace(ta, groups={t_a: ta.groups[t_a]})
+        tb = dataclasses.replace(tb, groups={t_a: tb.groups[t_b]})
+    if tb is None:
+        # a directory B answers for every file of A; a single CSV only for its own family
+        entry["missing"].append(f"{fam.file} not in B")
+        entry["checked"] = b_is_dir
+        return entry
+    xb = np.concatenate([x for x, _ in tb.groups.values()])
+    entry.update(rows_b=_rows(tb), range_b=(float(xb.min()), float(xb.max())))
+    entry["missing"] += [f"column {c} not in B" for c in fam.values if c in ta.columns and c not in tb.columns]
+    times_b = np.array(sorted(k for k in tb.groups if k is not None))
+    for t, (x, _) in ta.groups.items():
+        if t is not None and not (times_b.size and np.min(np.abs(times_b - t)) <= _TIME_MATCH_S):
+            entry["missing"].append(f"snapshot t = {t:.12g} s not in B")
+            continue
+        key = None if t is None else float(times_b[int(np.argmin(np.abs(times_b - t)))])
+        why = _reaches(x, tb.groups[key][0])
+        if why is not None:
+            entry["missing"].append(f"{fam.abscissa}: {why}" + ("" if t is None else f" at t = {t:.12g} s"))
+    return entry
+
+
+def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, tolerances: dict | None = None,
+                    allow_partial: bool = False) -> dict:
     """Compare two result directories or CSV files.
 
     Parameters
@@ -262,6 +322,10 @@ def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, toleran
         max |B − A| <= atol + rtol · max |A|.
     tolerances : dict, optional
         Per-quantity tolerances from :func:`load_tolerances` (override ``rtol``/``atol``).
+    allow_partial : bool
+        Pass on the overlap alone. By default B must cover A: every file of A (when B is a
+        directory), every value column and snapshot time of A, and A's abscissa range (to one of A's
+        median steps at each end); otherwise ``passed`` is false whatever the differences.
 
     Returns
     -------
@@ -271,7 +335,10 @@ def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, toleran
         over all snapshot times), ``n_points``, ``times`` (snapshot times compared, or None),
         ``max_abs``, ``rms_abs`` [unit], ``scale`` (max |A|), ``max_rel``, ``rms_rel``, ``rtol``,
         ``atol``, ``worst_at`` (abscissa, and time for snapshots, of the largest difference) and
-        ``passed``; ``skipped`` lists (family, column, reason).
+        ``passed``; ``skipped`` lists (family, column, reason); ``coverage`` has one entry per file
+        of A: ``kind``, ``file``, ``rows_a``, ``rows_b``, ``range_a``, ``range_b``, ``missing`` (what B
+        lacks; empty when it covers A) and ``checked`` (whether it counts toward ``covered``);
+        ``covered`` is true when B covers A.
 
     Raises
     ------
@@ -351,8 +418,13 @@ def compare_results(a, b, rtol: float = DEFAULT_RTOL, atol: float = 0.0, toleran
                 "rtol": r, "atol": at, "worst_at": (float(x[k]), None if fam.group is None else float(tt[k])),
                 "passed": bool(max_abs <= at + r * scale),
             })
+    b_is_dir = Path(b).is_dir()
+    coverage = [_coverage(k, tables_a[k], tables_b.get(k), b_is_dir, any(steady.values()))
+                for k in FAMILIES if k in tables_a]
+    covered = all(not c["missing"] for c in coverage if c["checked"])
     return {"a": str(a), "b": str(b), "comparisons": comparisons, "skipped": skipped, "notes": notes,
-            "passed": all(c["passed"] for c in comparisons)}
+            "coverage": coverage, "covered": covered, "allow_partial": bool(allow_partial),
+            "passed": all(c["passed"] for c in comparisons) and (covered or bool(allow_partial))}
 
 
 def _group_time(table: _Table, group) -> float:
@@ -374,8 +446,27 @@ def format_report(result: dict) -> str:
                      f"{c['max_rel']:>9.2e} {c['rms_rel']:>9.2e} {c['rtol']:>7.1e} {c['atol']:>8.2g}  {verdict}")
     for kind, column, reason in result["skipped"]:
         lines.append(f"{kind + '.' + column:<42} skipped ({reason})")
-    lines.append("agree within tolerances" if result["passed"]
-                 else "DIFFER: max |B-A| > atol + rtol·max|A| for a quantity marked BEYOND")
+    coverage = result.get("coverage", [])
+    if coverage:
+        lines.append("coverage of A by B:")
+    for c in coverage:
+        unit = "s" if c["abscissa"] == "time_s" else "m"
+        rng_b = "-" if c["range_b"] is None else f"{c['range_b'][0]:.4g}..{c['range_b'][1]:.4g} {unit}"
+        state = "covered" if not c["missing"] else ("; ".join(c["missing"]) + ("" if c["checked"] else
+                                                                               " (B is one file: not checked)"))
+        lines.append(f"  {c['file']:<22} rows A {c['rows_a']:>6}, B {c['rows_b']:>6}; range A "
+                     f"{c['range_a'][0]:.4g}..{c['range_a'][1]:.4g} {unit}, B {rng_b}: {state}")
+    differ = not all(c["passed"] for c in result["comparisons"])
+    uncovered = not result.get("covered", True)
+    if not differ and not uncovered:
+        lines.append("agree within tolerances, B covering A")
+    elif not differ and result.get("allow_partial"):
+        lines.append("agree within tolerances over what both have (--allow-partial: B does not cover A)")
+    else:
+        if differ:
+            lines.append("DIFFER: max |B-A| > atol + rtol·max|A| for a quantity marked BEYOND")
+        if uncovered:
+            lines.append("INCOMPLETE: B does not cover A (see coverage); --allow-partial compares the overlap alone")
     return "\n".join(lines)
 
 

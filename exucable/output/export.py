@@ -298,18 +298,27 @@ def problem_tables(model) -> dict[str, dict]:
 def export_problem(scenario, out_dir, mode: str | None = None) -> list[Path]:
     """Build ``scenario``'s model and write its discrete problem into ``out_dir``; ``problem.json``
     last (its presence marks a complete export). ``mode`` (``"dynamic"`` or ``"steady"``) overrides
-    ``solver.mode``, as for ``exucable run``. Returns the paths written."""
+    ``solver.mode``, as for ``exucable run``. Returns the paths written.
+
+    ``out_dir`` is checked and owned before the model is built
+    (:func:`exucable.output.outdir.owned_out_dir`)."""
     import dataclasses
 
     from ..model.build import build_model
     from ..scenario.specs import Scenario, load_scenario
+    from .outdir import owned_out_dir
 
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
-    model = build_model(sc)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    with owned_out_dir(out_dir) as out:
+        return _export(sc, build_model(sc), out)
+
+
+def _export(sc, model, out: Path) -> list[Path]:
+    """Write the tables, then ``problem.json``; an earlier export's ``problem.json`` goes first, so
+    it never vouches for tables of this one that a failed write left out."""
+    (out / "problem.json").unlink(missing_ok=True)
     written = []
     for name, data in problem_tables(model).items():
         write_csv(out / name, EXPORT_FILES[name], data)

@@ -26,12 +26,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 # The writers live in io.py (one atomic writer); re-exported here, where callers have found them.
-from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, read_csv, write_csv, write_json
+from ..errors import OutputError
+from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, csv_text, read_csv, write_csv, write_json
 from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
 from ..post.pressure import BEND_COLUMNS, PRESSURE_COLUMNS
 
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
-           "read_summary", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
+           "read_summary", "result_file_names", "DATA_FILES", "FIGURE_FILES", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
 HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N", "max_penetration_m",
                    "max_axis_offset_m", "max_axis_offset_s_conduit_m")
@@ -59,17 +60,69 @@ class RunResult:
     model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
 
 
+#: Every file a run may write into its directory, figures included (``snapshot_*.csv``:
+#: :data:`exucable.output.formats.SNAPSHOT_FILES`). A new run removes those of an earlier run that it
+#: does not write again, so no file of another run is left beside its ``summary.json``.
+DATA_FILES = ("history.csv", "tension_profile.csv", "contact_profile.csv", "rope_profile.csv", "bends.csv",
+              "pressure_profile.csv")
+FIGURE_FILES = ("pull_force.png", "tension_profile.png", "pressure.png")
+SUMMARY_FILE = "summary.json"
+
+
+def result_file_names() -> tuple[str, ...]:
+    """The names of every file :func:`write_results` may write (summary, data, snapshots, figures)."""
+    from .formats import SNAPSHOT_FILES
+    return (SUMMARY_FILE, *DATA_FILES, *SNAPSHOT_FILES, *FIGURE_FILES)
+
+
 def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
     """Write ``result`` into ``out_dir`` (created if needed): the CSV files, then ``summary.json``,
-    then (unless ``plots`` is false) the figures. Returns the paths."""
+    then (unless ``plots`` is false) the figures. Returns the paths.
+
+    The directory's ``summary.json`` vouches only for files of its own run: an earlier run's
+    ``summary.json`` is removed first, then every result file of that run (:func:`result_file_names`;
+    other files are left alone), and the new one is written last, listing the data files under
+    ``files`` (name → bytes). A write that fails (a full disk) therefore leaves no summary, and the
+    error says so. Raises :class:`~exucable.errors.OutputError` on a failed write.
+    """
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        for name in result_file_names():
+            try:
+                (out / name).unlink()
+            except FileNotFoundError:
+                pass
+        written = _write_data(out, result)
+    except OSError as exc:
+        raise OutputError(out, f"writing the results failed ({_reason(exc)}); no {SUMMARY_FILE} was left "
+                               "to vouch for an incomplete set: free space or choose another directory and "
+                               "run again") from None
+    if not plots:
+        return written
+    try:
+        return written + _write_figures(out, result)
+    except OSError as exc:
+        raise OutputError(out, f"the results and {SUMMARY_FILE} are written, but a figure is not "
+                               f"({_reason(exc)})") from None
+
+
+def _reason(exc: OSError) -> str:
+    what = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+    return f"{what}{exc.strerror or exc}"
+
+
+def _write_data(out: Path, result: RunResult) -> list[Path]:
+    """The CSV files and ``summary.json`` (last, listing them)."""
     written = []
+    contents = {}
     # one batch: the files are flushed to disk together and renamed in this order, summary.json
     # last; an error on the way still puts the files before it in place (io.AtomicBatch)
     with AtomicBatch() as batch:
         def add_csv(name, columns, data):
-            written.append(write_csv(out / name, columns, data, batch=batch))
+            text = csv_text(columns, data)
+            contents[name] = len(text.encode("utf-8"))
+            written.append(batch.add_text(out / name, text))
 
         add_csv("history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
         if result.tension_profile is not None:
@@ -86,18 +139,22 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
             from .formats import SNAPSHOT_FILES
             for name, data in result.snapshots.items():
                 add_csv(name, SNAPSHOT_FILES[name], data)
-        written.append(write_json(out / "summary.json", result.summary, batch=batch))
-    # the figures come after the numbers: they cost about half a second of matplotlib, and a
-    # failure to draw must not hold back (or lose) a result already computed
-    if plots:
-        plot_pull_force(out / "pull_force.png", result)
-        written.append(out / "pull_force.png")
-        if result.tension_profile is not None:
-            plot_tension_profile(out / "tension_profile.png", result)
-            written.append(out / "tension_profile.png")
-        if result.pressure_profile is not None:
-            plot_pressure(out / "pressure.png", result)
-            written.append(out / "pressure.png")
+        result.summary["files"] = dict(contents)
+        written.append(write_json(out / SUMMARY_FILE, result.summary, batch=batch))
+    return written
+
+
+def _write_figures(out: Path, result: RunResult) -> list[Path]:
+    """The figures, after the numbers: they cost about half a second of matplotlib, and a failure
+    to draw must not hold back (or lose) a result already computed."""
+    plot_pull_force(out / "pull_force.png", result)
+    written = [out / "pull_force.png"]
+    if result.tension_profile is not None:
+        plot_tension_profile(out / "tension_profile.png", result)
+        written.append(out / "tension_profile.png")
+    if result.pressure_profile is not None:
+        plot_pressure(out / "pressure.png", result)
+        written.append(out / "pressure.png")
     return written
 
 

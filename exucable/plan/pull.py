@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from exucable.quasistatic import engineering as eng
-from exucable.errors import ExucableError, ScenarioError
+from exucable.errors import ExucableError, ModelError, ScenarioError
 from exucable.geometry.centreline import Centreline
 from exucable.quasistatic.rope import sidewall_pressure_N_per_m, solve_rope
 from exucable.scenario.specs import Scenario, load_scenario, parse_scenario
@@ -191,6 +191,11 @@ def _pull_in_history(curve: Centreline, rope, n: int = 201) -> dict:
     return {"pulled_length_m": grid.tolist(), "pull_force_N": np.asarray(rope.tension_at(grid)).tolist()}
 
 
+#: The rope solver's argument names (its errors' keys) → the scenario keys a plan gives them from.
+_PLAN_ROPE_KEYS = {"friction": "contact.friction", "bend_friction": "contact.friction",
+                   "trailing_tension_N": "pull.back_tension", "weight_per_length_N_per_m": "cable.mass_per_length"}
+
+
 def _check(name, value, limit, where, quantity, lower_is_better=True) -> dict:
     if lower_is_better:
         passed = value <= limit
@@ -214,6 +219,11 @@ def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: floa
         else f"{_label(worst_t)}"
     t_max = direction["max_tension_N"]
     out = []
+    if not math.isfinite(t_max):
+        # e^(mu theta) past any float: no limit passes this, given or not
+        out.append({"name": "finite_tension", "passed": False, "value": t_max, "limit": None, "margin": None,
+                    "quantity": "force", "where": f"{where_t}: the tension grows beyond any number "
+                                                  "(friction times the angles turned is too large to pull)"})
     for name, limit in (("max_tension", lim.max_tension_N), ("conductor_tension", lim.conductor_tension_N),
                         ("grip_tension", lim.grip_limit_N)):
         if limit is not None:
@@ -373,7 +383,11 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     directions = {}
     for name in ("forward", "reverse"):
         curve = centreline if name == "forward" else centreline.reversed()
-        rope = solve_rope(centreline, mu_eff, w_total, back, name, bend_friction=mu_bend)
+        try:
+            rope = solve_rope(centreline, mu_eff, w_total, back, name, bend_friction=mu_bend)
+        except ModelError as exc:
+            # the rope solver names its own arguments; the user knows the scenario's keys
+            raise ModelError(_PLAN_ROPE_KEYS.get(exc.key, exc.key), exc.message) from None
         rows = _sections(curve, rope, w_total, swbp_factor)
         bends = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
         entry = {
@@ -414,6 +428,8 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
         "count": spec.count,
         "checks": directions[recommended]["checks"],
         "passed": bool(ok),
+        # without [limits] only the plan's own checks ran (finiteness, jam, the multibody run)
+        "limits_checked": any(getattr(spec.limits, f.name) is not None for f in dataclasses.fields(spec.limits)),
         "inputs": {
             "scenario": scenario.name,
             "cable_diameter_m": d,

@@ -183,6 +183,13 @@ _ENGINE_NOTE = {
 }
 
 
+def _verdict(plan: dict) -> str:
+    """The report's one-line verdict; "not checked" where no limit was given."""
+    if not plan["passed"]:
+        return "A check fails in both directions"
+    return "All checks pass" if plan.get("limits_checked", True) else "Limits not checked (no [limits] given)"
+
+
 def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, units: str = "si") -> str:
     """The report page as one HTML string.
 
@@ -204,7 +211,7 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
              f"<style>{_CSS}</style></head><body>",
              f"<h1>Pull plan: {html.escape(title)}</h1>",
              f"<p class='verdict {'ok' if passed else 'bad'}' id='verdict'>"
-             f"{'All checks pass' if passed else 'A check fails in both directions'} — recommended direction: "
+             f"{_verdict(plan)} — recommended direction: "
              f"<b id='recommended'>{rec}</b>, pull force {from_si(plan['directions'][rec]['pull_force_N'], 'force', units):.4g} {f}</p>",
              f"<p class='note'>Engine: {plan['engine']} ({_ENGINE_NOTE[plan['engine']]}). {plan['count']} cable(s), "
              f"arrangement {plan['arrangement']}, weight correction factor {plan['weight_correction_factor']:.4g}, "
@@ -229,8 +236,9 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
     for name in ("forward", "reverse"):
         checks = plan["directions"][name]["checks"]
         parts.append(f"<h2>Checks, {name} pull</h2>")
+        if not plan.get("limits_checked", True):
+            parts.append("<p>Limits not checked: none given ([limits] in the scenario).</p>")
         if not checks:
-            parts.append("<p>No limits given ([limits] in the scenario).</p>")
             continue
         rows = []
         for c in checks:

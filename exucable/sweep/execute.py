@@ -2,8 +2,9 @@
 
 Nothing lost, nothing twice:
 
-- a case is *finished* when ``DIR/cases/<hash>/case.json`` says ok/steady; finished cases are
-  never run again; failed ones are rerun only with ``retry_failed``;
+- a case is *finished* when ``DIR/cases/<hash>/case.json`` says so and the files it lists are
+  there as written (:func:`~exucable.sweep.store.read_verified_record`); finished cases are never
+  run again, a damaged one is; failed ones are rerun only with ``retry_failed``;
 - every case directory is installed by one rename of a complete temporary directory, so a
   kill of the sweep, or of a worker, at any moment loses no finished case;
 - ``sweep.csv`` is rewritten atomically after every finished case.
@@ -34,6 +35,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import ExucableError
+from ..output.outdir import check_out_dir
 from .pool import run_local
 from .progress import SweepProgress
 from .store import (
@@ -44,7 +46,7 @@ from .store import (
     case_dir,
     is_finished,
     make_row,
-    read_record,
+    read_verified_record,
     remove_stale,
     table_columns,
     write_manifest,
@@ -87,7 +89,7 @@ def plan(sweep, out_dir, retry_failed: bool = False) -> tuple[dict, list[int]]:
         a record, and failed ones if ``retry_failed``.
     """
     ids = sweep.case_ids()
-    records = {cid: read_record(case_dir(out_dir, cid)) for cid in ids}
+    records = {cid: read_verified_record(case_dir(out_dir, cid)) for cid in ids}
     todo = [i for i, cid in enumerate(ids)
             if records[cid] is None or (retry_failed and not is_finished(records[cid]))]
     return records, todo
@@ -139,8 +141,8 @@ def run_sweep(sweep, out_dir, workers: int | None = None, scheduler=None, retry_
 
 
 def _run_sweep(sweep, out: Path, workers, client, retry_failed, quiet, plots, runner, mp_context) -> list[dict]:
-    cases_dir = out / CASES_DIR
-    cases_dir.mkdir(parents=True, exist_ok=True)
+    check_out_dir(out)
+    cases_dir = check_out_dir(out / CASES_DIR)
     keys = sweep.keys
     ids = sweep.case_ids()
     extra = _extra_columns(sweep.output)

@@ -13,14 +13,24 @@ executor fails every case in flight without saying which one killed it.
 
 A case whose process dies without a record is started once more (a stray kill or an out-of-memory
 kill need not repeat); if it dies again it is recorded as failed with the exit code or signal.
+
+A case process dies with the sweep (:func:`_die_with_sweep`): killed, even by SIGKILL, the sweep
+leaves no case computing on as an orphan, whose files a re-run would otherwise race.
 """
 
 from __future__ import annotations
 
+import ctypes
+import os
 import signal
+import sys
+import threading
+import time
 import traceback
 from collections import deque
 from multiprocessing.connection import wait
+
+from ..io import pid_alive
 
 __all__ = ["run_local", "MAX_ATTEMPTS"]
 
@@ -28,16 +38,53 @@ __all__ = ["run_local", "MAX_ATTEMPTS"]
 MAX_ATTEMPTS = 2
 
 
-def _child(task: dict, runner, conn) -> None:
+#: Seconds between two looks of a case process at whether its sweep is still alive.
+WATCH_INTERVAL_S = 0.5
+_PR_SET_PDEATHSIG = 1       # linux/prctl.h
+
+
+def _die_with_sweep(sweep_pid: int) -> None:
+    """Make this case process die when the sweep process ``sweep_pid`` does.
+
+    On Linux the kernel sends SIGKILL when the parent dies (``prctl(PR_SET_PDEATHSIG)``); the
+    parent of a ``forkserver`` child is the fork server, which exits as soon as the sweep is gone.
+    A watch thread covers the rest (``spawn``, other systems, a sweep that died before the
+    ``prctl``): it kills this process once the sweep's pid is gone or this process was re-parented.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):
+            pass                                # no libc prctl here: the watch thread alone
+    parent = os.getppid()
+
+    def orphaned() -> bool:
+        return os.getppid() != parent or not pid_alive(sweep_pid)
+
+    def watch() -> None:
+        while not orphaned():
+            time.sleep(WATCH_INTERVAL_S)
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    if orphaned():
+        os.kill(os.getpid(), signal.SIGKILL)
+    threading.Thread(target=watch, name="exucable-watch-sweep", daemon=True).start()
+
+
+def _child(task: dict, runner, conn, sweep_pid: int | None = None) -> None:
     """Process target: run one case, send ``("ok", record)`` or ``("error", message, traceback)``."""
     from .worker import run_case
 
+    if sweep_pid is not None:
+        _die_with_sweep(sweep_pid)
     try:
         msg = ("ok", run_case(task, runner))
     except BaseException as exc:  # the harness failed (disk full, bad runner): report, don't hang
         msg = ("error", f"{type(exc).__name__}: {exc}", traceback.format_exc())
     try:
         conn.send(msg)
+    except OSError:
+        pass              # the sweep is gone (a broken pipe): the case directory is installed anyway
     finally:
         conn.close()
 
@@ -89,7 +136,7 @@ def run_local(tasks, workers: int, runner, ctx, on_record, on_running, on_failur
                 task = queue.popleft()
                 attempts[task["case"]] = attempts.get(task["case"], 0) + 1
                 r, w = ctx.Pipe(duplex=False)
-                proc = ctx.Process(target=_child, args=(task, runner, w), daemon=True,
+                proc = ctx.Process(target=_child, args=(task, runner, w, os.getpid()), daemon=True,
                                    name=f"exucable-case-{task['case']}")
                 proc.start()
                 w.close()   # the child holds the write end; EOF here once it is gone

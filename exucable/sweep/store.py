@@ -6,7 +6,8 @@ Layout of ``DIR``::
     DIR/sweep.csv               one row per case (rewritten atomically after each finished case)
     DIR/sweep.png               output against the first varied key
     DIR/cases/<hash>/           one finished case: run_scenario's files + case.json
-    DIR/cases/.<hash>.tmp-<pid> a case being run (never read; removed when a new run starts)
+    DIR/cases/.<hash>.tmp-<pid> a case being run by process <pid> (never read; removed by a later
+                                run once that process is gone)
 
 A case directory appears under its final name only by one ``os.rename`` of a complete temporary
 directory, so a kill at any moment leaves either the whole case or nothing. ``case.json`` is the
@@ -21,15 +22,17 @@ import io
 import json
 import math
 import os
+import re
 import shutil
 from pathlib import Path
 
 from ..errors import ExucableError
-from ..io import atomic_write_text
+from ..io import atomic_write_text, pid_alive, remove_stale_temporaries
 
 __all__ = [
     "CASES_DIR", "CASE_JSON", "MANIFEST", "TABLE", "FINISHED", "RESULT_COLUMNS", "RECORD_OUTPUTS",
-    "case_dir", "temp_dir", "read_record", "is_finished", "write_record", "install_case", "remove_stale",
+    "case_dir", "temp_dir", "read_record", "read_verified_record", "files_intact", "is_finished",
+    "write_record", "install_case", "remove_stale",
     "write_manifest", "read_manifest", "make_row", "rows_from_disk", "table_columns", "write_table",
     "read_table", "SweepLock",
 ]
@@ -74,6 +77,41 @@ def read_record(path) -> dict | None:
     return rec if isinstance(rec, dict) else None
 
 
+def files_intact(path, record: dict) -> bool:
+    """Whether a case directory still holds what its record says it finished with.
+
+    Every file the record lists under ``files`` (relative path → bytes) must be there with that
+    size, and a ``summary.json`` must parse as a JSON object with the record's status. Records
+    written before ``files`` existed are checked on ``summary.json`` alone, when it is there.
+    """
+    path = Path(path)
+    listed = record.get("files")
+    if isinstance(listed, dict):
+        for rel, size in listed.items():
+            try:
+                if (path / rel).stat().st_size != size:
+                    return False
+            except OSError:
+                return False
+    summary = path / "summary.json"
+    if not summary.exists():
+        return not (isinstance(listed, dict) and "summary.json" in listed)
+    try:
+        data = json.loads(summary.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and data.get("status", record.get("status")) == record.get("status")
+
+
+def read_verified_record(path) -> dict | None:
+    """:func:`read_record`, but None for a finished case whose files are damaged or gone
+    (:func:`files_intact`): such a case is run again, not skipped."""
+    rec = read_record(path)
+    if is_finished(rec) and not files_intact(path, rec):
+        return None
+    return rec
+
+
 def is_finished(record: dict | None) -> bool:
     """True if ``record`` is a successfully finished case (status ok or steady)."""
     return record is not None and record.get("status") in FINISHED
@@ -110,11 +148,11 @@ def install_case(tmp: Path, final: Path) -> dict:
     """Move a complete temporary case directory to its final name, atomically.
 
     A finished case already at ``final`` is never replaced (nothing twice: a task that ran
-    twice, e.g. after a lost Dask worker, keeps the first result); a failed one is replaced by
-    renaming it aside first. Returns the record now at ``final``.
+    twice, e.g. after a lost Dask worker, keeps the first result); a failed or damaged one is
+    replaced by renaming it aside first. Returns the record now at ``final``.
     """
     tmp, final = Path(tmp), Path(final)
-    existing = read_record(final)
+    existing = read_verified_record(final)
     if is_finished(existing):
         shutil.rmtree(tmp, ignore_errors=True)
         return existing
@@ -136,16 +174,24 @@ def install_case(tmp: Path, final: Path) -> dict:
     return rec
 
 
+_OWNED = re.compile(r"^\.[0-9a-f]+\.(?:tmp|old)-(\d+)(?:-parent)?$")
+
+
 def remove_stale(cases_dir) -> int:
-    """Remove temporary and set-aside case directories left by killed runs; returns how many."""
+    """Remove the temporary and set-aside case directories of processes that are gone; returns
+    how many. A directory whose process is alive (a case still running, e.g. one of a sweep killed
+    a moment ago) is left to it: deleting it would lose that case's files under its feet."""
     cases_dir = Path(cases_dir)
     n = 0
     if not cases_dir.is_dir():
         return 0
+    remove_stale_temporaries(cases_dir)
     for p in cases_dir.iterdir():
-        if p.name.startswith(".") and (".tmp-" in p.name or ".old-" in p.name):
-            shutil.rmtree(p, ignore_errors=True)
-            n += 1
+        m = _OWNED.match(p.name)
+        if m is None or pid_alive(int(m.group(1))):
+            continue
+        shutil.rmtree(p, ignore_errors=True)
+        n += 1
     return n
 
 
@@ -196,7 +242,7 @@ def rows_from_disk(out_dir) -> list[dict]:
     man = read_manifest(out_dir)
     keys = man["keys"]
     extra = _extra_columns(man.get("output", "pull_force_N"))
-    return [make_row(keys, c["params"], c["case"], read_record(case_dir(out_dir, c["case"])), extra)
+    return [make_row(keys, c["params"], c["case"], read_verified_record(case_dir(out_dir, c["case"])), extra)
             for c in man["cases"]]
 
 

@@ -30,7 +30,7 @@ from pathlib import Path
 from ..version import __version__
 from ..io import atomic_write_bytes, atomic_write_text
 from ..scenario.specs import parse_scenario
-from .store import CASE_JSON, RECORD_OUTPUTS, install_case, is_finished, read_record, temp_dir, write_record
+from .store import CASE_JSON, RECORD_OUTPUTS, install_case, is_finished, read_verified_record, temp_dir, write_record
 
 __all__ = ["default_runner", "execute_case", "run_case", "run_case_packed", "install_packed",
            "record_failure"]
@@ -101,6 +101,9 @@ def execute_case(task: dict, workdir, runner=None) -> dict:
         record["message"] = f"{type(exc).__name__}: {exc}"
         atomic_write_text(workdir / "error.txt", traceback.format_exc())
     record["wall_time_s"] = time.perf_counter() - t0
+    # what the case finished with, so a later run can tell a damaged case from a finished one
+    record["files"] = {p.relative_to(workdir).as_posix(): p.stat().st_size for p in sorted(workdir.rglob("*"))
+                       if p.is_file() and p.name != CASE_JSON and not p.name.startswith(".")}
     write_record(workdir, _stamp(record, task))
     return record
 
@@ -112,7 +115,7 @@ def run_case(task: dict, runner=None) -> dict:
     """
     cases_dir = Path(task["cases_dir"])
     final = cases_dir / task["case"]
-    existing = read_record(final)
+    existing = read_verified_record(final)
     if is_finished(existing):
         return existing
     tmp = temp_dir(cases_dir, task["case"], os.getpid())

@@ -42,3 +42,19 @@ def dying_runner(scenario, out_dir, quiet=True, plots=True):
     summary = {"status": "ok", "message": "", "pull_force_N": T2 * math.exp(mu * math.pi / 2)}
     Path(out_dir, "summary.json").write_text(json.dumps(summary))
     return summary
+
+
+def quick_runner(scenario, out_dir, quiet=True, plots=True):
+    """A stand-in: the capstan force for friction mu, written as summary.json and a one-row
+    history.csv (the files a finished case is verified by)."""
+    T2 = scenario.pull.back_tension_N
+    summary = {"status": "ok", "message": "", "pull_force_N": T2 * math.exp(scenario.contact.friction * math.pi / 2)}
+    Path(out_dir, "history.csv").write_text(f"time_s,pull_force_N\n0.0,{summary['pull_force_N']!r}\n")
+    Path(out_dir, "summary.json").write_text(json.dumps(summary))
+    return summary
+
+
+def sleeping_runner(scenario, out_dir, quiet=True, plots=True):
+    """A stand-in that computes for a minute (a case the tests kill its sweep under)."""
+    time.sleep(60)
+    return quick_runner(scenario, out_dir, quiet, plots)
