@@ -64,6 +64,9 @@ MAX_LENGTH_M = 1.0e5          # a route piece, bend radius or helix pitch up to 
 MIN_PIECE_M = 1.0e-6          # a straight shorter than 1 µm is no piece of a conduit
 _PIECE_WHY = "route pieces from 1 µm to 100 km"
 MAX_HELIX_TURNS = 1000.0
+# a curve turning less than 1e-6° is no bend: its segments would be shorter than round-off
+MIN_TURN_DEG = 1.0e-6
+_TURN_WHY = f"a curve turns at least {MIN_TURN_DEG:g}° (shorter segments are lost in round-off) and a helix at most {MAX_HELIX_TURNS:g} turns"
 MAX_PIECES = 10_000           # path pieces
 MAX_POINTS = 100_000          # survey points
 MAX_SEGMENTS = 200_000        # straight contact segments of the conduit
@@ -141,6 +144,8 @@ class _Spec:
     _SECTION: ClassVar[str] = ""
     #: Attributes ``to_dict`` leaves out (derived from another key that is echoed).
     _NOT_ECHOED: ClassVar[frozenset[str]] = frozenset()
+    #: Attributes with a default that are None when another key replaces them.
+    _NONE_MEANS_NOT_USED: ClassVar[frozenset[str]] = frozenset()
 
     def __post_init__(self):
         derived = set()
@@ -153,6 +158,10 @@ class _Spec:
                     raise ScenarioError(f.key, f"required key is missing: give {_what(f)}")
                 if f.derived:
                     derived.add(f.attr)
+                elif f.default is not None and f.attr not in self._NONE_MEANS_NOT_USED:
+                    # a file cannot say None: leaving the key out gives its default
+                    raise ScenarioError(f.key, f"must be {_what(f)}, got None; leave the key out for its default "
+                                               f"{f.default!r}")
                 continue
             object.__setattr__(self, f.attr, _coerce(f, value))
         # Not a dataclass field: no part in equality, hashing or repr.
@@ -273,6 +282,11 @@ class CableSpec(_Spec):
             given = self.mass_per_length_kg_per_m
             if given is not None and not math.isclose(given, from_density, rel_tol=1e-12):
                 raise ScenarioError("cable.mass_per_length", "give either density or mass_per_length, not both")
+            row = _FIELD_BY_KEY["cable.mass_per_length"]
+            if not row.ge <= from_density <= row.le:
+                raise ScenarioError("cable.density", f"gives a mass per length ρ·π r² = {from_density!r} kg/m with "
+                                                     f"cable.radius {self.radius_m!r} m, outside {row.ge:g} … "
+                                                     f"{row.le:g} kg/m ({row.why})")
             object.__setattr__(self, "mass_per_length_kg_per_m", from_density)
 
     @property
@@ -343,6 +357,7 @@ class ConduitSpec(_Spec):
     """
 
     _SECTION: ClassVar[str] = "conduit"
+    _NONE_MEANS_NOT_USED: ClassVar[frozenset[str]] = frozenset({"max_segment_angle_deg"})   # segments_per_bend given
 
     inner_radius_m: float = _default("conduit.inner_radius")
     start_m: tuple[float, float, float] = _default("conduit.start")
@@ -879,6 +894,10 @@ class Scenario:
         conduit_length_m = _conduit_length_m(conduit)
         # A relative tolerance absorbs float round-off when the length is written as the sum
         # of the route's pieces (e.g. ex1: 50 m cable in a 50 m conduit).
+        shortest = _FIELD_BY_KEY["cable.length"].ge
+        if self.cable.length_m is None and conduit_length_m < shortest:
+            raise ScenarioError("conduit.path", f"the route is {conduit_length_m:.3g} m long, and so the cable: at least "
+                                                f"{shortest:g} m ({_FIELD_BY_KEY['cable.length'].why})")
         if self.cable.length_m is not None and self.cable.length_m > conduit_length_m * (1.0 + 1e-9):
             raise ScenarioError(
                 "cable.length",
@@ -979,7 +998,9 @@ class Scenario:
         """
         from .dotted import parse_key, set_value  # pure-dict helpers shared with sweeps
 
-        d = self.to_dict()
+        # quantities as "<value> <SI unit>": read as the same numbers whatever display.units becomes
+        # (bare numbers would be re-read in the new unit system)
+        d = _quantities_as_si_strings(self.to_dict())
         for part in ("cable", "contact", "solver"):
             for name in getattr(self, part).derived_keys:
                 d[part].pop(name, None)
@@ -1020,6 +1041,9 @@ def read_toml(path: Path, what: str = "scenario") -> dict:
         raise ScenarioError("", f"{path}: TOML syntax error: {exc}") from None
     except UnicodeDecodeError as exc:
         raise ScenarioError("", f"{path}: not UTF-8 text: {exc}") from None
+    except RecursionError:
+        raise ScenarioError("", f"{path}: nested too deeply to read (arrays or tables within each other "
+                                "hundreds of levels deep)") from None
 
 
 def load_scenario(path) -> Scenario:
@@ -1195,7 +1219,7 @@ def _describe(value) -> str:
     if isinstance(value, numbers.Real):
         return f"a float ({float(value)!r})"
     if isinstance(value, str):
-        return f"a string ({value!r})"
+        return f"a string ({value!r})" if len(value) <= 80 else f"a string of {len(value)} characters ({value[:40]!r}...)"
     if isinstance(value, dict):
         return "a table"
     if isinstance(value, (list, tuple)):
@@ -1505,7 +1529,7 @@ def _parse_path(value, inner_radius: float) -> tuple:
             if kind == "straight":
                 item = _geo.Straight(t.number("straight", "m", gt=0.0, ge=MIN_PIECE_M, le=MAX_LENGTH_M, why=_PIECE_WHY))
             elif kind == "bend":
-                angle = t.number("bend", "deg", gt=0.0, lt=360.0)
+                angle = t.number("bend", "deg", gt=0.0, ge=MIN_TURN_DEG, lt=360.0, why=_TURN_WHY)
                 radius = _curve_radius(t, inner_radius)
                 if t.has("turn") and t.has("axis"):
                     raise ScenarioError(t.k("axis"), "give either turn or axis, not both")
@@ -1517,7 +1541,7 @@ def _parse_path(value, inner_radius: float) -> tuple:
                 axis = t.vector3("axis", "", default=None, nonzero=True)
                 item = _geo.Bend(angle, radius, turn=turn, axis=axis)
             else:
-                turns = t.number("helix_turns", "", gt=0.0, le=MAX_HELIX_TURNS, why=_SIZE_WHY)
+                turns = t.number("helix_turns", "", gt=0.0, ge=MIN_TURN_DEG / 360.0, le=MAX_HELIX_TURNS, why=_TURN_WHY)
                 radius = _curve_radius(t, inner_radius)
                 # Negative pitch descends; zero pitch over more than one turn is refused by geometry.
                 pitch = t.number("pitch", "m", ge=-MAX_LENGTH_M, le=MAX_LENGTH_M, why=_PIECE_WHY)
