@@ -719,7 +719,7 @@ class DisplaySpec(_Spec):
 
 def _curved_turning_deg(conduit: ConduitSpec) -> list[float]:
     """Turning of each curved piece of a route before it is built [deg] (a helix: 360° a turn, an
-    upper bound; a survey fillet: at most 180°)."""
+    upper bound; a survey fillet: the angle between its legs)."""
     if conduit.path is not None:
         out = []
         for item in conduit.path:
@@ -728,7 +728,14 @@ def _curved_turning_deg(conduit: ConduitSpec) -> list[float]:
             elif isinstance(item, _geo.Helix):
                 out.append(360.0 * float(item.turns))
         return out
-    return [180.0] * max(len(conduit.points_m) - 2, 0)
+    # a survey fillet turns by the angle between its two legs
+    legs = [tuple(b - a for a, b in zip(p, q)) for p, q in zip(conduit.points_m[:-1], conduit.points_m[1:])]
+    out = []
+    for u, v in zip(legs[:-1], legs[1:]):
+        nu, nv = math.hypot(*u), math.hypot(*v)
+        cos = sum(a * b for a, b in zip(u, v)) / (nu * nv) if nu > 0.0 and nv > 0.0 else 1.0
+        out.append(math.degrees(math.acos(min(1.0, max(-1.0, cos)))))
+    return out
 
 
 def _check_sizes(sc: "Scenario") -> None:
