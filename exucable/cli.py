@@ -85,6 +85,37 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print(f"exucable {args.command}: interrupted", file=sys.stderr)
         return 130
+    except (MemoryError, RecursionError) as exc:
+        # an input too large or too deeply nested for this machine: the user's to change
+        print(f"exucable {args.command}: error: the input is too large or too deeply nested to process "
+              f"({type(exc).__name__}){_logged(args.command, argv)}", file=sys.stderr)
+        return 2
+    except Exception as exc:  # an internal error: one line here, the traceback in a log file
+        print(f"exucable {args.command}: internal error: {type(exc).__name__}: {_one_line(exc)}"
+              f"{_logged(args.command, argv)}; please report it with that file", file=sys.stderr)
+        return 3
+
+
+def _one_line(exc: BaseException, limit: int = 300) -> str:
+    text = " ".join(str(exc).split())
+    return text if len(text) <= limit else text[:limit] + " ..."
+
+
+def _logged(command: str, argv) -> str:
+    """Write the current exception's traceback to a log file; `` (details in PATH)`` or ``""``."""
+    import os
+    import tempfile
+    import time
+    import traceback
+
+    from .io import atomic_write_text
+
+    path = os.path.join(tempfile.gettempdir(), f"exucable-{command}-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}.log")
+    try:
+        atomic_write_text(path, f"exucable {' '.join(map(str, argv))}\n\n{traceback.format_exc()}")
+    except Exception:      # the log is a courtesy: its own failure must not raise a second traceback
+        return ""
+    return f" (details in {path})"
 
 
 if __name__ == "__main__":

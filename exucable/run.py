@@ -20,7 +20,7 @@ from .output.results import RunResult, write_results
 from .scenario.specs import Scenario, load_scenario
 from .post.pressure import bend_table, default_window_m, pressure_profile
 from .post.tension import SteadyState, detect_steady_state, tension_at, tension_profile
-from .post.trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
+from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile"]
 
@@ -132,7 +132,16 @@ def _assess(model, out, st, h, pull_force_N):
         pull_force_N=(model.rope.pull_force_N if model.rope is not None
                       else pull_force_N if pull_force_N is not None else float("nan")),
         steady_window_s=sc.solver.steady_window_s, steady_tolerance=sc.solver.steady_tolerance,
-        end_time_s=out.end_time_s, base_status=out.status)
+        end_time_s=out.end_time_s, base_status=out.status, loaded=is_loaded(sc), friction=sc.contact.friction,
+        regularisation_velocity_m_per_s=(sc.contact.friction_regularisation_velocity_m_per_s
+                                         if sc.solver.mode == "dynamic" else None))
+
+
+def is_loaded(sc) -> bool:
+    """Whether anything loads the cable: gravity, a back tension or a prescribed pulling force.
+    Without, the quasi-static pulling force is 0 N (a valid answer)."""
+    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
+    return g > 0.0 or sc.pull.back_tension_N > 0.0 or sc.pull.force_N is not None
 
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
@@ -279,8 +288,13 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     if out.status == "failed":
         summary["failed_at_s"] = out.end_time_s
     summary["status"], summary["flags"] = _assess(model, out, st, h, summary["pull_force_N"])
+    if not is_loaded(sc):
+        summary["warnings"].append("no load acts on the cable (no gravity, pull.back_tension 0, no pull.force): its "
+                                   "rope reference is 0 N; what the run reports is the bending stiffness's share and "
+                                   f"inertia's, of the order of ρA·v² = {sc.cable.mass_per_length_kg_per_m * sc.pull.speed_m_per_s**2:.3g} N")
     summary["trust_limits"] = {"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
                                "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
+                               "friction_deficit_fraction_of_mu": FRICTION_DEFICIT_LIMIT,
                                "outside": "cable axis farther from the conduit axis than its inner radius"}
     if summary["flags"] and not summary["message"]:
         summary["message"] = "; ".join(f["message"] for f in summary["flags"])

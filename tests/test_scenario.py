@@ -258,7 +258,7 @@ def test_defaults_filled():
     assert (c.stiffness, c.damping, c.exponent, c.friction) == (1.0e6, 1.0e3, 1.5, 0.0)
     assert c.static_friction is None
     assert c.stribeck_velocity_m_per_s == 0.01
-    assert c.friction_regularisation_velocity_m_per_s == 1.0e-3
+    assert c.friction_regularisation_velocity_m_per_s == pytest.approx(0.01 * s.pull.speed_m_per_s, rel=1e-15)
     assert c.check_points_per_element is None and c.check_point_rule == "gauss"   # None: the mesh rule
     assert c.reference_spacing_m == 1.0e-3 and c.broad_phase == "aabb"
     p = s.pull

@@ -28,6 +28,11 @@ CONVERGE_COLUMNS = ("level", "refine", "elements", "element_length_m", "check_po
                     "uncertainty_N", "drift_N_per_s", "wall_time_s")
 
 
+# levels of refinement: 8 at ratio 2 are 128x the first mesh's elements (the model's check-point
+# bound, exucable.scenario.mesh.MAX_MODEL_CHECK_POINTS, refuses a level beyond memory)
+MAX_LEVELS = 8
+
+
 def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool = True, progress=None,
              mode: str | None = None) -> dict:
     """Run ``scenario`` on ``levels`` meshes refined by ``ratio``; returns the report (also written).
@@ -37,8 +42,9 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
     The quantity is the run's steady quantity: the pulling force, or for a force-controlled pull
     the trailing tension [N]. ``progress(level, summary)`` is called after each level.
     """
-    if levels < 3:
-        raise ValueError("converge: at least 3 levels are needed for an observed order")
+    if not 3 <= levels <= MAX_LEVELS:
+        raise ValueError(f"converge: 3 to {MAX_LEVELS} levels (an observed order needs three meshes; each level "
+                         "multiplies the elements by the ratio)")
     sc = scenario if not isinstance(scenario, (str, Path)) else load_scenario(scenario)
     out = Path(out_dir)
     rows, statuses = [], []
@@ -99,8 +105,14 @@ def main(args) -> int:
     if args.levels < 3:
         print("exucable converge: error: --levels: at least 3 (an observed order needs three meshes)", file=sys.stderr)
         return 2
-    if not args.ratio > 1.0:
-        print(f"exucable converge: error: --ratio: must be > 1, got {args.ratio}", file=sys.stderr)
+    if args.levels > MAX_LEVELS:
+        print(f"exucable converge: error: --levels: at most {MAX_LEVELS} (each level refines the mesh by --ratio: "
+              f"{MAX_LEVELS} levels at ratio 2 are already {2 ** (MAX_LEVELS - 1)}x the elements), got {args.levels}",
+              file=sys.stderr)
+        return 2
+    if not 1.0 < args.ratio <= 10.0:
+        print(f"exucable converge: error: --ratio: must be > 1 and <= 10 (each level multiplies the elements by it), "
+              f"got {args.ratio}", file=sys.stderr)
         return 2
     out = check_out_dir(Path(args.out) if args.out else default_out_dir(sc.name, suffix="-converge"))
     from .compile import announce_compiling

@@ -35,6 +35,14 @@ def _f(value, fmt=".6g") -> str:
     return "n/a" if value is None or not np.isfinite(value) else format(value, fmt)
 
 
+def _versus(got: float, ref: float) -> str:
+    """``got`` against ``ref`` in per cent, or in newtons where the reference is zero (no load: a
+    relative difference does not exist)."""
+    if ref != 0.0 and np.isfinite(ref):
+        return f"{100 * (got / ref - 1):+.3f} %"
+    return f"{got - ref:+.3g} N"
+
+
 def main(args) -> int:
     sc = load_scenario(args.scenario)
     out_dir = Path(args.out) if args.out else default_out_dir(sc.name)
@@ -52,10 +60,10 @@ def main(args) -> int:
     else:
         ref, got, what = rope, s["pull_force_N"], "pulling force"
     if ref is not None and got is not None and np.isfinite(got):
-        print(f"  rope reference: {what} {ref:.6g} N ({100 * (got / ref - 1):+.3f} %)")
+        print(f"  rope reference: {what} {ref:.6g} N ({_versus(got, ref)})")
     ref_c = s.get("rope_clearance_pull_force_N")
     if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
-        print(f"  rope with clearance: pulling force {ref_c:.6g} N ({100 * (got / ref_c - 1):+.3f} %)")
+        print(f"  rope with clearance: pulling force {ref_c:.6g} N ({_versus(got, ref_c)})")
     if s.get("mode") == "steady":
         print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
               f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")

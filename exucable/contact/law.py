@@ -68,7 +68,8 @@ class ContactLaw:
     friction: float = default_of("contact.friction")
     static_friction: float | None = default_of("contact.static_friction")
     stribeck_velocity_m_per_s: float = default_of("contact.stribeck_velocity")
-    regularisation_velocity_m_per_s: float = default_of("contact.friction_regularisation_velocity")
+    # 1 % of the paper's 0.1 m/s; a scenario sets 1 % of its own pull speed (scenarios/README.md)
+    regularisation_velocity_m_per_s: float = 1.0e-3
     damping_onset_m: float = default_of("contact.damping_onset")
 
     def __post_init__(self):

@@ -18,10 +18,19 @@ N_a N'_b (degree 5, not symmetric in a, b) is a fixed combination of the seven B
 polynomials of degree 6, so seven moments Σ_k B_m(ξ_k) J_k per column of the point Jacobians
 replace the 10 + 16 product sums (:func:`block_coefficients`).
 
-|∂r/∂x| = 1 + ε: the material speed is taken as V (the pull speed) everywhere rather than
-V (1 + ε)/(1 + ε_lead); the difference (strain, < 1e-3 on the paper's examples) changes only the
-regularisation factor V/√(V² + ε²) (by < 1e-6 at V = 0.1 m/s, ε = 1e-3 m/s) and the contact
-damping's share, whose entry and exit contributions cancel along a contact zone.
+Friction is fully developed sliding friction: every point in contact slides at |v_τ| ≈ V > 0,
+so the dynamic law's regularisation v_τ/√(|v_τ|² + ε²) (a smoothing of the stick/slip switch at
+v_τ = 0, which steady sliding never reaches) would only scale μ by V/√(V² + ε²) and make the
+pulling force depend on the pull speed (−8.8 % at V = ε). The steady kernel therefore uses
+ε = :data:`STEADY_REGULARISATION_FRACTION` · V: the factor is 1 − 5e-13 at every speed, the
+Jacobian formulas (in s = √(|v_τ|² + ε²)) stay exact, and a point whose v_τ vanished would still
+get a finite (zero) friction force. A Stribeck law (``contact.static_friction``) stays a function
+of the sliding speed |v_τ| ≈ V: it is a physical law the user chose, not a numerical device.
+
+|∂r/∂x| = 1 + ε_axial: the material speed is taken as V (the pull speed) everywhere rather than
+V (1 + ε_axial)/(1 + ε_lead); the difference (strain, < 1e-3 on the paper's examples) changes only
+the Stribeck factor and the contact damping's share, whose entry and exit contributions cancel
+along a contact zone.
 """
 
 from __future__ import annotations
@@ -65,7 +74,12 @@ from .fast import (
 )
 from .smooth import NEWTON_ITERATIONS
 
-__all__ = ["SteadySlidingKernel", "hermite_unit_derivative"]
+__all__ = ["SteadySlidingKernel", "hermite_unit_derivative", "steady_sliding_law", "STEADY_REGULARISATION_FRACTION"]
+
+#: Steady mode's friction regularisation velocity as a fraction of the pull speed [-]: the
+#: regularisation factor 1/√(1 + 1e-12) = 1 − 5e-13 is fully developed sliding at any speed,
+#: while ε > 0 keeps the force finite where v_τ = 0.
+STEADY_REGULARISATION_FRACTION = 1.0e-6
 
 # Degree of the polynomials in ξ whose sums over the check points make the Jacobian blocks:
 # N_a N_b (6) and N_a N'_b (5); see block_coefficients
@@ -92,8 +106,9 @@ class SteadySlidingKernel(ContactKernel):
     derivative (including the velocity's dependence on q) and the ``jac_qt_blocks`` are zero.
     """
 
-    def __init__(self, *args, speed_m_per_s: float, **kwargs):
-        super().__init__(*args, **kwargs)
+    def __init__(self, segments, element_length_m, cable_radius_m, law, *args, speed_m_per_s: float, **kwargs):
+        super().__init__(segments, element_length_m, cable_radius_m, steady_sliding_law(law, speed_m_per_s),
+                         *args, **kwargs)
         self.speed_m_per_s = float(speed_m_per_s)
         self._dnh = hermite_unit_derivative(self.xi)
         self._base_law = self.law
@@ -122,6 +137,27 @@ class SteadySlidingKernel(ContactKernel):
         self._last_point_state = None      # its forces were of the former law
         if isinstance(self._impl, _SteadyFast):
             self._impl.fast.law = law
+
+
+def steady_sliding_law(law, speed_m_per_s: float):
+    """``law`` with its friction fully developed at the sliding speed ``speed_m_per_s`` V [m/s].
+
+    The regularisation velocity becomes :data:`STEADY_REGULARISATION_FRACTION` · V, so that
+    μ v_τ/√(|v_τ|² + ε²) is μ v_τ/|v_τ| to 5e-13 wherever |v_τ| ≈ V (module docstring).
+
+    Parameters
+    ----------
+    law : exucable.contact.ContactLaw
+    speed_m_per_s : float
+        Pull speed V > 0 [m/s].
+
+    Returns
+    -------
+    exucable.contact.ContactLaw
+    """
+    if not speed_m_per_s > 0.0:
+        raise ValueError(f"steady sliding needs a pull speed > 0 m/s, got {speed_m_per_s!r}")
+    return replace(law, regularisation_velocity_m_per_s=STEADY_REGULARISATION_FRACTION * float(speed_m_per_s))
 
 
 class _SteadyReference(ReferenceKernel):

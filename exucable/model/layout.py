@@ -236,7 +236,11 @@ def lay_cable(
     speed_geom = np.linalg.norm(dP, axis=1)              # dσ/ds of the offset path
     stretch = 1.0 + T / axial_stiffness_N                # dσ/dx
     if np.any(stretch <= 0.5) or np.any(stretch > 1.5):
-        raise ValueError("tension profile implies a strain beyond ±50 %: check EA and the loads")
+        from ..errors import ModelError
+        raise ModelError("cable.youngs_modulus",
+                         f"the rope's tension (up to {float(np.max(np.abs(T))):.4g} N) would stretch the cable by "
+                         f"more than 50 % (EA = {axial_stiffness_N:.4g} N): the cable is far too soft for its loads; "
+                         "check cable.youngs_modulus (Pa), cable.radius and the loads")
     dx_ds = speed_geom / stretch
     x = np.concatenate([[0.0], np.cumsum(0.5 * (dx_ds[1:] + dx_ds[:-1]) * np.diff(s))])
     x_nodes = np.linspace(0.0, cable_length_m, n_elements + 1)

@@ -237,8 +237,11 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
     a = window_m / 2
 
     def body_pressure(x):
-        """The rope's pressure scaled by the cable's own tension over the rope's there [N/m]."""
-        return np.interp(x, rope_T[0], rope_p) * np.interp(x, *cab_T) / np.interp(x, *rope_T)
+        """The rope's pressure scaled by the cable's own tension over the rope's there [N/m]; 0
+        where the rope is slack (no load: its pressure is 0 and the scale undefined)."""
+        t_rope = np.interp(x, *rope_T)
+        scale = np.divide(np.interp(x, *cab_T), t_rope, out=np.zeros_like(t_rope), where=t_rope > 0.0)
+        return np.interp(x, rope_T[0], rope_p) * scale
 
     rows = []
     bends = [_Piece(p.s_start_m, p.s_end_m, p.radius_of_curvature_m, float(np.degrees(p.turning_angle_rad)))

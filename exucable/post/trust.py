@@ -17,6 +17,11 @@ Outside — the cable's axis farther from the conduit's axis than the inner radi
 the cable is outside its conduit.
 ``DYNAMIC_LIMIT`` — ρA·v² / pulling force (the rope's, when there is one) above this: the quasi-static capstan relation on which the
 pull rests shifts by about ρA·v²(e^{μθ}−1) (the centrifugal load ρA·v²·κ offsets T·κ on the wall).
+``FRICTION_DEFICIT_LIMIT`` — dynamic mode: the regularised friction μ v/√(v² + ε²) at the pull speed
+V falls short of μ by more than this fraction (ε = ``contact.friction_regularisation_velocity``):
+the friction is not fully developed and the pulling force comes out low (the unsafe side).
+A scenario without any load (no gravity, back tension or prescribed force) has a quasi-static
+pulling force of 0 N: ρA·v² has nothing to be compared with, and the zero answer stands.
 Not steady — no window of ``solver.steady_window`` in which drift and scatter stay within
 ``solver.steady_tolerance``.
 """
@@ -29,14 +34,22 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["AxisGauge", "cable_sample_points", "PullForceEstimate", "pull_force_uncertainty", "assess",
-           "PENETRATION_LIMIT", "DYNAMIC_LIMIT", "TRUSTED_STATUSES"]
+           "PENETRATION_LIMIT", "DYNAMIC_LIMIT", "FRICTION_DEFICIT_LIMIT", "TRUSTED_STATUSES", "friction_factor"]
 
 PENETRATION_LIMIT = 0.25
 DYNAMIC_LIMIT = 0.01
+# 1e-4 of μ: the capstan force's error μθ·deficit stays below 0.05 % up to μθ = 5 (a long route)
+FRICTION_DEFICIT_LIMIT = 1.0e-4
 TRUSTED_STATUSES = ("ok", "steady")
 # order of precedence: the run's status names the first that applies. A pull fast enough for
 # inertia to matter is named before what it causes (a whipping cable pressed into or out of the wall).
-_SEVERITY = ("failed", "dynamic", "outside_conduit", "penetration", "not_steady")
+_SEVERITY = ("failed", "dynamic", "friction_underdeveloped", "outside_conduit", "penetration", "not_steady")
+
+
+def friction_factor(speed_m_per_s: float, regularisation_velocity_m_per_s: float) -> float:
+    """V/√(V² + ε²) [-]: the share of μ the regularised friction law develops at sliding speed V."""
+    v, eps = float(speed_m_per_s), float(regularisation_velocity_m_per_s)
+    return v / math.hypot(v, eps) if v > 0.0 else 0.0
 
 
 def cable_sample_points(coordinates, element_length_m) -> np.ndarray:
@@ -166,15 +179,21 @@ def assess(*, failed: bool, steady: bool, max_penetration_m: float, max_penetrat
            max_axis_offset_s_conduit_m: float, clearance_m: float, cable_radius_m: float, inner_radius_m: float,
            mass_per_length_kg_per_m: float, speed_m_per_s: float, pull_force_N: float,
            steady_window_s: float, steady_tolerance: float, end_time_s: float,
-           base_status: str) -> tuple[str, list[dict]]:
+           base_status: str, loaded: bool = True, friction: float = 0.0,
+           regularisation_velocity_m_per_s: float | None = None) -> tuple[str, list[dict]]:
     """The run's status and its flags (see the module docstring).
+
+    ``loaded`` False (no gravity, back tension or prescribed force) skips the inertia check: the
+    quasi-static pulling force is 0 N. ``regularisation_velocity_m_per_s`` ε (dynamic mode; None in
+    steady mode, whose friction is fully developed) with ``friction`` μ > 0 checks the friction law's
+    development at the pull speed.
 
     Returns
     -------
     status : str
         ``base_status`` ("ok"/"steady"/"failed") when nothing is flagged, else the first flag
-        found of ``"failed"``, ``"dynamic"``, ``"outside_conduit"``, ``"penetration"``,
-        ``"not_steady"``.
+        found of ``"failed"``, ``"dynamic"``, ``"friction_underdeveloped"``, ``"outside_conduit"``,
+        ``"penetration"``, ``"not_steady"``.
     flags : list of dict
         Each with ``flag``, ``message``, and where known ``time_s`` and ``s_conduit_m`` (along the
         scenario's conduit).
@@ -196,13 +215,24 @@ def assess(*, failed: bool, steady: bool, max_penetration_m: float, max_penetrat
                                  f"min(clearance, cable radius) = {1e3 * limit:.3g} mm at s = {max_penetration_s_conduit_m:.4g} m, "
                                  f"t = {max_penetration_time_s:.4g} s (raise contact.stiffness)"})
     ratio = mass_per_length_kg_per_m * speed_m_per_s**2 / max(abs(pull_force_N), 1e-12) \
-        if np.isfinite(pull_force_N) else float("nan")
+        if np.isfinite(pull_force_N) and loaded else float("nan")
     if np.isfinite(ratio) and ratio > DYNAMIC_LIMIT:
         flags.append({"flag": "dynamic", "value": ratio, "limit": DYNAMIC_LIMIT,
                       "message": f"ρA·v² = {mass_per_length_kg_per_m * speed_m_per_s**2:.4g} N is "
                                  f"{100 * ratio:.3g} % of the pulling force (> {100 * DYNAMIC_LIMIT:g} %): inertia "
                                  f"changes the wall loads; the quasi-static answer and its rope reference do not apply "
                                  f"(lower pull.speed)"})
+    if regularisation_velocity_m_per_s is not None and friction > 0.0:
+        factor = friction_factor(speed_m_per_s, regularisation_velocity_m_per_s)
+        if 1.0 - factor > FRICTION_DEFICIT_LIMIT:
+            # V/√(V² + ε²) ≥ 1 - limit  ⇔  ε ≤ V √((1 - limit)^-2 - 1)
+            eps_max = speed_m_per_s * math.sqrt((1.0 - FRICTION_DEFICIT_LIMIT) ** -2 - 1.0)
+            flags.append({"flag": "friction_underdeveloped", "value": 1.0 - factor, "limit": FRICTION_DEFICIT_LIMIT,
+                          "message": f"at pull.speed {speed_m_per_s:.3g} m/s the regularised friction develops only "
+                                     f"{100 * factor:.4g} % of μ (contact.friction_regularisation_velocity "
+                                     f"{regularisation_velocity_m_per_s:.3g} m/s): the pulling force comes out low; "
+                                     f"set contact.friction_regularisation_velocity <= {eps_max:.2g} m/s "
+                                     f"(or use solver.mode = \"steady\")"})
     if not steady and not failed:
         flags.append({"flag": "not_steady", "time_s": end_time_s,
                       "message": f"no final window of {steady_window_s:g} s (solver.steady_window) in which drift and "

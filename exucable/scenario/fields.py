@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 __all__ = ["REQUIRED", "Field", "FIELDS", "SECTIONS", "fields_of", "default_of", "markdown_table", "format_default",
-           "readme_with_tables"]
+           "readme_with_tables", "range_text"]
 
 
 class _Required:
@@ -88,6 +88,11 @@ class Field:
         The default is computed from other values (so ``Scenario.replace`` re-derives it).
     nonzero : bool
         For ``vector3``: refuse [0, 0, 0].
+    why : str
+        Why the outer bounds are where they are (a plausibility range, or what keeps the run finite):
+        said in the error message and the README's rule.
+    max_abs : float or None
+        For ``vector3``: largest magnitude of a component.
     """
 
     key: str
@@ -106,6 +111,8 @@ class Field:
     ours: bool = False
     derived: bool = False
     nonzero: bool = False
+    why: str = ""
+    max_abs: float | None = None
 
     @property
     def section(self) -> str:
@@ -139,26 +146,26 @@ FIELDS: tuple[Field, ...] = (
     F("name", "name", "str", default=None, derived=True, default_doc="file stem", rule="non-empty string"),
     F("description", "description", "str", default="", rule="string"),
     # ---- cable (paper Sect. 2.2)
-    F("cable.radius", "radius_m", "float", "m", gt=0.0, rule="> 0"),
-    F("cable.density", "density_kg_per_m3", "float", "kg/m^3", None, unit_doc="kg/m³", gt=0.0, default_doc="—",
-      rule="> 0; give exactly one of `density`, `mass_per_length`"),
-    F("cable.mass_per_length", "mass_per_length_kg_per_m", "float", "kg/m", None, gt=0.0, default_doc="—",
-      rule="> 0"),
-    F("cable.youngs_modulus", "youngs_modulus_Pa", "float", "Pa", gt=0.0, rule="> 0"),
-    F("cable.bending_stiffness", "bending_stiffness_given_N_m2", "float", "N m^2", None, unit_doc="N m²", gt=0.0,
+    F("cable.radius", "radius_m", "float", "m", gt=0.0, ge=1.0e-5, rule="> 0", le=1.0, why="a cable from 20 µm to 2 m across"),
+    F("cable.density", "density_kg_per_m3", "float", "kg/m^3", None, unit_doc="kg/m³", gt=0.0, ge=1.0, default_doc="—",
+      rule="> 0; give exactly one of `density`, `mass_per_length`", le=1.0e5, why="foam to four times osmium's density"),
+    F("cable.mass_per_length", "mass_per_length_kg_per_m", "float", "kg/m", None, gt=0.0, ge=1.0e-7, default_doc="—",
+      rule="> 0", le=1.0e4, why="a cable's mass per length, a glass fibre to the heaviest submarine cable"),
+    F("cable.youngs_modulus", "youngs_modulus_Pa", "float", "Pa", gt=0.0, ge=1.0e5, rule="> 0", le=1.0e13, why="the range of cable materials, soft rubber to beyond diamond; a value like 1000 is usually MPa written as Pa (1000 MPa = 1e9 Pa)"),
+    F("cable.bending_stiffness", "bending_stiffness_given_N_m2", "float", "N m^2", None, unit_doc="N m²", gt=0.0, ge=1.0e-12,
       ours=True, default_doc="E π r⁴/4",
-      rule="> 0: EJ of a stranded or layered cable, apart from `youngs_modulus` (which still gives EA)"),
+      rule="> 0: EJ of a stranded or layered cable, apart from `youngs_modulus` (which still gives EA)", le=1.0e9, why="a glass fibre to a stiff steel pipe"),
     F("cable.elements", "elements", "int", "", None, ge=1, derived=True,
       default_doc="the mesh rule",
       rule="integer ≥ 1, an override of the mesh rule (below: chord sagitta ≤ 2 clearances and ≤ 0.2 rad "
            "per element on the tightest bend, at least 10); not with `element_length`; refused when the "
-           "sagitta exceeds 16 clearances or an element turns more than 0.5 rad"),
-    F("cable.element_length", "element_length_m", "float", "m", None, gt=0.0, ours=True, default_doc="—",
-      rule="> 0: elements of about this length instead of the mesh rule's; not with `elements`"),
-    F("cable.length", "length_m", "float", "m", None, gt=0.0, default_doc="conduit centreline length",
-      rule="> 0 and ≤ the conduit centreline length"),
+           "sagitta exceeds 16 clearances or an element turns more than 0.5 rad", le=20000, why="keeps the model's memory below a few GB (1 m elements on a 20 km cable)"),
+    F("cable.element_length", "element_length_m", "float", "m", None, gt=0.0, ge=1.0e-4, ours=True, default_doc="—",
+      rule="> 0: elements of about this length instead of the mesh rule's; not with `elements`", le=1.0e4, why="elements from 0.1 mm to 10 km"),
+    F("cable.length", "length_m", "float", "m", None, gt=0.0, ge=1.0e-3, default_doc="conduit centreline length",
+      rule="> 0 and ≤ the conduit centreline length", le=1.0e5, why="a cable from 1 mm to 100 km long"),
     F("cable.damping_time", "damping_time_s", "float", "s", _DAMPING_TIME_S, ge=0.0, ours=True,
-      rule="≥ 0; Kelvin–Voigt τ: axial damping τ·EA [N s], bending damping τ·EJ [N m² s]"),
+      rule="≥ 0; Kelvin–Voigt τ: axial damping τ·EA [N s], bending damping τ·EJ [N m² s]", le=10.0, why="Kelvin–Voigt τ far beyond any cable's (ms)"),
     F("cable.integration", "integration", "choice", "", "lobatto", choices=("lobatto", "reduced", "full"),
       ours=True,
       rule="Exudyn's quadrature of the element forces: `\"lobatto\"`, `\"reduced\"`, `\"full\"` "
@@ -176,14 +183,14 @@ FIELDS: tuple[Field, ...] = (
       rule="`exucable plan`, several cables: `true` (IEEE 1185, AEIC CG5, Polywater): the weight correction factor "
            "w_c multiplies the friction in bends too, T_out = T_in e^(w_c μ θ); `false`: on straights only, "
            "T_out = T_in e^(μ θ) in bends (SEC TES-P-104.05's worked example)"),
-    F("conduit.inner_radius", "inner_radius_m", "float", "m", gt=0.0, rule="> `cable.radius`"),
-    F("conduit.start", "start_m", "vector3", "m", (0.0, 0.0, 0.0), rule="3 numbers; path routes only"),
+    F("conduit.inner_radius", "inner_radius_m", "float", "m", gt=0.0, ge=1.0e-5, rule="> `cable.radius`", le=1.0, why="a duct from 20 µm to 2 m across"),
+    F("conduit.start", "start_m", "vector3", "m", (0.0, 0.0, 0.0), rule="3 numbers; path routes only", max_abs=1.0e8, why="coordinates within 1e8 m (a survey's UTM coordinates fit)"),
     F("conduit.heading", "heading", "vector3", "", (1.0, 0.0, 0.0), nonzero=True,
-      rule="3 numbers, nonzero; path routes only"),
-    F("conduit.max_segment_angle", "max_segment_angle_deg", "float", "deg", 1.0, gt=0.0, le=45.0,
-      rule="0 < a ≤ 45: turning per straight segment on curved parts"),
+      rule="3 numbers, nonzero; path routes only", max_abs=1.0e6, why="components within 1e6 (only the direction counts)"),
+    F("conduit.max_segment_angle", "max_segment_angle_deg", "float", "deg", 1.0, gt=0.0, ge=1.0e-3, le=45.0,
+      rule="0 < a ≤ 45: turning per straight segment on curved parts", why="at least 0.001° per segment keeps the segment count finite"),
     F("conduit.segments_per_bend", "segments_per_bend", "int", "", None, ge=1, default_doc="—",
-      rule="integer ≥ 1 segments per bend/helix/fillet; not with `max_segment_angle`"),
+      rule="integer ≥ 1 segments per bend/helix/fillet; not with `max_segment_angle`", le=10000, why="keeps the run's size finite"),
     F("conduit.path", "path", "custom", "", None, default_doc="—",
       rule="array of pieces (below); exactly one of `path`, `points`, `points_csv`"),
     F("conduit.points", "points_m", "custom", "m", None, default_doc="—",
@@ -194,24 +201,29 @@ FIELDS: tuple[Field, ...] = (
       rule="one number or one per interior vertex, each > `inner_radius`; required with `points`, and with "
            "`points_csv` unless the CSV has a `bend_radius` column (the scenario's value wins)"),
     # ---- contact (paper Sect. 2.4-2.5, Eqs. 17-23)
-    F("contact.stiffness", "stiffness", "float", "N/m^exponent", 1.0e6, gt=0.0, rule="> 0"),
-    F("contact.damping", "damping", "float", "N s/m", 1.0e3, ge=0.0, rule="≥ 0"),
-    F("contact.exponent", "exponent", "float", "", 1.5, ge=1.0, rule="≥ 1"),
-    F("contact.friction", "friction", "float", "", 0.0, ge=0.0, rule="≥ 0 (kinetic μ)"),
+    F("contact.stiffness", "stiffness", "float", "N/m^exponent", 1.0e6, gt=0.0, rule="> 0", le=1.0e15, why="far stiffer than any wall; beyond it Newton's steps lose precision"),
+    F("contact.damping", "damping", "float", "N s/m", 1.0e3, ge=0.0, rule="≥ 0", le=1.0e12, why="far beyond any wall's damping"),
+    F("contact.exponent", "exponent", "float", "", 1.5, ge=1.0, rule="≥ 1", le=5.0, why="Hertz exponents are 1 to 2.5"),
+    F("contact.friction", "friction", "float", "", 0.0, ge=0.0, rule="≥ 0 (kinetic μ)", le=5.0, why="cable–duct friction is 0.1 to 1; e^(μθ) must stay finite"),
     F("contact.static_friction", "static_friction", "float", "", None, ge=0.0, ours=True, default_doc="none",
-      rule="≥ `friction`"),
-    F("contact.stribeck_velocity", "stribeck_velocity_m_per_s", "float", "m/s", 0.01, gt=0.0, ours=True,
-      rule="> 0"),
+      rule="≥ `friction`", le=5.0, why="cable–duct friction is 0.1 to 1"),
+    F("contact.stribeck_velocity", "stribeck_velocity_m_per_s", "float", "m/s", 0.01, gt=0.0, ge=1.0e-6, ours=True,
+      rule="> 0", le=100.0, why="1/v_s² must stay finite"),
     F("contact.friction_regularisation_velocity", "friction_regularisation_velocity_m_per_s", "float", "m/s",
-      1.0e-3, gt=0.0, ours=True, rule="> 0"),
+      None, gt=0.0, ge=1.0e-9, ours=True, derived=True, default_doc="1 % of `pull.speed`",
+      rule="> 0: dynamic mode's friction direction v_τ/√(|v_τ|² + ε²); at 1 % of the pull speed the friction at "
+           "that speed is 99.995 % developed whatever the speed (a fixed 1 mm/s gave −4.5 % on Example 2 at "
+           "1 mm/s, benchmarks/slow_pull.py); a run where it develops less than 1 − 1e-4 of μ is flagged "
+           "`friction_underdeveloped`. Steady mode slides at the pull speed and uses fully developed friction",
+      le=10.0, why="1/ε must stay finite"),
     F("contact.check_points_per_element", "check_points_per_element", "int", "", None, ge=1,
       default_doc="the mesh rule",
       rule="integer ≥ 1; default: spaced at most λ/4, λ = √(EJ/T_max) the bending length over which bend-end "
-           "loads concentrate, 8–200 per element (8 on routes without bends)"),
+           "loads concentrate, 8–200 per element (8 on routes without bends)", le=1000, why="keeps the run's size finite (the mesh rule uses at most 200)"),
     F("contact.check_point_rule", "check_point_rule", "choice", "", "gauss", choices=("gauss", "uniform"),
       ours=True, rule="`\"gauss\"` or `\"uniform\"`"),
-    F("contact.reference_spacing", "reference_spacing_m", "float", "m", 1.0e-3, gt=0.0, ours=True,
-      rule="> 0; each check point's force is scaled by its share of the element length / this"),
+    F("contact.reference_spacing", "reference_spacing_m", "float", "m", 1.0e-3, gt=0.0, ge=1.0e-6, ours=True,
+      rule="> 0; each check point's force is scaled by its share of the element length / this", le=1.0e3, why="a weight scale from 1 µm to 1 km"),
     F("contact.broad_phase", "broad_phase", "choice", "", "aabb", choices=("aabb", "none"),
       rule="`\"aabb\"` or `\"none\"`"),
     F("contact.damping_onset", "damping_onset_m", "float", "m", 5.0e-5, ge=0.0, ours=True,
@@ -219,33 +231,33 @@ FIELDS: tuple[Field, ...] = (
            "the paper's Eq. 18, whose damping force jumps to C·δ̇ at first touch (each touch then cuts the "
            "step: Example 4 took 7745 steps per 0.03 s with 0, 90 with 1e-5); 5e-5 halves Newton's "
            "iterations against 1e-5, results within their uncertainty (docs/performance.md); in dynamic "
-           "runs min(δ/δ_d, 1) is held within a time step at the step's start value (exucable/contact/law.py)"),
+           "runs min(δ/δ_d, 1) is held within a time step at the step's start value (exucable/contact/law.py)", le=1.0, why="a penetration scale below 1 m"),
     F("contact.surface", "surface", "choice", "", "smooth", choices=("smooth", "segments"), ours=True,
       rule="`\"smooth\"`: closest points on the exact bends/helices (the segments still do the search); "
            "`\"segments\"`: on the straight segments, as the paper (Sect. 2.3)"),
     # ---- pull (paper Sect. 2.1, Eq. 1)
-    F("pull.speed", "speed_m_per_s", "float", "m/s", gt=0.0, rule="> 0"),
+    F("pull.speed", "speed_m_per_s", "float", "m/s", gt=0.0, ge=1.0e-6, rule="> 0", le=100.0, why="pull speeds from 1 µm/s to 100 m/s (real rigs: below 1 m/s)"),
     F("pull.direction", "direction", "choice", "", "forward", choices=("forward", "reverse"),
       rule="`\"forward\"` (out at the end of the route) or `\"reverse\"`"),
     F("pull.back_tension", "back_tension_N", "float", "N", 0.0, ge=0.0,
-      rule="≥ 0, at the trailing end along the conduit tangent"),
+      rule="≥ 0, at the trailing end along the conduit tangent", le=1.0e8, why="up to 100 MN, beyond any cable's strength"),
     F("pull.force", "force_N", "float", "N", None, gt=0.0, default_doc="none",
       rule="> 0: prescribed pulling force (force-controlled pull, Example 3); not with a nonzero "
-           "`back_tension`"),
+           "`back_tension`", le=1.0e8, why="up to 100 MN, beyond any cable's strength"),
     F("pull.ramp_time", "ramp_time_s", "float", "s", 0.0, ge=0.0, ours=True,
-      rule="≥ 0: time over which speed/loads ramp up from the start state"),
+      rule="≥ 0: time over which speed/loads ramp up from the start state", le=1.0e6, why="keeps the run's size finite"),
     F("pull.feed_from_reel", "feed_from_reel", "bool", "", False, ours=True,
       rule="`exucable plan`: also the pull-in history (tension at the rig vs pulled length), with `back_tension` "
            "as the reel's back tension"),
     # ---- gravity
     F("gravity.g", "g_m_per_s2", "float", "m/s^2", unit_doc="m/s²", ge=0.0,
-      default_doc="required if the table is present", rule="≥ 0, acting along −z"),
+      default_doc="required if the table is present", rule="≥ 0, acting along −z", le=1000.0, why="up to 100 g"),
     # ---- solver
-    F("solver.end_time", "end_time_s", "float", "s", gt=0.0, rule="> 0"),
+    F("solver.end_time", "end_time_s", "float", "s", gt=0.0, rule="> 0", le=1.0e6, why="keeps the run's size finite"),
     F("solver.step", "step_s", "float", "s", 1.0e-2, gt=0.0,
-      rule="> 0 (initial and maximum step; the adaptive controller cuts it where needed)"),
-    F("solver.min_step", "min_step_s", "float", "s", None, gt=0.0, ours=True, derived=True,
-      default_doc="min(1e-8, step)", rule="0 < min_step ≤ step"),
+      rule="> 0 (initial and maximum step; the adaptive controller cuts it where needed)", le=1.0e3, why="keeps the run's size finite"),
+    F("solver.min_step", "min_step_s", "float", "s", None, gt=0.0, ge=1.0e-15, ours=True, derived=True,
+      default_doc="min(1e-8, step)", rule="0 < min_step ≤ step", why="keeps the run's size finite"),
     F("solver.spectral_radius", "spectral_radius", "float", "", 0.5, ge=0.0, le=1.0, ours=True,
       rule="generalized-α ρ∞ in [0, 1]"),
     # 12 iterations and 1e-7: measured on Example 2, 735 -> 155 steps at the same pulling
@@ -256,25 +268,25 @@ FIELDS: tuple[Field, ...] = (
     # contracts linearly (0.3-0.5) or cycles; halving it costs fewer iterations (Ex. 4 288 its in
     # 71 steps -> 290 in 73, 4.06 -> 3.97 per step; 100 m route 685 -> 669; Ex. 1-3 unchanged)
     F("solver.newton_max_iterations", "newton_max_iterations", "int", "", 8, ge=1, ours=True,
-      rule="integer ≥ 1: a step attempt not converged after this many Newton iterations is retried at half the step"),
-    F("solver.newton_tolerance", "newton_tolerance", "float", "", 1.0e-5, gt=0.0, lt=1.0, ours=True,
+      rule="integer ≥ 1: a step attempt not converged after this many Newton iterations is retried at half the step", le=100, why="Newton converges in a few iterations or not at all; more only burns time"),
+    F("solver.newton_tolerance", "newton_tolerance", "float", "", 1.0e-5, gt=0.0, ge=1.0e-14, lt=1.0, ours=True,
       rule="0 < tol < 1: Newton's residual relative to its first one in the step, which the rig's "
-           "reaction (≈ the pulling force) dominates; 1e-5 changes results by < 1e-5 against 1e-7"),
+           "reaction (≈ the pulling force) dominates; 1e-5 changes results by < 1e-5 against 1e-7", why="below 1e-14 round-off never lets Newton stop"),
     F("solver.startup_time", "startup_time_s", "float", "s", 0.05, ge=0.0, ours=True,
       rule="≥ 0: a mass-proportional damper toward the start's sliding velocities settles the pre-tensioned "
-           "start and fades out over this time; the steady state is looked for after it"),
+           "start and fades out over this time; the steady state is looked for after it", le=1.0e6, why="keeps the run's size finite"),
     F("solver.startup_damping", "startup_damping_1_per_s", "float", "1/s", 200.0, ge=0.0, ours=True,
-      rule="≥ 0: its initial rate"),
+      rule="≥ 0: its initial rate", le=1.0e6, why="a rate far beyond the cable's own (stiff damping stalls the steps)"),
     F("solver.exit_span_damping", "exit_span_damping_1_per_s", "float", "1/s", 0.0, ge=0.0, ours=True,
       rule="≥ 0: velocity-controlled dynamic runs: a mass-proportional damper toward the steady flow V·r'/|r'| on the "
            "cable past the conduit's exit (the span hanging from the mouth to the rig, which nothing else damps; it "
            "exerts no force on a steadily sliding cable); 0 switches it off. The industry scenarios use 10 "
-           "(reference/README.md, \"Why the force wandered\")"),
+           "(reference/README.md, \"Why the force wandered\")", le=1.0e6, why="a rate far beyond the cable's own (stiff damping stalls the steps)"),
     F("solver.output_interval", "output_interval_s", "float", "s", None, gt=0.0, ours=True, derived=True,
-      default_doc="max(step, end_time/1000)", rule="> 0"),
+      default_doc="max(step, end_time/1000)", rule="> 0", why="keeps the run's size finite; at most 1e6 outputs per run"),
     F("solver.steady_stop", "steady_stop", "bool", "", False, ours=True,
       rule="stop once the pulling force is steady"),
-    F("solver.steady_window", "steady_window_s", "float", "s", 0.2, gt=0.0, ours=True, rule="> 0"),
+    F("solver.steady_window", "steady_window_s", "float", "s", 0.2, gt=0.0, ours=True, rule="> 0", le=1.0e6, why="keeps the run's size finite"),
     F("solver.steady_tolerance", "steady_tolerance", "float", "", 1.0e-3, gt=0.0, ours=True,
       rule="> 0, relative drift/scatter bound"),
     F("solver.pretension", "pretension", "bool", "", True, ours=True,
@@ -301,34 +313,34 @@ FIELDS: tuple[Field, ...] = (
       default_doc="the rule in `solver.mode`",
       rule="≥ 0; steady mode and `solver.start_from = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "
            "reaches after pulling that far: `exucable validate` sets it to the dynamic run's "
-           "`reference_pulled_out_m` to compare both modes in the same state)"),
+           "`reference_pulled_out_m` to compare both modes in the same state)", le=1.0e4, why="keeps the run's size finite"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
       rule="array of times in [0, `solver.end_time`]: the whole state is written at each "
            "(interpolated between solver steps)"),
     F("output.snapshot_interval", "snapshot_interval_s", "float", "s", None, gt=0.0, ours=True,
-      default_doc="none", rule="> 0: also a snapshot at every multiple of it up to `solver.end_time`"),
+      default_doc="none", rule="> 0: also a snapshot at every multiple of it up to `solver.end_time`", why="keeps the run's size finite; at most 10000 snapshots"),
     # ---- limits (exucable plan)
     F("limits.max_tension", "max_tension_N", "float", "N", None, gt=0.0, ours=True, default_doc="none",
-      rule="> 0: largest allowed pulling tension"),
+      rule="> 0: largest allowed pulling tension", le=1.0e9, why="up to 1 GN"),
     F("limits.grip_limit", "grip_limit_N", "float", "N", None, gt=0.0, ours=True, default_doc="none",
-      rule="> 0: rating of the pulling eye or grip"),
+      rule="> 0: rating of the pulling eye or grip", le=1.0e9, why="up to 1 GN"),
     F("limits.conductor_material", "conductor_material", "choice", "", None, choices=("copper", "aluminium"),
       ours=True, default_doc="none",
       rule="with `conductor_area` and `conductors`: the conductors' tension limit"),
     F("limits.conductor_area", "conductor_area_m2", "float", "m^2", None, unit_doc="m²", gt=0.0, ours=True,
-      default_doc="none", rule="> 0: cross-section of ONE conductor"),
+      default_doc="none", rule="> 0: cross-section of ONE conductor", le=1.0, why="up to 1 m²"),
     F("limits.conductors", "conductors", "int", "", None, ge=1, ours=True, default_doc="none",
-      rule="integer ≥ 1: conductors sharing the pull (all cables)"),
+      rule="integer ≥ 1: conductors sharing the pull (all cables)", le=1000, why="up to 1000 conductors"),
     F("limits.conductor_rule", "conductor_rule", "choice", "", None, choices=("iec", "us"), ours=True,
       default_doc="iec; us with imperial units",
       rule="`iec`: 50 N/mm² copper, 30 N/mm² aluminium; `us`: 0.008 / 0.006 lb/cmil, × 0.8 above 3 conductors"),
     F("limits.max_sidewall_pressure", "max_sidewall_pressure_N_per_m", "float", "N/m", None, gt=0.0, ours=True,
-      default_doc="none", rule="> 0: largest SWBP on the most loaded cable"),
+      default_doc="none", rule="> 0: largest SWBP on the most loaded cable", le=1.0e9, why="up to 1 GN/m"),
     F("limits.min_bend_radius_multiple", "min_bend_radius_multiple", "float", "", None, gt=0.0, ours=True,
-      default_doc="none", rule="> 0: smallest bend centreline radius as a multiple of the cable diameter"),
+      default_doc="none", rule="> 0: smallest bend centreline radius as a multiple of the cable diameter", le=1000.0, why="up to 1000 diameters"),
     F("limits.min_clearance", "min_clearance_m", "float", "m", None, gt=0.0, ours=True, default_doc="none",
-      rule="> 0: smallest clearance between the uppermost cable and the duct"),
+      rule="> 0: smallest clearance between the uppermost cable and the duct", le=1.0, why="up to 1 m"),
     # ---- display
     F("display.units", "units", "choice", "", "si", choices=("si", "imperial"), ours=True,
       rule="unit system of bare numbers in the file and of printed tables (see above); results files stay SI"),
@@ -377,12 +389,31 @@ def _default_cell(f: Field) -> str:
     return format_default(f.default)
 
 
+def range_text(f: Field) -> str:
+    """The allowed range of a row as the README says it, e.g. ``1e-05 … 1 m``, ``> 0 and ≤ 1e+06 s``,
+    ``|each| ≤ 1e+08 m``; ``""`` without bounds."""
+    unit = f" {f.readme_unit}" if f.readme_unit else ""
+    if f.max_abs is not None:
+        return f"|each| ≤ {f.max_abs:g}{unit}"
+    if f.ge is not None and f.le is not None:
+        return f"{f.ge:g} … {f.le:g}{unit}"
+    parts = [f"{op} {v:g}" for op, v in (("≥", f.ge), (">", f.gt), ("≤", f.le), ("<", f.lt)) if v is not None]
+    return " and ".join(parts) + unit if parts else ""
+
+
+def _rule_cell(f: Field) -> str:
+    if not f.why:
+        return f.rule
+    bounds = range_text(f)
+    return f"{f.rule}; range {bounds} ({f.why})" if bounds else f"{f.rule} ({f.why})"
+
+
 def markdown_table(section: str) -> str:
     """The README key table of one section, rendered from :data:`FIELDS`."""
     lines = ["| key | unit | default | rule |", "| --- | --- | --- | --- |"]
     for f in fields_of(section):
         key = f"`{f.name}`" + (" (*ours*)" if f.ours else "")
-        cells = (key, f.readme_unit, _default_cell(f), f.rule)
+        cells = (key, f.readme_unit, _default_cell(f), _rule_cell(f))
         lines.append("|" + "|".join(f" {c} " if c else " " for c in cells) + "|")
     return "\n".join(lines)
 

@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 from ..errors import ModelError
 
 __all__ = ["MeshPlan", "plan_mesh", "rule_element_length_m", "bending_length_m",
-           "MAX_SAGITTA_CLEARANCES", "REFUSE_SAGITTA_CLEARANCES", "MAX_TURN_RAD", "REFUSE_TURN_RAD"]
+           "MAX_SAGITTA_CLEARANCES", "REFUSE_SAGITTA_CLEARANCES", "MAX_TURN_RAD", "REFUSE_TURN_RAD",
+           "MAX_MODEL_CHECK_POINTS"]
 
 MAX_SAGITTA_CLEARANCES = 2.0       # rule: chord sagitta ≤ 2 clearances
 MAX_TURN_RAD = 0.2                 # rule: turning per element
@@ -42,6 +43,8 @@ MIN_ELEMENTS = 10
 CHECK_POINTS_PER_BENDING_LENGTH = 4
 MIN_CHECK_POINTS = 8
 MAX_CHECK_POINTS = 200
+# elements × check points per element of one model: ~1 kB each (README "Performance"), ~2 GB
+MAX_MODEL_CHECK_POINTS = 2_000_000
 
 
 def bending_length_m(bending_stiffness_N_m2: float, tension_N: float) -> float:
@@ -173,5 +176,13 @@ def plan_mesh(centreline, clearance_m: float, cable_length_m: float, bending_sti
             warnings.append(f"contact.check_points_per_element: {k} points space {1e3 * L_e / k:.3g} mm apart, "
                             f"more than half the bending length √(EJ/T) = {1e3 * lam:.3g} mm over which bend-end "
                             f"loads concentrate (the rule gives {rule_k})")
+    if n * k > MAX_MODEL_CHECK_POINTS:
+        what = (f"{key} ({n} elements{f' after refining by {refine:g}' if refine != 1.0 else ''})"
+                if source != "rule" else f"the mesh rule's {n} elements (clearance {clearance_m:.3g} m)")
+        raise ModelError(key if source != "rule" else "cable.element_length",
+                         f"{what} × {k} check points per element = {n * k} check points, more than "
+                         f"{MAX_MODEL_CHECK_POINTS} (about 1 kB each: a bound that keeps the run's memory finite); "
+                         "give fewer elements (cable.elements or a longer cable.element_length) or fewer "
+                         "contact.check_points_per_element")
     return MeshPlan(elements=n, element_length_m=L_e, check_points_per_element=k, rule_element_length_m=rule_L,
                     rule_check_points_per_element=rule_k, bending_length_m=lam, source=source, warnings=warnings)

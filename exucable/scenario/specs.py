@@ -52,6 +52,28 @@ __all__ = [
 ]
 
 _DEFAULT_MIN_STEP_S = 1.0e-8
+# default friction regularisation velocity as a fraction of the pull speed: the regularised friction
+# then develops 1/√(1 + 1e-4) = 99.995 % of μ at the pull speed, whatever the speed
+REGULARISATION_FRACTION_OF_SPEED = 0.01
+
+# Sizes that keep a run finite (time and memory), checked before anything is allocated. A run's
+# memory grows with its check points (~1 kB each, README "Performance": 153 MB for 136 000) and
+# elements; the conduit's segments and pieces are searched at every Newton iteration.
+_SIZE_WHY = "a bound that keeps the run's time and memory finite"
+MAX_LENGTH_M = 1.0e5          # a route piece, bend radius or helix pitch up to 100 km
+MIN_PIECE_M = 1.0e-6          # a straight shorter than 1 µm is no piece of a conduit
+_PIECE_WHY = "route pieces from 1 µm to 100 km"
+MAX_HELIX_TURNS = 1000.0
+# a curve turning less than 1e-6° is no bend: its segments would be shorter than round-off
+MIN_TURN_DEG = 1.0e-6
+_TURN_WHY = f"a curve turns at least {MIN_TURN_DEG:g}° (shorter segments are lost in round-off) and a helix at most {MAX_HELIX_TURNS:g} turns"
+MAX_PIECES = 10_000           # path pieces
+MAX_POINTS = 100_000          # survey points
+MAX_SEGMENTS = 200_000        # straight contact segments of the conduit
+MAX_OUTPUTS = 1_000_000       # stored output states: solver.end_time / solver.output_interval
+MAX_SNAPSHOTS = 10_000        # snapshot files
+# e^(μθ) up to e^50 ≈ 5e21: tension ratios beyond any real pull; the rope's exponentials stay finite
+MAX_FRICTION_TURNING = 50.0
 
 _FIELD_BY_KEY: dict[str, Field] = {f.key: f for f in FIELDS}
 
@@ -77,13 +99,13 @@ def _coerce(f: Field, value):
     key = f.key
     if f.kind == "float":
         v = _as_float(key, value, f.unit)
-        _check_range(key, v, f.unit, **f.bounds)
+        _check_range(key, v, f.unit, why=f.why, **f.bounds)
         return v
     if f.kind == "int":
         if isinstance(value, bool) or not isinstance(value, numbers.Integral):
             raise ScenarioError(key, f"must be an integer, got {_describe(value)}")
         v = int(value)
-        _check_range(key, v, "", **f.bounds)
+        _check_range(key, v, "", why=f.why, **f.bounds)
         return v
     if f.kind == "bool":
         if not isinstance(value, bool):
@@ -99,7 +121,7 @@ def _coerce(f: Field, value):
             raise ScenarioError(key, f"must be one of {allowed}, got {_describe(value)}")
         return value
     if f.kind == "vector3":
-        return _vector3(key, value, f.unit, nonzero=f.nonzero)
+        return _vector3(key, value, f.unit, nonzero=f.nonzero, max_abs=f.max_abs, why=f.why)
     return value  # "custom": checked by the section's own code
 
 
@@ -122,6 +144,8 @@ class _Spec:
     _SECTION: ClassVar[str] = ""
     #: Attributes ``to_dict`` leaves out (derived from another key that is echoed).
     _NOT_ECHOED: ClassVar[frozenset[str]] = frozenset()
+    #: Attributes with a default that are None when another key replaces them.
+    _NONE_MEANS_NOT_USED: ClassVar[frozenset[str]] = frozenset()
 
     def __post_init__(self):
         derived = set()
@@ -134,6 +158,10 @@ class _Spec:
                     raise ScenarioError(f.key, f"required key is missing: give {_what(f)}")
                 if f.derived:
                     derived.add(f.attr)
+                elif f.default is not None and f.attr not in self._NONE_MEANS_NOT_USED:
+                    # a file cannot say None: leaving the key out gives its default
+                    raise ScenarioError(f.key, f"must be {_what(f)}, got None; leave the key out for its default "
+                                               f"{f.default!r}")
                 continue
             object.__setattr__(self, f.attr, _coerce(f, value))
         # Not a dataclass field: no part in equality, hashing or repr.
@@ -254,6 +282,11 @@ class CableSpec(_Spec):
             given = self.mass_per_length_kg_per_m
             if given is not None and not math.isclose(given, from_density, rel_tol=1e-12):
                 raise ScenarioError("cable.mass_per_length", "give either density or mass_per_length, not both")
+            row = _FIELD_BY_KEY["cable.mass_per_length"]
+            if not row.ge <= from_density <= row.le:
+                raise ScenarioError("cable.density", f"gives a mass per length ρ·π r² = {from_density!r} kg/m with "
+                                                     f"cable.radius {self.radius_m!r} m, outside {row.ge:g} … "
+                                                     f"{row.le:g} kg/m ({row.why})")
             object.__setattr__(self, "mass_per_length_kg_per_m", from_density)
 
     @property
@@ -324,6 +357,7 @@ class ConduitSpec(_Spec):
     """
 
     _SECTION: ClassVar[str] = "conduit"
+    _NONE_MEANS_NOT_USED: ClassVar[frozenset[str]] = frozenset({"max_segment_angle_deg"})   # segments_per_bend given
 
     inner_radius_m: float = _default("conduit.inner_radius")
     start_m: tuple[float, float, float] = _default("conduit.start")
@@ -401,8 +435,9 @@ class ContactSpec(_Spec):
         Static friction coefficient μ_s ≥ μ [-], or None for no static peak.
     stribeck_velocity_m_per_s : float
         Decay velocity of the static-to-kinetic transition [m/s].
-    friction_regularisation_velocity_m_per_s : float
-        Sliding speed below which friction is regularised (linear in velocity) [m/s].
+    friction_regularisation_velocity_m_per_s : float or None
+        Sliding speed below which friction is regularised (linear in velocity) [m/s]; None until a
+        :class:`Scenario` sets :data:`REGULARISATION_FRACTION_OF_SPEED` of its pull speed.
     check_points_per_element : int or None
         Contact check points per cable element; None: the mesh rule's (:mod:`exucable.scenario.mesh`).
     check_point_rule : str
@@ -518,6 +553,8 @@ class OutputSpec(_Spec):
         raw = self.snapshots_s
         if not isinstance(raw, (list, tuple)):
             raise ScenarioError("output.snapshots", f"must be an array of times [s], got {_describe(raw)}")
+        if len(raw) > MAX_SNAPSHOTS:
+            raise ScenarioError("output.snapshots", f"must have at most {MAX_SNAPSHOTS} times, got {len(raw)} ({_SIZE_WHY})")
         times = []
         for i, value in enumerate(raw):
             key = f"output.snapshots[{i}]"
@@ -684,6 +721,72 @@ class DisplaySpec(_Spec):
     units: str = _default("display.units")
 
 
+def _curved_turning_deg(conduit: ConduitSpec) -> list[float]:
+    """Turning of each curved piece of a route before it is built [deg] (a helix: 360° a turn, an
+    upper bound; a survey fillet: the angle between its legs)."""
+    if conduit.path is not None:
+        out = []
+        for item in conduit.path:
+            if isinstance(item, _geo.Bend):
+                out.append(float(item.angle_deg))
+            elif isinstance(item, _geo.Helix):
+                out.append(360.0 * float(item.turns))
+        return out
+    # a survey fillet turns by the angle between its two legs
+    legs = [tuple(b - a for a, b in zip(p, q)) for p, q in zip(conduit.points_m[:-1], conduit.points_m[1:])]
+    out = []
+    for u, v in zip(legs[:-1], legs[1:]):
+        nu, nv = math.hypot(*u), math.hypot(*v)
+        cos = sum(a * b for a, b in zip(u, v)) / (nu * nv) if nu > 0.0 and nv > 0.0 else 1.0
+        out.append(math.degrees(math.acos(min(1.0, max(-1.0, cos)))))
+    return out
+
+
+def _check_sizes(sc: "Scenario") -> None:
+    """Refuse a scenario whose derived sizes (segments, check points, outputs, snapshots) would not
+    keep the run finite, before the conduit or the model is built."""
+    cd = sc.conduit
+    turning = _curved_turning_deg(cd)
+    if cd.segments_per_bend is not None:
+        n_seg, key = cd.segments_per_bend * len(turning), "conduit.segments_per_bend"
+    else:
+        n_seg = sum(math.ceil(t / cd.max_segment_angle_deg) for t in turning)
+        key = "conduit.max_segment_angle"
+    if n_seg > MAX_SEGMENTS:
+        raise ScenarioError(key, f"gives about {n_seg} conduit segments on {len(turning)} curved pieces, more than "
+                                 f"{MAX_SEGMENTS} ({_SIZE_WHY}); give a larger max_segment_angle or fewer segments_per_bend")
+    c = sc.cable
+    if c.elements is not None and sc.contact.check_points_per_element is not None:
+        n_cp = c.elements * sc.contact.check_points_per_element
+        from .mesh import MAX_MODEL_CHECK_POINTS
+        if n_cp > MAX_MODEL_CHECK_POINTS:
+            raise ScenarioError("contact.check_points_per_element",
+                                f"{c.elements} elements × {sc.contact.check_points_per_element} check points = {n_cp}, "
+                                f"more than {MAX_MODEL_CHECK_POINTS} ({_SIZE_WHY}); give fewer of either")
+    sp = sc.solver
+    if sp.end_time_s / sp.output_interval_s > MAX_OUTPUTS:
+        raise ScenarioError("solver.output_interval", f"gives {sp.end_time_s / sp.output_interval_s:.3g} outputs over "
+                                                      f"solver.end_time {sp.end_time_s:g} s, more than {MAX_OUTPUTS} "
+                                                      f"({_SIZE_WHY}); give a longer interval")
+    iv = sc.output.snapshot_interval_s
+    if iv is not None and sp.end_time_s / iv > MAX_SNAPSHOTS:
+        raise ScenarioError("output.snapshot_interval", f"gives {sp.end_time_s / iv:.3g} snapshots over solver.end_time "
+                                                        f"{sp.end_time_s:g} s, more than {MAX_SNAPSHOTS} ({_SIZE_WHY}); "
+                                                        "give a longer interval")
+
+
+def _check_friction_turning(sc: "Scenario", conduit) -> None:
+    """Refuse μ·θ (the route's total turning θ) beyond :data:`MAX_FRICTION_TURNING`: the capstan
+    ratio e^(μθ) would exceed any real pull and overflow the rope's exponentials."""
+    mu = max(sc.contact.friction, sc.contact.static_friction or 0.0)
+    theta = float(sum(p.turning_angle_rad for p in conduit.centreline.pieces if p.is_curved))
+    if mu * theta > MAX_FRICTION_TURNING:
+        key = "contact.static_friction" if (sc.contact.static_friction or 0.0) > sc.contact.friction else "contact.friction"
+        raise ScenarioError(key, f"μ {mu:g} × the route's total turning {theta:.4g} rad = {mu * theta:.4g}: the capstan "
+                                 f"ratio e^(μθ) would exceed e^{MAX_FRICTION_TURNING:g} (no real pull; the tension "
+                                 "overflows); check the friction and the route")
+
+
 def default_elements(centreline, clearance_m: float, cable_length_m: float,
                      element_length_m: float | None = None) -> int:
     """The default number of cable elements: the mesh rule's (:func:`exucable.scenario.mesh.rule_element_length_m`:
@@ -796,18 +899,38 @@ class Scenario:
             )
         if self.cable.count > 1:
             _eng.check_fit(self.cable.count, 2.0 * self.conduit.inner_radius_m, 2.0 * self.cable.radius_m)
+        _check_sizes(self)
         conduit = self.build_conduit()  # route errors surface here, keyed
+        _check_friction_turning(self, conduit)
         conduit_length_m = _conduit_length_m(conduit)
         # A relative tolerance absorbs float round-off when the length is written as the sum
         # of the route's pieces (e.g. ex1: 50 m cable in a 50 m conduit).
+        shortest = _FIELD_BY_KEY["cable.length"].ge
+        if self.cable.length_m is None and conduit_length_m < shortest:
+            raise ScenarioError("conduit.path", f"the route is {conduit_length_m:.3g} m long, and so the cable: at least "
+                                                f"{shortest:g} m ({_FIELD_BY_KEY['cable.length'].why})")
         if self.cable.length_m is not None and self.cable.length_m > conduit_length_m * (1.0 + 1e-9):
             raise ScenarioError(
                 "cable.length",
                 f"must be <= the conduit centreline length {conduit_length_m:.6g} m, got {self.cable.length_m!r}",
             )
+        if self.contact.friction_regularisation_velocity_m_per_s is None:
+            contact = copy.copy(self.contact)
+            eps = REGULARISATION_FRACTION_OF_SPEED * self.pull.speed_m_per_s
+            object.__setattr__(contact, "friction_regularisation_velocity_m_per_s", eps)
+            object.__setattr__(contact, "_derived", contact.__dict__.get("_derived", frozenset())
+                               | {"friction_regularisation_velocity_m_per_s"})
+            object.__setattr__(self, "contact", contact)
         if self.cable.elements is None:
             n = default_elements(conduit.centreline, self.conduit.inner_radius_m - self.cable.radius_m,
                                  self.cable_length_m, self.cable.element_length_m)
+            limit = _FIELD_BY_KEY["cable.elements"].le
+            if n > limit:
+                key = "cable.element_length" if self.cable.element_length_m is not None else "conduit.inner_radius"
+                raise ScenarioError(key, f"gives {n} cable elements (cable length {self.cable_length_m:.6g} m, clearance "
+                                         f"{self.conduit.inner_radius_m - self.cable.radius_m:.3g} m under the mesh rule), "
+                                         f"more than {limit} ({_FIELD_BY_KEY['cable.elements'].why}); give a longer "
+                                         "cable.element_length, fewer cable.elements, or a larger clearance")
             # a copy, not dataclasses.replace: that would re-check, and elements next to a given
             # element_length reads as both given
             cable = copy.copy(self.cable)
@@ -876,7 +999,8 @@ class Scenario:
             ``sc.replace(**{"contact.friction": 0.3, "conduit.path[1].radius": 0.8})``; a whole
             table may be given as a dict (``gravity={"g": 9.81}``) or ``None`` to remove an
             optional table (``gravity=None``). Derived defaults (``cable.elements``,
-            ``solver.min_step``, ``solver.output_interval``) are derived again.
+            ``contact.friction_regularisation_velocity``, ``solver.min_step``,
+            ``solver.output_interval``) are derived again.
 
         Raises
         ------
@@ -885,8 +1009,10 @@ class Scenario:
         """
         from .dotted import parse_key, set_value  # pure-dict helpers shared with sweeps
 
-        d = self.to_dict()
-        for part in ("cable", "solver"):
+        # quantities as "<value> <SI unit>": read as the same numbers whatever display.units becomes
+        # (bare numbers would be re-read in the new unit system)
+        d = _quantities_as_si_strings(self.to_dict())
+        for part in ("cable", "contact", "solver"):
             for name in getattr(self, part).derived_keys:
                 d[part].pop(name, None)
         for key, value in changes.items():
@@ -926,6 +1052,9 @@ def read_toml(path: Path, what: str = "scenario") -> dict:
         raise ScenarioError("", f"{path}: TOML syntax error: {exc}") from None
     except UnicodeDecodeError as exc:
         raise ScenarioError("", f"{path}: not UTF-8 text: {exc}") from None
+    except RecursionError:
+        raise ScenarioError("", f"{path}: nested too deeply to read (arrays or tables within each other "
+                                "hundreds of levels deep)") from None
 
 
 def load_scenario(path) -> Scenario:
@@ -1101,7 +1230,7 @@ def _describe(value) -> str:
     if isinstance(value, numbers.Real):
         return f"a float ({float(value)!r})"
     if isinstance(value, str):
-        return f"a string ({value!r})"
+        return f"a string ({value!r})" if len(value) <= 80 else f"a string of {len(value)} characters ({value[:40]!r}...)"
     if isinstance(value, dict):
         return "a table"
     if isinstance(value, (list, tuple)):
@@ -1117,36 +1246,37 @@ def _as_float(key: str, value, unit: str) -> float:
     """A finite float from an int or float (not a bool)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ScenarioError(key, f"must be a number{_unit(unit)}, got {_describe(value)}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:       # an integer of hundreds of digits
+        raise ScenarioError(key, f"must be a finite number{_unit(unit)}, got an integer of {len(str(abs(value)))} "
+                                 "digits") from None
     if not math.isfinite(v):
         raise ScenarioError(key, f"must be a finite number{_unit(unit)}, got {v}")
     return v
 
 
-def _check_range(key: str, v, unit: str, gt=None, ge=None, lt=None, le=None) -> None:
-    """Raise unless ``v`` satisfies every given bound; the message lists them all."""
-    ok = (
-        (gt is None or v > gt)
-        and (ge is None or v >= ge)
-        and (lt is None or v < lt)
-        and (le is None or v <= le)
-    )
-    if ok:
+def _check_range(key: str, v, unit: str, gt=None, ge=None, lt=None, le=None, why: str = "") -> None:
+    """Raise unless ``v`` satisfies every given bound. Without ``why`` the message lists them all;
+    with ``why`` (a row with a plausibility range) it names the first bound broken, and for a
+    nonzero one the reason for the range."""
+    checks = (("> ", gt, lambda b: v > b), (">= ", ge, lambda b: v >= b), ("< ", lt, lambda b: v < b),
+              ("<= ", le, lambda b: v <= b))
+    broken = [(op, b) for op, b, ok in checks if b is not None and not ok(b)]
+    if not broken:
         return
-    parts = []
-    if gt is not None:
-        parts.append(f"> {gt:g}")
-    if ge is not None:
-        parts.append(f">= {ge:g}")
-    if lt is not None:
-        parts.append(f"< {lt:g}")
-    if le is not None:
-        parts.append(f"<= {le:g}")
-    raise ScenarioError(key, f"must be {' and '.join(parts)}{_unit(unit)}, got {v!r}")
+    got = repr(v) if not isinstance(v, int) or abs(v) < 10**30 else f"an integer of {len(str(abs(v)))} digits"
+    if why:
+        op, b = broken[0]
+        raise ScenarioError(key, f"must be {op}{b:g}{_unit(unit)}, got {got}" + (f" ({why})" if b != 0 else ""))
+    parts = [f"{op}{b:g}" for op, b, _ in checks if b is not None]
+    raise ScenarioError(key, f"must be {' and '.join(parts)}{_unit(unit)}, got {got}")
 
 
-def _vector3(key: str, value, unit: str, nonzero: bool = False) -> tuple[float, float, float]:
-    """Three finite numbers as a tuple."""
+def _vector3(key: str, value, unit: str, nonzero: bool = False, max_abs: float | None = None,
+             why: str = "") -> tuple[float, float, float]:
+    """Three finite numbers as a tuple, each of magnitude ≤ ``max_abs`` if given; ``nonzero``: the
+    largest at least 1e-12 of ``max_abs`` (1e-12 without), so that its norm neither over- nor underflows."""
     if not isinstance(value, (list, tuple)) or len(value) != 3:
         raise ScenarioError(key, f"must be an array of 3 numbers [x, y, z]{_unit(unit)}, got {_describe(value)}")
     out = []
@@ -1158,6 +1288,13 @@ def _vector3(key: str, value, unit: str, nonzero: bool = False) -> tuple[float, 
         out.append(float(c))
     if nonzero and not any(out):
         raise ScenarioError(key, "must be a nonzero vector, got [0, 0, 0]")
+    big = max(abs(c) for c in out)
+    if max_abs is not None and big > max_abs:
+        raise ScenarioError(key, f"each component must be within ±{max_abs:g}{_unit(unit)}, got {big!r}"
+                                 + (f" ({why})" if why else ""))
+    smallest = 1e-12 * (max_abs if max_abs is not None else 1.0)
+    if nonzero and big < smallest:
+        raise ScenarioError(key, f"must have a component of magnitude >= {smallest:g}{_unit(unit)}, got {out!r}")
     return (out[0], out[1], out[2])
 
 
@@ -1196,12 +1333,12 @@ class _Table:
             raise ScenarioError(self.k(name), f"required key is missing: give {what}")
         return default, False
 
-    def number(self, name: str, unit: str, default=REQUIRED, **bounds) -> float | None:
+    def number(self, name: str, unit: str, default=REQUIRED, why: str = "", **bounds) -> float | None:
         value, given = self._get(name, default, f"a number{_unit(unit)}")
         if not given and value is None:
             return None
         v = _as_float(self.k(name), value, unit)
-        _check_range(self.k(name), v, unit, **bounds)
+        _check_range(self.k(name), v, unit, why=why, **bounds)
         return v
 
     def integer(self, name: str, default=REQUIRED, **bounds) -> int | None:
@@ -1383,6 +1520,8 @@ def _parse_path(value, inner_radius: float) -> tuple:
             "{ bend = 90.0, radius = 0.5, turn = \"left\" }, { helix_turns = 2.0, radius = 1.0, pitch = 0.05 }; "
             f"got {_describe(value)}",
         )
+    if len(value) > MAX_PIECES:
+        raise ScenarioError(key, f"must have at most {MAX_PIECES} pieces, got {len(value)} ({_SIZE_WHY})")
     items = []
     for i, raw in enumerate(value):
         ikey = f"{key}[{i}]"
@@ -1399,9 +1538,9 @@ def _parse_path(value, inner_radius: float) -> tuple:
         t = _Table(raw, ikey, _PATH_KINDS[kind])
         try:
             if kind == "straight":
-                item = _geo.Straight(t.number("straight", "m", gt=0.0))
+                item = _geo.Straight(t.number("straight", "m", gt=0.0, ge=MIN_PIECE_M, le=MAX_LENGTH_M, why=_PIECE_WHY))
             elif kind == "bend":
-                angle = t.number("bend", "deg", gt=0.0, lt=360.0)
+                angle = t.number("bend", "deg", gt=0.0, ge=MIN_TURN_DEG, lt=360.0, why=_TURN_WHY)
                 radius = _curve_radius(t, inner_radius)
                 if t.has("turn") and t.has("axis"):
                     raise ScenarioError(t.k("axis"), "give either turn or axis, not both")
@@ -1413,10 +1552,10 @@ def _parse_path(value, inner_radius: float) -> tuple:
                 axis = t.vector3("axis", "", default=None, nonzero=True)
                 item = _geo.Bend(angle, radius, turn=turn, axis=axis)
             else:
-                turns = t.number("helix_turns", "", gt=0.0)
+                turns = t.number("helix_turns", "", gt=0.0, ge=MIN_TURN_DEG / 360.0, le=MAX_HELIX_TURNS, why=_TURN_WHY)
                 radius = _curve_radius(t, inner_radius)
                 # Negative pitch descends; zero pitch over more than one turn is refused by geometry.
-                pitch = t.number("pitch", "m")
+                pitch = t.number("pitch", "m", ge=-MAX_LENGTH_M, le=MAX_LENGTH_M, why=_PIECE_WHY)
                 turn = t.choice("turn", _HELIX_TURNS, default="left")
                 item = _geo.Helix(turns, radius, pitch, turn=turn)
         except GeometryError as exc:
@@ -1427,7 +1566,7 @@ def _parse_path(value, inner_radius: float) -> tuple:
 
 def _curve_radius(t: _Table, inner_radius: float) -> float:
     """Centreline radius of a bend or helix: the conduit tube must not fold onto itself."""
-    radius = t.number("radius", "m", gt=0.0)
+    radius = t.number("radius", "m", gt=0.0, le=MAX_LENGTH_M, why=_PIECE_WHY)
     if radius <= inner_radius:
         raise ScenarioError(
             t.k("radius"), f"must be > the conduit inner radius {inner_radius!r} m, got {radius!r}"
@@ -1438,7 +1577,10 @@ def _curve_radius(t: _Table, inner_radius: float) -> float:
 def _parse_points(key: str, value) -> tuple[tuple[float, float, float], ...]:
     if not isinstance(value, (list, tuple)) or len(value) < 2:
         raise ScenarioError(key, f"must be an array of at least 2 points [[x, y, z], ...] (m), got {_describe(value)}")
-    return tuple(_vector3(f"{key}[{i}]", p, "m") for i, p in enumerate(value))
+    if len(value) > MAX_POINTS:
+        raise ScenarioError(key, f"must have at most {MAX_POINTS} points, got {len(value)} ({_SIZE_WHY})")
+    start = _FIELD_BY_KEY["conduit.start"]
+    return tuple(_vector3(f"{key}[{i}]", p, "m", max_abs=start.max_abs, why=start.why) for i, p in enumerate(value))
 
 
 def _parse_bend_radius(value, n_points: int, inner_radius: float):
@@ -1447,7 +1589,7 @@ def _parse_bend_radius(value, n_points: int, inner_radius: float):
 
     def one(k, v):
         r = _as_float(k, v, "m")
-        _check_range(k, r, "m", gt=0.0)
+        _check_range(k, r, "m", gt=0.0, le=MAX_LENGTH_M, why=_PIECE_WHY)
         if r <= inner_radius:
             raise ScenarioError(k, f"must be > the conduit inner radius {inner_radius!r} m, got {r!r}")
         return r

@@ -74,6 +74,12 @@ def display_unit(dimension: str, system: str, small: bool = False) -> str:
     return DEFAULT_UNIT[system][dimension]
 
 
+def _short(value) -> str:
+    """``repr(value)``, cut to 60 characters for the one-line error."""
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:40]}... ({len(text)} characters)"
+
+
 def to_si(key: str, value, dimension: str, system: str = "si", small: bool = False) -> float:
     """Read one quantity and return it in SI.
 
@@ -96,14 +102,17 @@ def to_si(key: str, value, dimension: str, system: str = "si", small: bool = Fal
         Not a number or quantity string, an unknown unit, or a unit of another dimension.
     """
     if isinstance(value, bool):
-        raise ScenarioError(key, f"must be a number or a quantity such as \"12 {display_unit(dimension, system, small)}\", got {value!r}")
+        raise ScenarioError(key, f"must be a number or a quantity such as \"12 {display_unit(dimension, system, small)}\", got {_short(value)}")
     if isinstance(value, numbers.Real):
         unit = display_unit(dimension, system, small)
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:        # an integer of hundreds of digits
+            raise ScenarioError(key, f"must be a finite number, got an integer of {len(str(abs(value)))} digits") from None
     elif isinstance(value, str):
         m = _QUANTITY.match(value)
         if not m:
-            raise ScenarioError(key, f"cannot read {value!r} as a quantity; write e.g. \"12 {display_unit(dimension, system, small)}\"")
+            raise ScenarioError(key, f"cannot read {_short(value)} as a quantity; write e.g. \"12 {display_unit(dimension, system, small)}\"")
         number, unit = float(m.group(1)), m.group(2)
         if unit not in UNITS:
             allowed = ", ".join(u for u, (d, _) in UNITS.items() if d == dimension)
@@ -113,10 +122,10 @@ def to_si(key: str, value, dimension: str, system: str = "si", small: bool = Fal
     dim, factor = UNITS[unit]
     if dim != dimension:
         allowed = ", ".join(u for u, (d, _) in UNITS.items() if d == dimension)
-        raise ScenarioError(key, f"{value!r} is a {dim.replace('_', ' ')}, but this key is a "
+        raise ScenarioError(key, f"{_short(value)} is a {dim.replace('_', ' ')}, but this key is a "
                                  f"{dimension.replace('_', ' ')}: use one of {allowed}")
-    if not math.isfinite(number):
-        raise ScenarioError(key, f"must be finite, got {value!r}")
+    if not math.isfinite(number) or not math.isfinite(number * factor):
+        raise ScenarioError(key, f"must be finite, got {_short(value)}")
     return number * factor
 
 

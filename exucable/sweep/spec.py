@@ -36,11 +36,16 @@ import difflib
 import hashlib
 import itertools
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
 from ..errors import ScenarioError
+
+# Cases of one sweep: each is validated (a route built) before the first runs, ~10 ms apiece, so
+# 10 000 cases take minutes to check and a sweep of hours at the least
+MAX_CASES = 10_000
 from ..scenario.specs import Scenario, parse_scenario, read_toml
 from ..scenario.dotted import keys_overlap, parse_key, set_value, unset_value
 
@@ -268,6 +273,10 @@ def parse_sweep(data: dict, base_dir, default_name: str = "sweep") -> Sweep:
     for k, (toks, where) in set_keys.items():
         set_value(prepared, toks, set_values[k], where)
 
+    n_cases = math.prod(len(vary_values[k]) for k in keys) if mode == "grid" else len(vary_values[keys[0]])
+    if n_cases > MAX_CASES:
+        raise ScenarioError("vary", f"gives {n_cases} cases, more than {MAX_CASES} (each is a run of its own, and "
+                                    "every case is checked before the first runs); split the sweep or vary fewer values")
     if mode == "grid":
         combos = list(itertools.product(*(range(len(vary_values[k])) for k in keys)))
     else:

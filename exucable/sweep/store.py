@@ -45,7 +45,7 @@ LOCK = ".sweep.lock"
 
 # A case is finished (never re-run) when its record has one of these statuses: trusted, or
 # completed but flagged as untrustworthy (exucable.post.trust; re-running would give the same answer).
-FINISHED = ("ok", "steady", "outside_conduit", "penetration", "dynamic", "not_steady")
+FINISHED = ("ok", "steady", "outside_conduit", "penetration", "dynamic", "friction_underdeveloped", "not_steady")
 
 # sweep.csv columns after the varied keys, in order; "message" is kept last (free text).
 RESULT_COLUMNS = ("case", "status", "pull_force_N", "rope_pull_force_N", "max_tension_N",
