@@ -39,6 +39,7 @@ _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:2em auto;max-width:1000px;color:#222}
 h1{font-size:1.5em;margin-bottom:.2em} h2{font-size:1.2em;border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.4em}
 table{border-collapse:collapse;margin:.4em 0 .8em 0;font-size:.9em} th,td{border:1px solid #ccc;padding:.2em .5em;text-align:right}
+td{white-space:nowrap} td.w{white-space:normal}
 th{background:#f3f3f3} td.l,th.l{text-align:left} .pass{color:#11751b;font-weight:600} .fail{color:#b00020;font-weight:600}
 .unchecked{color:#8a5a00;font-weight:600}
 .verdict{font-size:1.05em;padding:.6em 1em;border-radius:6px;border:1px solid #999}
@@ -166,7 +167,7 @@ def _column_scales(rows) -> list[float | None]:
     return scales
 
 
-def _table(header, rows, left=(1, 2), table_id: str | None = None, raw=()) -> str:
+def _table(header, rows, left=(1, 2), table_id: str | None = None, raw=(), wrap=()) -> str:
     scales = _column_scales(rows)
     attr = f" id='{table_id}'" if table_id else ""
     out = [f"<table{attr}><tr>" + "".join(f'<th class="{"l" if i in left else ""}">{html.escape(str(h))}</th>'
@@ -180,7 +181,8 @@ def _table(header, rows, left=(1, 2), table_id: str | None = None, raw=()) -> st
                 text = str(v)
             else:
                 text = html.escape(fmt_number(v, scales[i]))
-            cells.append(f'<td class="{"l" if i in left else ""}">{text}</td>')
+            css = ("l" if i in left else "") + (" w" if i in wrap else "")
+            cells.append(f'<td class="{css.strip()}">{text}</td>')
         out.append("<tr>" + "".join(cells) + "</tr>")
     out.append("</table>")
     return "\n".join(out)
@@ -377,7 +379,7 @@ def _checks_table(plan: dict, name: str, units: str) -> str:
         rows.append([c["name"], "<span class='unchecked'>not checked</span>" if c["why"].startswith("not checked")
                      else "n/a", None, None, "", None, c["why"]])
     return _table(["check", "result", "value", "limit", "unit", "margin", "where / why"], rows,
-                  left=(0, 1, 4, 6), table_id=f"checks-{name}", raw=(1,))
+                  left=(0, 1, 4, 6), table_id=f"checks-{name}", raw=(1,), wrap=(6,))
 
 
 def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, units: str = "si",
@@ -418,33 +420,36 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
     for name in ("forward", "reverse"):
         parts += [f"<div class='block'><h2>Checks, {html.escape(direction_label(plan, name))} pull</h2>",
                   _checks_table(plan, name, units), "</div>"]
+    # each heading travels with what it heads (div.block: no page break inside when printed)
     if route_png:
-        parts += ["<h2>Route</h2>", _figure(base64.b64encode(route_png).decode("ascii"), "route",
-                                            "The route with its points named as in the tables.", "route")]
-    parts += ["<h2>Tension along the route</h2>",
+        parts += ["<div class='block'><h2>Route</h2>", _figure(base64.b64encode(route_png).decode("ascii"), "route",
+                                                               "The route with its points named as in the tables.",
+                                                               "route"), "</div>"]
+    parts += ["<div class='block'><h2>Tension along the route</h2>",
               _figure(_tension_figure(plan, units), "tension along the route",
                       "Both directions on one axis: the distance along the route from its first point; bends "
-                      "shaded, points named on top.", "tension")]
+                      "shaded, points named on top.", "tension"), "</div>"]
     sw = _swbp_figure(plan, units, next((c["limit"] for c in plan["checks"]
                                          if c["name"] == "max_sidewall_pressure"), None))
     if sw:
-        parts += ["<h2>Sidewall bearing pressure per bend</h2>",
+        parts += ["<div class='block'><h2>Sidewall bearing pressure per bend</h2>",
                   _figure(sw, "sidewall bearing pressure per bend",
-                          "Bends numbered in route order, the same bend side by side in both directions.", "swbp")]
+                          "Bends numbered in route order, the same bend side by side in both directions.", "swbp"),
+                  "</div>"]
     for name in ("forward", "reverse"):
         d = plan["directions"][name]
         header, rows = section_rows(d, units)
         loads = ("<p class='note'>End point loads: the concentrated force where the stiff cable meets the bend's "
                  "wall at its ends; a negative value means the cable's stiffness lifts it off the wall there "
                  "(no concentrated load).</p>" if len(header) > 10 else "")
-        parts += [f"<h2>Sections, {html.escape(direction_label(plan, name))} pull</h2>",
+        parts += [f"<div class='block'><h2>Sections, {html.escape(direction_label(plan, name))} pull</h2>",
                   f"<p>Pull force {fmt_number(from_si(d['pull_force_N'], 'force', units))} {f}; max tension "
                   f"{fmt_number(from_si(d['max_tension_N'], 'force', units))} {f}; "
                   f"{'every given limit is met' if d['passed'] else 'a check fails'}"
                   f"{'; the cable runs slack somewhere (a downhill stretch steeper than the friction angle)' if d['slack'] else ''}"
                   ". Sections in pull order, numbered and named in route order.</p>",
                   f"<div id='sections-{name}'>" + _table(header, rows, left=(1, 3), table_id=f"sections-table-{name}")
-                  + "</div>" + loads]
+                  + "</div>" + loads + "</div>"]
     if "pull_in" in plan["directions"]["forward"]:
         # The quasi-static rope integrates from the tail: with the head at x the rig pulls T(x) of the full
         # pull, so the history is the tension curve above read as "force at the rig vs pulled length".
@@ -454,15 +459,19 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
                   "against pulled length"
                   f"{'' if plan['engine'] == 'rope' else ' (from the rope with every engine)'}. Tables: "
                   "<code>pull_in_forward.csv</code>, <code>pull_in_reverse.csv</code>.</p>"]
-    assumptions = ["Several cables: the rope carries the weight of all n cables and the friction μ times the weight "
-                   "correction factor (reference/engineering.toml).",
-                   "The rope (every engine's reference) is perfectly flexible, EJ = 0, and lies on the duct's centreline."]
+    assumptions = ["The rope (every engine's reference) is perfectly flexible, EJ = 0, and lies on the duct's "
+                   "centreline."]
+    if plan["count"] > 1:
+        assumptions.append(f"{plan['count']} cables: the rope carries the weight of all of them and the friction μ "
+                           "times the weight correction factor; the SWBP is that of the most loaded cable "
+                           "(reference/engineering.toml).")
     if plan["engine"] != "rope":
         assumptions.append("The multibody model uses E and EJ above; a cable's real EJ may differ from E·π·r⁴/4 by "
                            "an order of magnitude (stranded or layered cables): give cable.bending_stiffness from "
                            "the data sheet.")
     parts += ["<div class='block'><h2>Inputs and assumptions</h2>",
-              _table(["input", f"value ({units})", "SI"], _input_rows(plan, units), left=(0, 1, 2), table_id="inputs"),
+              _table(["input", f"value ({units})", "SI"], _input_rows(plan, units), left=(0, 1, 2), table_id="inputs",
+                     wrap=(0,)),
               "<ul class='note'>" + "".join(f"<li>{html.escape(a)}</li>" for a in assumptions) + "</ul></div>",
               "<div class='block'><h2>Sign-off</h2><table class='sign' id='sign-off'><tr><th class='l'>role</th>"
               "<th class='l'>name</th><th class='l'>signature</th><th class='l'>date</th></tr>"
