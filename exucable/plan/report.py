@@ -439,9 +439,10 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
     for name in ("forward", "reverse"):
         d = plan["directions"][name]
         header, rows = section_rows(d, units)
-        loads = ("<p class='note'>End point loads: the concentrated force where the stiff cable meets the bend's "
-                 "wall at its ends; a negative value means the cable's stiffness lifts it off the wall there "
-                 "(no concentrated load).</p>" if len(header) > 10 else "")
+        loads = ("<p class='note'>End point loads: the concentrated force where the stiff cable lands on the bend's "
+                 "wall at each end, beyond the bend's distributed pressure (exucable/post/pressure.py). A negative "
+                 "value: near that end the cable bears on the wall less than the distributed pressure would put "
+                 "there (it lifts off); there is no concentrated load.</p>" if len(header) > 10 else "")
         parts += [f"<div class='block'><h2>Sections, {html.escape(direction_label(plan, name))} pull</h2>",
                   f"<p>Pull force {fmt_number(from_si(d['pull_force_N'], 'force', units))} {f}; max tension "
                   f"{fmt_number(from_si(d['max_tension_N'], 'force', units))} {f}; "
