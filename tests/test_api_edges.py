@@ -99,6 +99,14 @@ def test_run_takes_a_mode_and_a_steady_result_is_a_state(monkeypatch, tmp_path):
     # range is a few per cent of the force, not trailing tension (150 N) to pull force
     lo, hi = axes[0].get_ylim()
     assert lo > 190.0 and hi < 220.0
+    # the bend's two point-load labels clear of each other and of the legend
+    fig = captured["pressure.png"]
+    renderer = fig.canvas.get_renderer()
+    fig.draw(renderer)
+    ax = fig.axes[0]
+    boxes = [t.get_window_extent(renderer) for t in ax.texts] + [ax.get_legend().get_window_extent(renderer)]
+    assert len(boxes) == 3
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
 
 
 def test_run_prints_in_the_scenarios_display_units(monkeypatch, capsys, tmp_path):

@@ -228,3 +228,25 @@ def test_screenshot_and_pdf_of_the_report(tmp_path):
     img = imread(shot)
     assert img.shape[0] >= 1000 and img.shape[1] == 1000
     assert float(img[..., :3].std()) > 0.05                  # not a blank page
+
+
+def test_route_plan_view_labels_do_not_collide():
+    """A level route in plan view, in feet: every point name and bend label inside the figure and clear
+    of every other label (bounding boxes as drawn)."""
+    from exucable.plan.pull import load_plan_scenario
+    from exucable.plots.route import route_figure
+
+    scenario, _ = load_plan_scenario(COMMSCOPE)
+    fig = route_figure(scenario.build_conduit(), "t", "ft", 0.3048, list("ABCDEFGH"))
+    ax = fig.axes[0]
+    assert ax.name != "3d" and ax.get_xlabel() == "x [ft]"
+    renderer = fig.canvas.get_renderer()
+    fig.draw(renderer)
+    boxes = [(t.get_text(), t.get_window_extent(renderer)) for t in ax.texts]
+    assert sorted(name for name, _ in boxes if len(name) == 1) == list("ABCDEFGH")
+    assert sum(name.startswith("bend ") for name, _ in boxes) == 3
+    frame = fig.bbox
+    for i, (a, box_a) in enumerate(boxes):
+        assert frame.x0 <= box_a.x0 and box_a.x1 <= frame.x1 and frame.y0 <= box_a.y0 and box_a.y1 <= frame.y1, a
+        for b, box_b in boxes[i + 1:]:
+            assert not box_a.overlaps(box_b), (a, b)

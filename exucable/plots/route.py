@@ -230,16 +230,21 @@ def _figure_3d(conduit, title: str | None = None, unit: str = "m", per_unit: flo
             u_label = 0.5 * piece.length_m * (min(1.0, 1.0 / turns) if piece.kind == "helix" else 1.0)
             # Set the label off the curve, away from its centre of curvature, so it hides no line.
             outward = -piece.curvature_vector(u_label) / piece.curvature_1_per_m
-            at = piece.point(u_label) / per_unit + 0.07 * extent * outward
-            ax.text(at[0], at[1], at[2], _piece_label(number, piece, unit, per_unit), fontsize=8, color="0.1",
+            # further out with named points, whose names sit at the bend's ends
+            at = piece.point(u_label) / per_unit + (0.14 if point_names else 0.07) * extent * outward
+            label = _piece_label(number, piece, unit, per_unit)
+            if point_names:                 # the tables' name of the bend: "bend 2", not "B2"
+                label = "bend " + label[1:].replace(" ", ": ", 1)
+            ax.text(at[0], at[1], at[2], label, fontsize=8, color="0.1",
                     ha="center", va="center", bbox=_LABEL_BOX)
     points = np.concatenate(all_points)
 
     start, end = np.asarray(c.start_m) / per_unit, np.asarray(c.end_m) / per_unit
     ax.scatter(*start, color="tab:green", s=45, marker="o", depthshade=False, zorder=5)
     ax.scatter(*end, color="tab:red", s=45, marker="s", depthshade=False, zorder=5)
-    ax.text(*start, "  start", color="tab:green", fontsize=9, fontweight="bold")
-    ax.text(*end, "  end", color="tab:red", fontsize=9, fontweight="bold")
+    if not point_names:                 # named points say where the route starts and ends themselves
+        ax.text(*start, "  start", color="tab:green", fontsize=9, fontweight="bold")
+        ax.text(*end, "  end", color="tab:red", fontsize=9, fontweight="bold")
 
     _equal_box(ax, points)
     if point_names:
