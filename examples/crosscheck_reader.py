@@ -8,8 +8,10 @@ forces and compare them with exucable's (``snapshot_contact.csv``).
 
 Usage::
 
-    exucable export scenarios/fast/paper_ex2_bend90.toml out/ex2-export
-    exucable run scenarios/fast/paper_ex2_bend90.toml --out out/ex2-export   # with [output] snapshots
+    cp scenarios/fast/paper_ex2_bend90.toml ex2.toml
+    printf '[output]\nsnapshots = [0.2]\n' >> ex2.toml     # the state to compare at
+    exucable export ex2.toml out/ex2-export
+    exucable run ex2.toml --out out/ex2-export
     python examples/crosscheck_reader.py out/ex2-export
 
 prints, for the first snapshot, the largest difference of the per-element normal and friction
@@ -190,6 +192,9 @@ def first_snapshot_check(directory) -> dict[str, float]:
 if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit(__doc__)
+    if not (Path(sys.argv[1]) / "snapshot_nodes.csv").is_file():
+        sys.exit(f"{sys.argv[1]}: no snapshot_nodes.csv; run the scenario with [output] snapshots into the "
+                 "export's directory (usage above)")
     res = first_snapshot_check(sys.argv[1])
     print(f"first snapshot t = {res['time_s']:.12g} s: max relative difference of the per-element "
           f"normal forces {res['normal_force_N']:.2e}, friction forces {res['friction_force_N']:.2e}")
