@@ -7,6 +7,8 @@ A and B are result directories or single CSV files. Every quantity family of the
 family                 file                        abscissa        values
 =====================  ==========================  ==============  ==========================================
 ``history``            ``history.csv``             ``time_s``      pull_force_N, trailing_tension_N, max_tension_N
+                                                                  (not of a steady-mode run: its rows are
+                                                                  solve steps; its state's profiles compare)
 ``tension_profile``    ``tension_profile.csv``     ``x_m``         tension_N
 ``contact_profile``    ``contact_profile.csv``     ``s_conduit_m`` normal_force_per_length_N_per_m, penetration_m
 ``rope_profile``       ``rope_profile.csv``        ``s_conduit_m`` tension_N, sidewall_pressure_N_per_m
@@ -35,6 +37,7 @@ Use :func:`compare_results` from Python; :mod:`exucable.commands.compare` is the
 from __future__ import annotations
 
 import csv
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -169,11 +172,30 @@ def _read_csv(path: Path) -> _Table:
     return _Table(path, kind, groups, notes)
 
 
+def _steady_mode(path: Path) -> bool:
+    """Whether a result directory holds a steady-mode run (``summary.json`` ``mode``)."""
+    try:
+        return json.loads((path / "summary.json").read_text(encoding="utf-8")).get("mode") == "steady"
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def _load(source) -> dict:
-    """Tables of a result directory or a single CSV, keyed by family."""
+    """Tables of a result directory or a single CSV, keyed by family.
+
+    A steady-mode run's ``history.csv`` counts static solve steps, not time: it is left out (the run's
+    state, its profiles, is what compares with a dynamic run's final state), with a note saying so.
+    """
     path = Path(source)
     if path.is_dir():
-        tables = {kind: _read_csv(path / fam.file) for kind, fam in FAMILIES.items() if (path / fam.file).is_file()}
+        steady = _steady_mode(path)
+        tables = {kind: _read_csv(path / fam.file) for kind, fam in FAMILIES.items() if (path / fam.file).is_file()
+                  and not (steady and kind == "history")}
+        if steady and tables:
+            first = next(iter(tables.values()))
+            tables[next(iter(tables))] = _Table(first.path, first.kind, first.groups, first.notes + (
+                f"{path}: a steady-mode result, one state: its history.csv (static solve steps, not time) is not "
+                "compared; the profiles of its state are",))
         if not tables:
             raise ExucableError(f"{path}: result directory has none of "
                                 + ", ".join(f.file for f in FAMILIES.values()))
