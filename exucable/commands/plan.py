@@ -143,8 +143,8 @@ def main(args) -> int:
         for c in d["checks"]:
             value, limit, unit = check_in_units(c, units)
             margin = "" if c["margin"] is None else f", margin {100 * c['margin']:.1f} %"
-            limit = "" if limit is None else f", limit {fmt_number(limit)} {unit}"
-            value = "" if value is None else f"value {fmt_number(value)} {unit}"
+            limit = "" if limit is None else f", limit {fmt_number(limit)} {unit}".rstrip()
+            value = "" if value is None else f"value {fmt_number(value)} {unit}".rstrip()
             print(f"  check {c['name']}: {'pass' if c['passed'] else 'FAIL'} ({value}"
                   f"{limit}{margin}{'; ' if value else ''}{c['where']})")
         unchecked = [c["name"] for c in d["not_checked"] if c["why"].startswith("not checked")]
