@@ -250,3 +250,12 @@ def test_route_plan_view_labels_do_not_collide():
         assert frame.x0 <= box_a.x0 and box_a.x1 <= frame.x1 and frame.y0 <= box_a.y0 and box_a.y1 <= frame.y1, a
         for b, box_b in boxes[i + 1:]:
             assert not box_a.overlaps(box_b), (a, b)
+
+
+def test_pdf_without_a_browser_is_a_one_line_error_naming_the_fix(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("EXUCABLE_BROWSER", str(tmp_path / "no-such-browser"))
+    assert find_browser() is None
+    assert cli_main(["plan", str(COMMSCOPE), "--out", str(tmp_path / "plan"), "--pdf"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--pdf" in err and "apt-get install chromium" in err
+    assert not (tmp_path / "plan").exists()                  # refused before anything was written

@@ -117,6 +117,11 @@ def main(args) -> int:
     from exucable.plan.report import check_in_units, direction_label, fmt_number, section_rows
     from exucable.scenario.units import display_unit, from_si
 
+    if args.pdf:
+        from exucable.plan.report import find_browser, report_pdf
+
+        if find_browser() is None:           # say so before anything runs or is written
+            report_pdf("")
     scenario, spec = load_plan_scenario(args.scenario, units=args.units)
     plan = plan_pull(scenario, spec, engine=args.engine, progress=True)
     units = spec.units

@@ -148,9 +148,12 @@ def section_rows(direction: dict, units: str) -> tuple[list[str], list[list]]:
                swbp, from_si(r["max_tension_so_far_N"], "force", units)]
         if beside:
             rope_p = r["rope_sidewall_pressure_N_per_m"]
+            # on the scale of the section's tension, as the tension columns beside (a load of 0.03 lbf
+            # beside 36 lbf reads 0.03, not -0.03095)
+            t_scale = abs(from_si(r["tension_out_N"], "force", units))
             loads = (None if "entry_point_load_N" not in r else
-                     f"{fmt_number(from_si(r['entry_point_load_N'], 'force', units))} / "
-                     f"{fmt_number(from_si(r['exit_point_load_N'], 'force', units))}")
+                     f"{fmt_number(from_si(r['entry_point_load_N'], 'force', units), t_scale)} / "
+                     f"{fmt_number(from_si(r['exit_point_load_N'], 'force', units), t_scale)}")
             row += [from_si(r["rope_tension_out_N"], "force", units),
                     None if rope_p is None else from_si(rope_p, "force_per_length", units), loads]
         rows.append(row)
