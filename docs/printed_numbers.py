@@ -1,7 +1,7 @@
 """The numbers the README and examples/README.md print, computed by running what they show.
 
 Each printed number is produced here by running the very code the document shows (the README's Python
-block, ``examples/paper_example2.py``) and formatted as the document prints it; ``tests/test_docs_numbers.py``
+block, ``examples/paper_example2.py``, ``examples/friction_sweep.py``) and formatted as the document prints it; ``tests/test_docs_numbers.py``
 runs :func:`stale` so a document whose number no longer matches what the code prints fails the suite.
 
 Run from the repository root:
@@ -43,11 +43,16 @@ def readme_snippet_comment() -> tuple[str, str]:
     return r"res\.pull_force_N, res\.pull_force_uncertainty_N, res\.status +#[^\n]*", line
 
 
-def example2_sentence() -> tuple[str, str]:
-    """(pattern, text): examples/README.md's sentence on ``paper_example2.py``, from running it at full length."""
-    spec = importlib.util.spec_from_file_location("paper_example2", ROOT / "examples" / "paper_example2.py")
+def _load_example(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "examples" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
+    return module
+
+
+def example2_sentence() -> tuple[str, str]:
+    """(pattern, text): examples/README.md's sentence on ``paper_example2.py``, from running it at full length."""
+    module = _load_example("paper_example2")
     with contextlib.redirect_stdout(io.StringIO()):
         res, capstan = module.main()
     rel = 100 * (res.pull_force_N / capstan - 1)
@@ -57,7 +62,26 @@ def example2_sentence() -> tuple[str, str]:
     return r"`paper_example2\.py` [0-9.]+ ± [0-9.]+ N against the capstan [0-9.]+ N \([+−-][0-9.]+ %\)", text
 
 
-GENERATED = ((README, readme_snippet_comment), (EXAMPLES_README, example2_sentence))
+def _signed(x: float) -> str:
+    return f"{'+' if x >= 0 else '−'}{abs(x):.3f}"
+
+
+def friction_sweep_sentence() -> tuple[str, str]:
+    """(pattern, text): examples/README.md's sentence on ``friction_sweep.py``, from running it at full length
+    (the largest and smallest deviation from the capstan over its frictions)."""
+    import tempfile
+
+    module = _load_example("friction_sweep")
+    with tempfile.TemporaryDirectory() as tmp, contextlib.redirect_stdout(io.StringIO()):
+        mu, force, capstan = module.main(out=Path(tmp) / "friction_sweep.png")
+    dev = [100 * (f / c - 1) for f, c in zip(force, capstan)]
+    text = (f"`friction_sweep.py` μ = {mu[0]:g} … {mu[-1]:g} within {_signed(max(dev))} … {_signed(min(dev))} % "
+            "of the capstan")
+    return r"`friction_sweep\.py` μ = [0-9.]+ … [0-9.]+ within [+−-][0-9.]+ … [+−-][0-9.]+ % of the capstan", text
+
+
+GENERATED = ((README, readme_snippet_comment), (EXAMPLES_README, example2_sentence),
+             (EXAMPLES_README, friction_sweep_sentence))
 
 
 _NUMBER = re.compile(r"[+−-]?[0-9]+\.([0-9]+)")
