@@ -215,7 +215,11 @@ class Route:
 
 @dataclass(frozen=True)
 class History:
-    """Time histories at the output interval (numpy arrays, one value per output time)."""
+    """Time histories at the output interval (numpy arrays, one value per output time) [s], [N].
+
+    A steady-mode result has no time: one row per static solve step, ``time_s`` the step number
+    (README "Two solver modes").
+    """
 
     time_s: np.ndarray
     pull_force_N: np.ndarray
@@ -364,7 +368,8 @@ def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False, m
     )
 
 
-def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False) -> list[tuple[dict, Result]]:
+def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False,
+         mode: str | None = None) -> list[tuple[dict, Result]]:
     """Run ``scenario`` for every combination of ``values``, one after another (a Python sweep).
 
     Named ``vary`` because ``exucable.sweep`` is the package of sweep files (``exucable sweep``).
@@ -376,6 +381,8 @@ def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False
         Dotted key → values, e.g. ``{"contact.friction": [0.1, 0.2, 0.3]}``; the first key varies slowest.
     progress : bool
         Progress bar of each run.
+    mode : {"dynamic", "steady"}, optional
+        Solver mode of every run, overriding ``solver.mode`` (as :func:`run`).
 
     Returns
     -------
@@ -387,4 +394,4 @@ def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False
     keys = list(values)
     params = [dict(zip(keys, combo)) for combo in itertools.product(*(values[k] for k in keys))]
     cases = [scenario.replace(**p) for p in params]
-    return [(p, run(c, progress=progress)) for p, c in zip(params, cases)]
+    return [(p, run(c, progress=progress, mode=mode)) for p, c in zip(params, cases)]
