@@ -231,7 +231,7 @@ def _figure_3d(conduit, title: str | None = None, unit: str = "m", per_unit: flo
             # Set the label off the curve, away from its centre of curvature, so it hides no line.
             outward = -piece.curvature_vector(u_label) / piece.curvature_1_per_m
             # further out with named points, whose names sit at the bend's ends
-            at = piece.point(u_label) / per_unit + (0.14 if point_names else 0.07) * extent * outward
+            at = piece.point(u_label) / per_unit + (0.1 if point_names else 0.07) * extent * outward
             label = _piece_label(number, piece, unit, per_unit)
             if point_names:                 # the tables' name of the bend: "bend 2", not "B2"
                 label = "bend " + label[1:].replace(" ", ": ", 1)
