@@ -323,6 +323,9 @@ def first_snapshot_check(directory) -> dict[str, float]:
 if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit(__doc__)
+    if not (Path(sys.argv[1]) / "snapshot_nodes.csv").is_file():
+        sys.exit(f"{sys.argv[1]}: no snapshot_nodes.csv; run the scenario with [output] snapshots into the "
+                 "export's directory (usage above)")
     res = first_snapshot_check(sys.argv[1])
     print(f"first snapshot t = {res['time_s']:.12g} s: max relative difference of the per-element "
           f"normal forces {res['normal_force_N']:.2e}, friction forces {res['friction_force_N']:.2e}")

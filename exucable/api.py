@@ -37,8 +37,11 @@ from .scenario.specs import (
     Scenario,
     SolverSpec,
     _build_conduit,
+    _coerce,
     _conduit_length_m,
+    _FIELD_BY_KEY,
     _parse_conduit,
+    _quantities_to_si,
 )
 from .scenario.fields import REQUIRED, fields_of
 
@@ -72,10 +75,12 @@ def _keys_doc(section: str) -> str:
 
 def _part(section: str, spec_cls, summary: str):
     def make(**keys):
-        return spec_cls.from_keys(**keys)
+        # quantities read as in a file: a number in SI, or a string with its unit ("2.5 mm")
+        return spec_cls.from_keys(**_quantities_to_si({section: keys}, "si")[section])
 
     make.__name__ = make.__qualname__ = section.capitalize()
-    make.__doc__ = (f"{summary}\n\nTakes the ``[{section}]`` keys of a scenario file; returns a validated "
+    make.__doc__ = (f"{summary}\n\nTakes the ``[{section}]`` keys of a scenario file, read as in a file (SI "
+                    "numbers, or strings with a unit such as ``\"2.5 mm\"``); returns a validated "
                     f":class:`~exucable.scenario.specs.{spec_cls.__name__}`.\n\n{_keys_doc(section)}\n\n"
                     "Raises\n------\nScenarioError\n    Unknown key or bad value, naming the dotted key.\n")
     return make
@@ -84,7 +89,7 @@ def _part(section: str, spec_cls, summary: str):
 Cable = _part("cable", CableSpec, "The cable (paper Sect. 2.2): radius, density or mass per length, E, mesh.")
 Contact = _part("contact", ContactSpec, "The cable–conduit contact law (paper Sects. 2.4–2.5, Eqs. 17–23).")
 Pull = _part("pull", PullSpec, "The pulling rig (paper Sect. 2.1, Eq. 1) and the trailing-end load.")
-Gravity = _part("gravity", GravitySpec, "Gravity along −z.")
+Gravity = _part("gravity", GravitySpec, "Gravity along −z (``Gravity()``: g = 9.81 m/s²).")
 Solver = _part("solver", SolverSpec, "Time integration settings.")
 Output = _part("output", OutputSpec, "What is written besides the standard results (snapshots).")
 
@@ -95,10 +100,12 @@ class Route:
     Each method returns a new Route (a route is a value); every piece is checked as it is added,
     with the scenario file's dotted keys in the error (``conduit.path[1].radius``).
 
+    Lengths are numbers in metres or strings with a unit (``"3.5 mm"``, ``"10 ft"``), as in a file.
+
     Parameters
     ----------
-    inner_radius : float
-        Conduit inner radius [m].
+    inner_radius : float or str
+        Conduit inner radius [m], checked at once.
     start : sequence of 3 float
         Start of the centreline [m] (default the origin).
     heading : sequence of 3 float
@@ -112,6 +119,10 @@ class Route:
     def __init__(self, inner_radius: float, start=(0.0, 0.0, 0.0), heading=(1.0, 0.0, 0.0),
                  max_segment_angle: float | None = None, segments_per_bend: int | None = None,
                  _pieces: tuple = (), _survey: dict | None = None):
+        # read and checked here, so that a bad radius is named before the first piece
+        inner_radius = _coerce(_FIELD_BY_KEY["conduit.inner_radius"],
+                               _quantities_to_si({"conduit": {"inner_radius": inner_radius}}, "si")["conduit"]
+                               ["inner_radius"])
         keys: dict[str, Any] = {"inner_radius": inner_radius}
         if _survey is None:
             keys.update(start=list(start), heading=list(heading))
@@ -137,6 +148,9 @@ class Route:
         if self._survey is not None:
             raise ValueError("a survey route is complete: build pieces on a Route(inner_radius=...) instead")
         k = self._keys
+        i = len(self._pieces)
+        # lengths as in a file ("10 ft"), errors keyed conduit.path[i]
+        piece = _quantities_to_si({"conduit": {"path": [{}] * i + [dict(piece)]}}, "si")["conduit"]["path"][i]
         return Route(k["inner_radius"], k["start"], k["heading"], k.get("max_segment_angle"),
                      k.get("segments_per_bend"), _pieces=self._pieces + (piece,))
 
@@ -201,7 +215,11 @@ class Route:
 
 @dataclass(frozen=True)
 class History:
-    """Time histories at the output interval (numpy arrays, one value per output time)."""
+    """Time histories at the output interval (numpy arrays, one value per output time) [s], [N].
+
+    A steady-mode result has no time: one row per static solve step, ``time_s`` the step number
+    (README "Two solver modes").
+    """
 
     time_s: np.ndarray
     pull_force_N: np.ndarray
@@ -238,15 +256,20 @@ class Result:
     Attributes
     ----------
     pull_force_N : float
-        Mean pulling force in the steady window [N] (NaN if nothing was recorded).
+        Mean pulling force in the steady window [N] (NaN if nothing was recorded); in steady mode the
+        pulling force of the steady sliding state.
     pull_force_uncertainty_N : float
-        Its uncertainty [N]: ``summary["pull_force_uncertainty_N"]`` when the run wrote one, else
-        √(σ² + d²) of the steady window (σ the scatter, d the drift of the least-squares line
-        across it): how steady the number is, not how mesh-converged.
+        Its uncertainty [N], as ``summary["pull_force_uncertainty_N"]``: from whole oscillation periods
+        and the drift over the steady window; how steady the number is, not how mesh-converged. NaN
+        where the summary has none (null): a steady-mode result (one static state has no scatter) or a
+        run without a steady window.
     status : str
-        ``"ok"``, ``"steady"`` (stopped once steady) or ``"failed"``.
+        ``"ok"``, ``"steady"`` (stopped once steady), ``"failed"``, or for a result that must not be
+        trusted the first of ``"dynamic"``, ``"outside_conduit"``, ``"penetration"``, ``"not_steady"``
+        (README "Results format"; every cause is in ``summary["flags"]``).
     message : str
-        The solver's message when failed.
+        What the solver or the trust checks said: the failure, the flags' causes, or in steady mode how
+        the static solve converged; ``""`` when there is nothing to say.
     history : History
     tension_profile : TensionProfile
     summary : dict
@@ -269,6 +292,15 @@ class Result:
     scenario: Scenario
     out_dir: Path | None
 
+    def __repr__(self) -> str:
+        s = self.summary
+        mode = s.get("mode", "dynamic")
+        u = self.pull_force_uncertainty_N
+        force = f"{self.pull_force_N:.6g} N" + ("" if math.isnan(u) else f" ± {u:.2g} N")
+        return (f"Result(status={self.status!r}, mode={mode!r}, pull_force_N={force}, "
+                f"rope_pull_force_N={self.rope_pull_force_N:.6g} N, steps={s.get('steps')}, "
+                f"wall_time_s={s.get('wall_time_s', float('nan')):.3g}, out_dir={self.out_dir!r})")
+
     @property
     def trailing_tension_N(self) -> float:
         """Mean trailing-end tension in the steady window [N]."""
@@ -285,8 +317,8 @@ def _number(value) -> float:
 
 
 def _uncertainty(summary: dict) -> float:
-    if summary.get("pull_force_uncertainty_N") is not None:
-        return float(summary["pull_force_uncertainty_N"])
+    if "pull_force_uncertainty_N" in summary:      # null (steady mode, no window): NaN, as the summary says
+        return _number(summary["pull_force_uncertainty_N"])
     std = _number(summary.get("pull_force_std_N"))
     drift = _number(summary.get("steady_drift_N"))
     if math.isnan(drift):
@@ -294,25 +326,30 @@ def _uncertainty(summary: dict) -> float:
     return math.hypot(std, drift)
 
 
-def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False) -> Result:
+def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False, mode: str | None = None) -> Result:
     """Simulate one scenario.
 
     Parameters
     ----------
-    scenario : Scenario, or path of a scenario file
+    scenario : Scenario, or path of a scenario file, or a shipped scenario's name
     out_dir : path, optional
         Write the result files there (docs/results-format.md); by default nothing is written.
     progress : bool
         Show a progress bar on stderr (only when it is a terminal).
+    mode : {"dynamic", "steady"}, optional
+        Solver mode, overriding ``solver.mode`` (README "Two solver modes").
 
     Returns
     -------
     Result
         A failed integration does not raise: ``status == "failed"`` and what was recorded.
     """
+    from .errors import ScenarioError
     from .run import run_scenario
 
-    raw = run_scenario(scenario, out_dir, quiet=not progress, plots=out_dir is not None)
+    if mode is not None and mode not in ("dynamic", "steady"):
+        raise ScenarioError("solver.mode", f"mode must be \"dynamic\" or \"steady\", got {mode!r}")
+    raw = run_scenario(scenario, out_dir, quiet=not progress, plots=out_dir is not None, mode=mode)
     h = raw.history
     s = raw.summary
     return Result(
@@ -331,7 +368,8 @@ def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False) -
     )
 
 
-def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False) -> list[tuple[dict, Result]]:
+def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False,
+         mode: str | None = None) -> list[tuple[dict, Result]]:
     """Run ``scenario`` for every combination of ``values``, one after another (a Python sweep).
 
     Named ``vary`` because ``exucable.sweep`` is the package of sweep files (``exucable sweep``).
@@ -343,6 +381,8 @@ def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False
         Dotted key → values, e.g. ``{"contact.friction": [0.1, 0.2, 0.3]}``; the first key varies slowest.
     progress : bool
         Progress bar of each run.
+    mode : {"dynamic", "steady"}, optional
+        Solver mode of every run, overriding ``solver.mode`` (as :func:`run`).
 
     Returns
     -------
@@ -354,4 +394,4 @@ def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False
     keys = list(values)
     params = [dict(zip(keys, combo)) for combo in itertools.product(*(values[k] for k in keys))]
     cases = [scenario.replace(**p) for p in params]
-    return [(p, run(c, progress=progress)) for p, c in zip(params, cases)]
+    return [(p, run(c, progress=progress, mode=mode)) for p, c in zip(params, cases)]

@@ -18,6 +18,7 @@ __all__ = ["main", "SUBCOMMANDS"]
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "route": ("exucable.commands.route", "draw a scenario's conduit route and print its table"),
     "run": ("exucable.commands.run", "simulate one scenario and write its results"),
+    "scenarios": ("exucable.commands.scenarios", "list the shipped scenarios, by the names every command takes"),
     "validate": ("exucable.commands.validate", "run the paper's examples (or --suite industry: published pulls) against their references"),
     "sweep": ("exucable.commands.sweep", "run a parameter sweep (local pool or Dask)"),
     "compare": ("exucable.commands.compare", "compare two result sets (yours and ours)"),

@@ -75,6 +75,10 @@ class AtomicBatch:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp", dir=path.parent)
         f = os.fdopen(fd, "wb")
         try:
+            if hasattr(os, "fchmod"):
+                # mkstemp makes the file 0600; a file made by open() gets 0666 less the umask, which
+                # lets colleagues on a shared drive read results as they read any other file of the user's
+                os.fchmod(fd, 0o666 & ~_umask())
             f.write(data)
             f.flush()
         except BaseException:
@@ -121,6 +125,21 @@ class AtomicBatch:
     def __exit__(self, exc_type, exc, tb):
         self.commit()
         return False
+
+
+def _umask() -> int:
+    """The process's umask, read without changing it where the system allows (Linux ``/proc``);
+    elsewhere set and restored at once."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def _remove(f, tmp) -> None:

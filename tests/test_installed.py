@@ -62,3 +62,9 @@ def test_wheel_installed_elsewhere_validates(tmp_path):
     assert (elsewhere / "validation" / "validation.csv").is_file()
     assert (elsewhere / "validation" / "fig12_coils.png").is_file()
     assert not list(elsewhere.glob("*.toml")) and not (elsewhere / "scenarios").exists()
+    # the README's commands, as written, from outside the repository: shipped scenarios by name or by
+    # their scenarios/... path
+    assert "industry/commscope_conquest_run_a_h" in _run([bin_dir / "exucable", "scenarios"], cwd=elsewhere)
+    _run([bin_dir / "exucable", "route", "scenarios/paper_ex4_spatial.toml", "-o", "route.png"], cwd=elsewhere)
+    _run([bin_dir / "exucable", "plan", "industry/commscope_conquest_run_a_h", "--out", "plan"], cwd=elsewhere)
+    assert (elsewhere / "route.png").is_file() and (elsewhere / "plan" / "report.html").is_file()

@@ -4,11 +4,12 @@ no result already written lost on an error."""
 from __future__ import annotations
 
 import os
+import stat
 
 import pytest
 
 import exucable.io as eio
-from exucable.io import AtomicBatch, write_csv
+from exucable.io import AtomicBatch, atomic_write_text, write_csv
 
 
 def test_a_batch_lands_every_file_in_the_order_added(tmp_path, monkeypatch):
@@ -65,3 +66,23 @@ def test_columns_of_unequal_length_are_refused(tmp_path):
     with pytest.raises(ValueError, match="unequal length"):
         write_csv(tmp_path / "history.csv", ["time_s", "max_penetration_m"], {"time_s": [1.0, 2.0], "max_penetration_m": []})
     assert not (tmp_path / "history.csv").exists()
+
+
+@pytest.mark.skipif(not hasattr(os, "fchmod"), reason="POSIX permissions only")
+@pytest.mark.parametrize("mask", [0o022, 0o077, 0o002])
+def test_files_get_the_users_umask_as_open_would_give_them(tmp_path, mask):
+    """A result file on a shared drive is readable by whoever the user's umask lets read it: the mode
+    open() would give (0666 & ~umask), not mkstemp's 0600."""
+    old = os.umask(mask)
+    try:
+        atomic_write_text(tmp_path / "a.txt", "x")
+        with AtomicBatch() as batch:
+            batch.add_text(tmp_path / "b.txt", "y")
+        with open(tmp_path / "c.txt", "w") as f:   # the reference: what the system gives a plain new file
+            f.write("z")
+    finally:
+        os.umask(old)
+    expected = stat.S_IMODE(os.stat(tmp_path / "c.txt").st_mode)
+    assert expected == 0o666 & ~mask
+    for name in ("a.txt", "b.txt"):
+        assert stat.S_IMODE(os.stat(tmp_path / name).st_mode) == expected, name

@@ -320,15 +320,23 @@ def test_without_limits_the_plan_says_not_checked(tmp_path, capsys):
 
 @pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
 def test_an_infinite_tension_fails_with_or_without_limits():
-    """A tension past what a float holds (a back tension of 1.79e308 N grown by friction) is infinite,
-    and that fails a check of its own instead of passing unchecked."""
-    plan = _plan(pull__back_tension=1.79e308)
+    """A tension past what a float holds is infinite, and that fails a check of its own instead of
+    passing unchecked. The scenario's ranges now refuse the inputs that made one (a back tension of
+    1.79e308 N grown by friction), so the check is exercised on a direction whose tension overflowed."""
+    from exucable.errors import ScenarioError
+    from types import SimpleNamespace
+
+    import exucable.plan.pull as pull
+
+    with pytest.raises(ScenarioError, match=r"^pull\.back_tension"):
+        _plan(pull__back_tension=1.79e308)
+    scenario, spec = parse_plan_scenario(_data(), ROOT)
+    plan = plan_pull(scenario, spec)
     for name in ("forward", "reverse"):
-        d = plan["directions"][name]
-        assert not math.isfinite(d["max_tension_N"])
-        check = next(c for c in d["checks"] if c["name"] == "finite_tension")
+        d = dict(plan["directions"][name], max_tension_N=math.inf)
+        check = next(c for c in pull._checks(d, spec, scenario, plan["clearance_m"], SimpleNamespace(risk="not applicable"))
+                     if c["name"] == "finite_tension")
         assert check["passed"] is False
-    assert plan["passed"] is False
 
 
 def test_a_rope_that_cannot_be_solved_names_the_scenario_key(monkeypatch):

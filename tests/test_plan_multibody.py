@@ -106,7 +106,7 @@ def test_steady_engine_plan_against_the_capstan_rope_in_both_directions(tmp_path
         rows = list(csv.DictReader(f))
     assert len(rows) == 5 and float(rows[1]["rope_tension_out_N"]) > 0.0 and rows[1]["exit_point_load_N"] != ""
     page = (out / "report.html").read_text()
-    assert "Engine: steady (multibody model" in page and "rope T out" in page
+    assert "<th>Engine</th><td>steady: multibody model" in page and "rope T out" in page
 
 
 class _Terminal(io.StringIO):

@@ -79,7 +79,6 @@ BAD = [
     ("no-speed", with_(base(), ("pull", "speed"), _DELETE), "pull.speed", "required"),
     ("no-end-time", with_(base(), ("solver", "end_time"), _DELETE), "solver.end_time", "required"),
     ("no-inner-radius", with_(base(), ("conduit", "inner_radius"), _DELETE), "conduit.inner_radius", "required"),
-    ("gravity-without-g", with_(base(), ("gravity",), {}), "gravity.g", "required"),
     # wrong types
     ("radius-bool", with_(base(), ("cable", "radius"), True), "cable.radius", "must be a number"),
     # a quantity may carry its unit ("2.5 mm"); a string that is no quantity is refused with the key

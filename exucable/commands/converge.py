@@ -86,7 +86,8 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scenario", help="scenario file (TOML)")
+    p.add_argument("scenario", help="scenario file (TOML), or a shipped scenario's name "
+                                    "(`exucable scenarios` lists them)")
     p.add_argument("--levels", type=int, default=3, help="number of meshes, at least 3 (default 3)")
     p.add_argument("--ratio", type=float, default=2.0, help="refinement ratio of the element length (default 2)")
     p.add_argument("--out", "-o", default=None, help="result directory (default: out/<scenario name>-converge)")

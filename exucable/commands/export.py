@@ -8,7 +8,8 @@ __all__ = ["add_arguments", "main"]
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scenario", help="scenario file (TOML)")
+    p.add_argument("scenario", help="scenario file (TOML), or a shipped scenario's name "
+                                    "(`exucable scenarios` lists them)")
     p.add_argument("out", help="directory to write problem.json and the CSV tables into")
     p.add_argument("--mode", choices=("dynamic", "steady"), default=None,
                    help="override solver.mode: the problem of that mode (as exucable run --mode)")

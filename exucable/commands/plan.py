@@ -3,18 +3,20 @@
 Prints per direction the section table and the checks, and the recommended direction; writes
 ``DIR/plan.json`` (SI; fields in README "exucable plan"), ``sections_forward.csv``,
 ``sections_reverse.csv``, ``checks.csv``, ``pull_in_<direction>.csv`` (with ``pull.feed_from_reel``),
-``route.png`` and ``report.html``, each atomically, ``plan.json`` last. Exit status 0 when every check
-passes in the recommended direction, 1 when a check fails in both directions, 2 on bad input.
+``route.png`` and ``report.html`` (with ``--pdf`` also ``report.pdf``, printed by a headless Chromium), each
+atomically, ``plan.json`` last. Exit status 0 when every check passes in the recommended direction, 1 when a
+check fails in both directions, 2 on bad input.
 """
 
 from __future__ import annotations
 
 import csv
+import datetime
 import io
 from pathlib import Path
 
 from exucable.plan.pull import ENGINES, load_plan_scenario, plan_pull
-from exucable.io import atomic_write_text, write_csv, write_json
+from exucable.io import atomic_write_bytes, atomic_write_text, write_csv, write_json
 from exucable.output.outdir import check_out_dir, name_as_path_part
 from exucable.scenario.units import SYSTEMS
 
@@ -31,7 +33,8 @@ CHECK_COLUMNS = ("direction", "name", "passed", "value", "limit", "margin", "whe
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scenario", help="scenario file (TOML), with optional [limits], cable.count, cable.arrangement")
+    p.add_argument("scenario", help="scenario file (TOML) or a shipped scenario's name, with optional [limits], "
+                                    "cable.count, cable.arrangement")
     p.add_argument("--out", default=None, help="output directory (default: plan_<scenario name>)")
     p.add_argument("--engine", choices=ENGINES, default="rope",
                    help="rope (default, instant, any cable.count); steady (one static solve per direction) or "
@@ -40,6 +43,12 @@ def add_arguments(p) -> None:
     p.add_argument("--units", choices=SYSTEMS, default=None,
                    help="units of the printed tables and the report (default: the scenario's display.units); "
                         "the file's bare numbers are always read in its own display.units")
+    p.add_argument("--project", default=None, help="project name for the report's title block")
+    p.add_argument("--engineer", default=None, help="engineer's name for the report's title block")
+    p.add_argument("--revision", default=None, help="revision of the plan for the report's title block")
+    p.add_argument("--pdf", action="store_true",
+                   help="also write report.pdf, the page printed by a headless Chromium (A4; Letter with imperial "
+                        "units); needs chromium or chrome on PATH")
 
 
 def _text_csv(columns, rows) -> str:
@@ -51,10 +60,16 @@ def _text_csv(columns, rows) -> str:
     return buf.getvalue()
 
 
-def write_plan(out_dir, plan: dict, scenario, units: str) -> list[Path]:
-    """Write the plan's files into ``out_dir`` (each atomically, ``plan.json`` last); return their paths."""
+def write_plan(out_dir, plan: dict, scenario, units: str, meta: dict | None = None, pdf: bool = False) -> list[Path]:
+    """Write the plan's files into ``out_dir`` (each atomically, ``plan.json`` last); return their paths.
+
+    ``meta`` fills the report's title block (``project``, ``engineer``, ``revision``, ``date``,
+    ``scenario_file``); ``pdf`` also prints the page to ``report.pdf``
+    (:func:`exucable.plan.report.report_pdf`).
+    """
     from exucable.plots.route import plot_route
-    from exucable.plan.report import plan_report_html
+    from exucable.plan.report import plan_report_html, report_pdf
+    from exucable.scenario.units import UNITS, display_unit
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -76,23 +91,27 @@ def write_plan(out_dir, plan: dict, scenario, units: str) -> list[Path]:
     rows = [dict(c, direction=n) for n in ("forward", "reverse") for c in plan["directions"][n]["checks"]]
     atomic_write_text(out / "checks.csv", _text_csv(CHECK_COLUMNS, rows))
     written.append(out / "checks.csv")
-    route_png = plot_route(scenario.build_conduit(), out / "route.png", title=scenario.name)
+    length_unit = display_unit("length", units)
+    route_png = plot_route(scenario.build_conduit(), out / "route.png", title=scenario.name, length_unit=length_unit,
+                           metres_per_unit=UNITS[length_unit][1], point_names=plan["point_names"])
     written.append(route_png)
-    page = plan_report_html(plan, scenario.name, route_png.read_bytes(), units)
+    page = plan_report_html(plan, scenario.name, route_png.read_bytes(), units, meta=meta)
     atomic_write_text(out / "report.html", page)
     written.append(out / "report.html")
+    if pdf:
+        atomic_write_bytes(out / "report.pdf", report_pdf(page, paper="Letter" if units == "imperial" else "A4"))
+        written.append(out / "report.pdf")
     write_json(out / "plan.json", plan, indent=1)
     written.append(out / "plan.json")
     return written
 
 
 def _print_table(header, rows) -> None:
-    def cell(v):
-        if v is None:
-            return "–"
-        return f"{v:.4g}" if isinstance(v, float) else str(v)
+    from exucable.plan.report import fmt_number
 
-    cells = [[cell(v) for v in r] for r in rows]
+    scales = [max([abs(r[i]) for r in rows if isinstance(r[i], float) and abs(r[i]) < float("inf")], default=None)
+              for i in range(len(header))]
+    cells = [[str(v) if isinstance(v, int) else fmt_number(v, scales[i]) for i, v in enumerate(r)] for r in rows]
     widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
     print("  " + "  ".join(h.rjust(w) for h, w in zip(header, widths)))
     for c in cells:
@@ -100,9 +119,14 @@ def _print_table(header, rows) -> None:
 
 
 def main(args) -> int:
-    from exucable.plan.report import check_in_units, section_rows
+    from exucable.plan.report import check_in_units, direction_label, fmt_number, section_rows
     from exucable.scenario.units import display_unit, from_si
 
+    if args.pdf:
+        from exucable.plan.report import find_browser, report_pdf
+
+        if find_browser() is None:           # say so before anything runs or is written
+            report_pdf("")
     scenario, spec = load_plan_scenario(args.scenario, units=args.units)
     # checked before planning: a multibody engine's solves are not lost to a bad --out
     out = check_out_dir(Path(args.out) if args.out else Path(f"plan_{name_as_path_part(scenario.name)}"))
@@ -113,18 +137,21 @@ def main(args) -> int:
     plan = plan_pull(scenario, spec, engine=args.engine, progress=True)
     units = spec.units
     f = display_unit("force", units)
+    def force(v):
+        return f"{fmt_number(from_si(v, 'force', units))} {f}"
+
     print(f"{scenario.name}: {plan['count']} cable(s), {plan['arrangement']}, weight correction "
-          f"{plan['weight_correction_factor']:.4g}, jam ratio {plan['jam_ratio']:.3g} ({plan['jam_risk']}), "
-          f"clearance {from_si(plan['clearance_m'], 'length', units, small=True):.3g} {display_unit('length', units, small=True)}")
+          f"{fmt_number(plan['weight_correction_factor'])}, jam ratio {fmt_number(plan['jam_ratio'])} ({plan['jam_risk']}), "
+          f"clearance {fmt_number(from_si(plan['clearance_m'], 'length', units, small=True))} "
+          f"{display_unit('length', units, small=True)}, fill {fmt_number(plan['fill_percent'], 10.0)} %")
     for name in ("forward", "reverse"):
         d = plan["directions"][name]
-        print(f"\n{name} pull: pull force {from_si(d['pull_force_N'], 'force', units):.4g} {f}, "
-              f"max tension {from_si(d['max_tension_N'], 'force', units):.4g} {f}")
+        print(f"\n{direction_label(plan, name)} pull: pull force {force(d['pull_force_N'])}, "
+              f"max tension {force(d['max_tension_N'])}")
         if "rope_pull_force_N" in d:
             print(f"  {plan['engine']} engine, {d['elements']} elements: status {d['status']}"
                   f"{'; ' + d['message'] if d['message'] else ''}; rope: pull force "
-                  f"{from_si(d['rope_pull_force_N'], 'force', units):.4g} {f}, max tension "
-                  f"{from_si(d['rope_max_tension_N'], 'force', units):.4g} {f}")
+                  f"{force(d['rope_pull_force_N'])}, max tension {force(d['rope_max_tension_N'])}")
         _print_table(*section_rows(d, units))
         if d["slack"]:
             print("  note: the cable runs slack somewhere (a downhill stretch steeper than the friction angle): "
@@ -134,13 +161,25 @@ def main(args) -> int:
         for c in d["checks"]:
             value, limit, unit = check_in_units(c, units)
             margin = "" if c["margin"] is None else f", margin {100 * c['margin']:.1f} %"
-            limit = "" if limit is None else f", limit {limit:.4g} {unit}"
-            value = "" if value is None else f"value {value:.4g} {unit}"
+            limit = "" if limit is None else f", limit {fmt_number(limit)} {unit}".rstrip()
+            value = "" if value is None else f"value {fmt_number(value)} {unit}".rstrip()
             print(f"  check {c['name']}: {'pass' if c['passed'] else 'FAIL'} ({value}"
                   f"{limit}{margin}{'; ' if value else ''}{c['where']})")
-    write_plan(out, plan, scenario, units)
-    verdict = (" (a check fails in both directions)" if not plan["passed"]
-               else "" if plan["limits_checked"] else " (limits not checked: no [limits])")
-    print(f"\nrecommended direction: {plan['recommended_direction']}{verdict}")
-    print(f"written: {out}/plan.json, sections_*.csv, checks.csv, report.html")
+        unchecked = [c["name"] for c in d["not_checked"] if c["why"].startswith("not checked")]
+        if unchecked:
+            print(f"  not checked (no limit given): {', '.join(unchecked)}")
+    meta = {"project": args.project, "engineer": args.engineer, "revision": args.revision,
+            "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+            "scenario_file": str(scenario.source_path or args.scenario)}
+    written = write_plan(out, plan, scenario, units, meta=meta, pdf=args.pdf)
+    rec = direction_label(plan, plan["recommended_direction"])
+    if plan["passed"]:
+        checked = [c["name"] for c in plan["checks"]]
+        print(f"\nrecommended direction: {rec}" + ("" if plan["limits_checked"] else " (limits not checked: no [limits] given)"))
+    else:
+        failing = sorted({c["name"] for n in ("forward", "reverse") for c in plan["directions"][n]["checks"]
+                          if not c["passed"]})
+        print(f"\nFAIL: no direction meets every given limit (failing: {', '.join(failing)}); "
+              f"lower maximum tension: {rec}")
+    print(f"written: {', '.join(str(p) for p in written)}")
     return 0 if plan["passed"] else 1

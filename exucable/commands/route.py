@@ -12,7 +12,8 @@ __all__ = ["add_arguments", "main"]
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scenario", help="scenario file (TOML)")
+    p.add_argument("scenario", help="scenario file (TOML), or a shipped scenario's name "
+                                    "(`exucable scenarios` lists them)")
     p.add_argument("-o", "--out", default=None, help="PNG to write (default: <scenario name>_route.png)")
 
 

@@ -17,7 +17,8 @@ __all__ = ["add_arguments", "main"]
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scenario", help="scenario file (TOML)")
+    p.add_argument("scenario", help="scenario file (TOML), or a shipped scenario's name "
+                                    "(`exucable scenarios` lists them)")
     p.add_argument("--out", "-o", default=None, help="result directory, this run's alone: an earlier run's result files in it are replaced "
                         "(default: out/<scenario name>, the name made safe as a directory name)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
@@ -44,37 +45,53 @@ def _versus(got: float, ref: float) -> str:
 
 
 def main(args) -> int:
+    from ..scenario.units import display_unit, from_si
+
     sc = load_scenario(args.scenario)
     out_dir = Path(args.out) if args.out else default_out_dir(sc.name)
     announce_compiling()
     res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
                        mode=args.mode)
     s = res.summary
-    rope = s.get("rope_pull_force_N")
-    print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
-          f"(± {_f(s['pull_force_uncertainty_N'], '.2g')} N, sd {_f(s['pull_force_std_N'], '.2g')} N, "
-          f"drift {_f(s['pull_force_drift_N_per_s'], '.2g')} N/s), trailing tension {_f(s['trailing_tension_N'])} N, "
-          f"max tension {_f(s['max_tension_N'])} N")
-    if s["steady_quantity"] == "trailing_tension_N":     # force-controlled: T2 is the result
-        ref, got, what = s.get("rope_trailing_tension_N"), s["trailing_tension_N"], "trailing tension"
+    # the printout in the scenario's display units (the files stay SI)
+    system = sc.display.units
+    N = display_unit("force", system)
+    per_s = f"{N}/s"
+
+    def force(key):
+        v = s.get(key)
+        return None if v is None else from_si(v, "force", system)
+
+    rope = force("rope_pull_force_N")
+    if s.get("mode") == "steady":       # one static state: no scatter, no drift, no time
+        spread = "one steady state"
     else:
-        ref, got, what = rope, s["pull_force_N"], "pulling force"
+        spread = (f"± {_f(force('pull_force_uncertainty_N'), '.2g')} {N}, sd {_f(force('pull_force_std_N'), '.2g')} "
+                  f"{N}, drift {_f(force('pull_force_drift_N_per_s'), '.2g')} {per_s}")
+    print(f"{sc.name}: status {s['status']}, pulling force {_f(force('pull_force_N'))} {N} ({spread}), trailing "
+          f"tension {_f(force('trailing_tension_N'))} {N}, max tension {_f(force('max_tension_N'))} {N}")
+    if s["steady_quantity"] == "trailing_tension_N":     # force-controlled: T2 is the result
+        ref, got, what = force("rope_trailing_tension_N"), force("trailing_tension_N"), "trailing tension"
+    else:
+        ref, got, what = rope, force("pull_force_N"), "pulling force"
     if ref is not None and got is not None and np.isfinite(got):
-        print(f"  rope reference: {what} {ref:.6g} N ({_versus(got, ref)})")
-    ref_c = s.get("rope_clearance_pull_force_N")
+        print(f"  rope reference: {what} {ref:.6g} {N} ({_versus(got, ref)})")
+    ref_c = force("rope_clearance_pull_force_N")
     if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
-        print(f"  rope with clearance: pulling force {ref_c:.6g} N ({_versus(got, ref_c)})")
+        print(f"  rope with clearance: pulling force {ref_c:.6g} {N} ({_versus(got, ref_c)})")
     if s.get("mode") == "steady":
         print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
               f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     else:
         print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
               f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
-    print(f"  results in {out_dir}/")
+    print(f"  results in {out_dir}/" + (f" (SI: N, m; printed here in {system} units)" if system != "si" else ""))
     m = s.get("mesh") or {}
     if m:
-        print(f"  mesh: {m['elements']} elements of {m['element_length_m']:.4g} m ({m['source']}; rule "
-              f"{m['rule_element_length_m']:.4g} m), {m['check_points_per_element']} check points per element")
+        ln = display_unit("length", system)
+        print(f"  mesh: {m['elements']} elements of {from_si(m['element_length_m'], 'length', system):.4g} {ln} "
+              f"({m['source']}; rule {from_si(m['rule_element_length_m'], 'length', system):.4g} {ln}), "
+              f"{m['check_points_per_element']} check points per element")
     for w in s.get("warnings", []):
         print(f"  warning: {w}", file=sys.stderr)
     if s["status"] == "failed":

@@ -7,6 +7,8 @@ A and B are result directories or single CSV files. Every quantity family of the
 family                 file                        abscissa        values
 =====================  ==========================  ==============  ==========================================
 ``history``            ``history.csv``             ``time_s``      pull_force_N, trailing_tension_N, max_tension_N
+                                                                  (not of a steady-mode run: its rows are
+                                                                  solve steps; its state's profiles compare)
 ``tension_profile``    ``tension_profile.csv``     ``x_m``         tension_N
 ``contact_profile``    ``contact_profile.csv``     ``s_conduit_m`` normal_force_per_length_N_per_m, penetration_m
 ``rope_profile``       ``rope_profile.csv``        ``s_conduit_m`` tension_N, sidewall_pressure_N_per_m
@@ -195,7 +197,11 @@ def is_steady_result(source) -> bool:
 
 
 def _load(source) -> dict:
-    """Tables of a result directory or a single CSV, keyed by family."""
+    """Tables of a result directory or a single CSV, keyed by family.
+
+    A steady-mode run's ``history.csv`` counts static solve steps, not time: it is left out (the run's
+    state, its profiles, is what compares with a dynamic run's final state), with a note saying so.
+    """
     path = Path(source)
     if path.is_dir():
         # a steady result's history.csv is its pseudo-time steps (possibly one row): not read

@@ -38,8 +38,10 @@ from exucable.quasistatic.rope import sidewall_pressure_N_per_m, solve_rope
 from exucable.scenario.specs import Scenario, load_scenario, parse_scenario
 from exucable.post.trust import TRUSTED_STATUSES
 from exucable.scenario.units import SYSTEMS
+from exucable.output.versions import versions
 
-__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES"]
+__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES",
+           "CHECKS", "point_names"]
 
 ENGINES = ("rope", "steady", "dynamic")
 
@@ -58,6 +60,7 @@ class PlanLimits:
     max_sidewall_pressure_N_per_m: float | None = None
     min_bend_radius_multiple: float | None = None
     min_clearance_m: float | None = None
+    max_fill_percent: float | None = None
 
 
 @dataclass(frozen=True)
@@ -98,7 +101,8 @@ def plan_spec(scenario: Scenario, units: str | None = None) -> PlanSpec:
     limits = PlanLimits(max_tension_N=lim.max_tension_N, grip_limit_N=lim.grip_limit_N,
                         conductor_tension_N=conductor,
                         max_sidewall_pressure_N_per_m=lim.max_sidewall_pressure_N_per_m,
-                        min_bend_radius_multiple=lim.min_bend_radius_multiple, min_clearance_m=lim.min_clearance_m)
+                        min_bend_radius_multiple=lim.min_bend_radius_multiple, min_clearance_m=lim.min_clearance_m,
+                        max_fill_percent=lim.max_fill_percent)
     if units is not None and units not in SYSTEMS:
         raise ExucableError(f"--units: must be one of {', '.join(SYSTEMS)}, got {units!r}")
     return PlanSpec(count=scenario.cable.count, arrangement=scenario.cable.arrangement,
@@ -176,6 +180,47 @@ def _sections(curve, rope, w_N_per_m: float, swbp_factor: float) -> list[dict]:
     return rows
 
 
+def point_names(scenario: Scenario, pieces: int) -> list[str]:
+    """Names of the route's ``pieces + 1`` points in route order: ``display.point_names``, else A, B, …, Z,
+    AA, AB, … (the letters the installation manuals put on their route drawings).
+
+    Raises
+    ------
+    ScenarioError
+        ``display.point_names`` of the wrong length, naming the count needed.
+    """
+    given = scenario.display.point_names
+    if given is not None:
+        if len(given) != pieces + 1:
+            raise ScenarioError("display.point_names", f"must name {pieces + 1} points (the route's start and the "
+                                                       f"end of each of its {pieces} pieces), got {len(given)}")
+        return list(given)
+    names = []
+    for i in range(pieces + 1):
+        name, k = "", i
+        while True:
+            name = chr(ord("A") + k % 26) + name
+            k = k // 26 - 1
+            if k < 0:
+                break
+        names.append(name)
+    return names
+
+
+def _name_sections(rows: list[dict], names: list[str], direction: str) -> None:
+    """Give each section (pull order) its place on the route: ``route_index`` (1-based, route order),
+    ``from_point`` and ``to_point`` in pull direction, ``name`` ("B–C"), and ``bend_number`` (bends and
+    helices counted in route order, the same in both directions; None on straights)."""
+    n = len(rows)
+    curved = [r["sidewall_pressure_N_per_m"] is not None for r in (rows if direction == "forward" else rows[::-1])]
+    bend_numbers = list(np.cumsum(curved))
+    for r in rows:
+        k = r["index"] if direction == "forward" else n + 1 - r["index"]
+        a, b = (names[k - 1], names[k]) if direction == "forward" else (names[k], names[k - 1])
+        r.update(route_index=k, from_point=a, to_point=b, name=f"{a}–{b}",
+                 bend_number=int(bend_numbers[k - 1]) if curved[k - 1] else None)
+
+
 def _pull_in_history(curve: Centreline, rope, n: int = 201) -> dict:
     """Tension at the cable's head while it advances from the entrance to the exit (rope, quasi-static).
 
@@ -208,6 +253,10 @@ def _check(name, value, limit, where, quantity, lower_is_better=True) -> dict:
 
 
 def _label(row) -> str:
+    if row.get("bend_number") is not None:
+        return f"bend {row['bend_number']} ({row['name']})"
+    if "name" in row:
+        return f"{row['kind']} {row['name']}"
     return f"section {row['index']} ({row['kind']})"
 
 
@@ -241,11 +290,48 @@ def _checks(direction: dict, spec: PlanSpec, scenario: Scenario, clearance: floa
     if lim.min_clearance_m is not None:
         out.append(_check("min_clearance", clearance, lim.min_clearance_m, "duct cross-section", "small_length",
                           lower_is_better=False))
+    if lim.max_fill_percent is not None:
+        fill = eng.conduit_fill_percent(spec.count, 2.0 * scenario.conduit.inner_radius_m,
+                                        2.0 * scenario.cable.radius_m)
+        out.append(_check("max_fill", fill, lim.max_fill_percent, "duct cross-section", "percent"))
     if jam.risk != "not applicable":
         # A number to compare with: the jam band 2.6 ≤ JR < 2.9 is "significant" (Cableizer JR_p).
         passed = jam.risk != "significant"
         out.append({"name": "jam_ratio", "passed": passed, "value": jam.jam_ratio, "limit": None,
                     "margin": None, "quantity": None, "where": f"jam risk {jam.risk} (significant for 2.6 <= 1.05 D/d < 2.9)"})
+    return out
+
+
+#: Every check a plan can make: name -> (the scenario keys that enable it, what it compares).
+CHECKS = {
+    "max_tension": ("limits.max_tension", "largest tension against the allowed pulling tension"),
+    "conductor_tension": ("limits.conductor_material, conductor_area, conductors",
+                          "largest tension against the conductors' allowed stress"),
+    "grip_tension": ("limits.grip_limit", "largest tension against the pulling eye's or grip's rating"),
+    "max_sidewall_pressure": ("limits.max_sidewall_pressure", "largest sidewall bearing pressure in a bend"),
+    "min_bend_radius": ("limits.min_bend_radius_multiple", "smallest bend radius against n cable diameters"),
+    "min_clearance": ("limits.min_clearance", "clearance above the uppermost cable"),
+    "max_fill": ("limits.max_fill", "conduit fill n·d²/D²"),
+    "jam_ratio": ("cable.count = 3", "jam ratio 1.05·D/d outside the band 2.6–2.9"),
+}
+
+
+def _not_checked(checks: list[dict], spec: PlanSpec, has_bends: bool) -> list[dict]:
+    """The checks of :data:`CHECKS` not made, each with its reason: no limit given, or not applicable."""
+    made = {c["name"] for c in checks}
+    out = []
+    for name, (key, what) in CHECKS.items():
+        if name in made:
+            continue
+        if name == "jam_ratio":
+            why = f"not applicable: {spec.count} cable(s) (jamming concerns three cables)"
+        elif name in ("max_sidewall_pressure", "min_bend_radius") and not has_bends and (
+                (spec.limits.max_sidewall_pressure_N_per_m if name == "max_sidewall_pressure"
+                 else spec.limits.min_bend_radius_multiple) is not None):
+            why = "not applicable: the route has no bends"
+        else:
+            why = f"not checked: no limit given ({key})"
+        out.append({"name": name, "what": what, "why": why})
     return out
 
 
@@ -307,7 +393,10 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     return {
         # a run that failed before its first converged state has no pulling force
         "pull_force_N": float("nan") if summary["pull_force_N"] is None else summary["pull_force_N"],
-        "max_tension_N": max(r["max_tension_so_far_N"] for r in rows),
+        # the rig pulls on the leading end, so the largest tension is at least the pulling force (a dynamic
+        # run's sections are its last state, its pulling force the mean over its steady window)
+        "max_tension_N": max([r["max_tension_so_far_N"] for r in rows]
+                             + ([] if summary["pull_force_N"] is None else [float(summary["pull_force_N"])])),
         "max_sidewall_pressure_N_per_m": max(pressures) if pressures else None,
         "slack": rope_entry["slack"],
         "sections": rows,
@@ -348,8 +437,10 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
         The content of ``plan.json`` (SI): ``engine``, ``directions.forward`` / ``.reverse`` (each with
         ``pull_force_N``, ``max_tension_N``, ``max_sidewall_pressure_N_per_m``, ``sections``, ``checks``,
         ``passed`` and, if asked, ``pull_in``), ``recommended_direction``, ``weight_correction_factor``,
-        ``jam_ratio``, ``jam_risk``, ``clearance_m``, ``arrangement``, ``count``, ``checks`` (those of the
-        recommended direction), ``passed``, ``inputs``.
+        ``jam_ratio``, ``jam_risk``, ``clearance_m``, ``arrangement``, ``count``, ``checks`` and
+        ``not_checked`` (those of the recommended direction; every direction has its own), ``passed``,
+        ``fill_percent``, ``point_names`` (route order), ``inputs``, ``versions``. Each section row has
+        ``route_index``, ``name`` ("B–C" in pull direction) and ``bend_number`` (route order).
 
     Raises
     ------
@@ -379,6 +470,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     mu_bend = None if spec.weight_correction_in_bends else scenario.contact.friction
     back = scenario.pull.back_tension_N
     centreline = scenario.build_conduit().centreline
+    names = point_names(scenario, len(centreline.pieces))
 
     directions = {}
     for name in ("forward", "reverse"):
@@ -389,6 +481,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
             # the rope solver names its own arguments; the user knows the scenario's keys
             raise ModelError(_PLAN_ROPE_KEYS.get(exc.key, exc.key), exc.message) from None
         rows = _sections(curve, rope, w_total, swbp_factor)
+        _name_sections(rows, names, name)
         bends = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
         entry = {
             "pull_force_N": rope.pull_force_N,
@@ -401,6 +494,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
         if engine != "rope":
             entry = _multibody_direction(scenario, name, engine, entry, progress)
         entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
+        entry["not_checked"] = _not_checked(entry["checks"], spec, any(r["bend_number"] for r in rows))
         if engine != "rope":
             # a run that failed or is flagged (exucable.post.trust) gives numbers no check should pass on
             entry["checks"].append({"name": "multibody_run", "passed": entry["status"] in TRUSTED_STATUSES,
@@ -427,18 +521,31 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
         "arrangement": arrangement,
         "count": spec.count,
         "checks": directions[recommended]["checks"],
+        "not_checked": directions[recommended]["not_checked"],
         "passed": bool(ok),
         # without [limits] only the plan's own checks ran (finiteness, jam, the multibody run)
         "limits_checked": any(getattr(spec.limits, f.name) is not None for f in dataclasses.fields(spec.limits)),
+        "fill_percent": eng.conduit_fill_percent(spec.count, D, d),
+        "point_names": names,
+        "point_s_m": [float(p.s_start_m) for p in centreline.pieces] + [float(centreline.length_m)],
         "inputs": {
             "scenario": scenario.name,
+            "description": scenario.description,
+            "scenario_file": None if scenario.source_path is None else str(scenario.source_path),
             "cable_diameter_m": d,
             "duct_inner_diameter_m": D,
+            "count": spec.count,
+            "arrangement": spec.arrangement,
             "weight_per_length_one_cable_N_per_m": scenario.cable.mass_per_length_kg_per_m * g,
+            "gravity_m_per_s2": g,
             "friction": scenario.contact.friction,
             "back_tension_N": back,
             "route_length_m": centreline.length_m,
+            "youngs_modulus_Pa": scenario.cable.youngs_modulus_Pa,
+            "bending_stiffness_N_m2": scenario.cable.bending_stiffness_N_m2,
+            "bending_stiffness_given": scenario.cable.bending_stiffness_given_N_m2 is not None,
             "units": spec.units,
             "limits": scenario.limits.to_dict(),
         },
+        "versions": versions(),
     }

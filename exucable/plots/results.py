@@ -1,4 +1,5 @@
-"""Figures of one run: pulling and trailing force against time, tension along the cable."""
+"""Figures of one run: pulling and trailing force against time (a steady-mode run: against the static
+solve's steps), tension along the cable, sidewall pressure along the conduit."""
 
 from __future__ import annotations
 
@@ -9,30 +10,71 @@ from ..io import new_figure, save_figure
 __all__ = ["plot_pull_force", "plot_tension_profile", "plot_pressure"]
 
 
+def _zoom(values: np.ndarray, centre: float, references, spread: float) -> tuple[float, float]:
+    """A y-range around ``centre`` wide enough for the scatter ``spread`` and every reference, at
+    least ±0.5 % of the centre: the pulling force's scatter and its gap to the rope stay visible
+    instead of being flattened by the start-up's range."""
+    half = max(4.0 * spread, 0.005 * abs(centre), 1e-9)
+    for r in references:
+        half = max(half, 1.25 * abs(r - centre))
+    return centre - half, centre + half
+
+
 def plot_pull_force(path, result) -> None:
-    """Pulling force and trailing tension [N] against time [s], with the steady window and the
-    rope reference when there is one."""
+    """Pulling force [N] on a scale that shows its scatter and its gap to the rope references (top),
+    trailing tension [N] below it. A dynamic run is drawn against time [s] with its steady window; a
+    steady-mode run is one static state, drawn against the static solve's steps (no time axis), its
+    converged force marked."""
     h, s = result.history, result.summary
-    fig = new_figure(figsize=(7, 4))
-    ax = fig.subplots()
-    ax.plot(h["time_s"], h["pull_force_N"], label="pulling force (leading end)")
-    ax.plot(h["time_s"], h["trailing_tension_N"], label="trailing-end tension")
-    rope = s.get("rope_pull_force_N")
-    if rope is not None:
-        ax.axhline(rope, color="k", ls="--", lw=1, label=f"rope reference {rope:.4g} N")
-    t0 = s.get("steady_from_s")
-    if s.get("steady") and t0 is not None:
-        ax.axvspan(t0, h["time_s"][-1], color="g", alpha=0.08, label="steady window")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("force [N]")
+    steady_mode = s.get("mode") == "steady"
+    x = np.asarray(h["time_s"], dtype=float)
+    pull_h = np.asarray(h["pull_force_N"], dtype=float)
+    fig = new_figure(figsize=(7, 5.2))
+    ax, low = fig.subplots(2, 1, sharex=True, gridspec_kw=dict(height_ratios=(2.3, 1.0)))
+    ax.plot(x, pull_h, ".-" if steady_mode else "-", ms=3, lw=1.2, label="pulling force (leading end)")
     pull = s.get("pull_force_N")
+    refs = []
+    for key, style, what in (("rope_pull_force_N", "--", "rope reference"),
+                             ("rope_clearance_pull_force_N", ":", "rope free in its clearance")):
+        value = s.get(key)
+        if value is not None:
+            refs.append(value)
+            ax.axhline(value, color="k", ls=style, lw=1, label=f"{what} {value:.5g} N")
+    t0 = s.get("steady_from_s")
+    spread = 0.0
+    if not steady_mode and s.get("steady") and t0 is not None:
+        ax.axvspan(t0, x[-1], color="g", alpha=0.08, label="steady window")
+        window = pull_h[x >= t0]
+        spread = float(np.std(window)) if window.size else 0.0
+    u = s.get("pull_force_uncertainty_N")
+    if pull is not None and np.isfinite(pull):
+        band = f" ± {u:.2g} N" if u is not None else ""
+        ax.axhline(pull, color="tab:blue", lw=0.8, alpha=0.7,
+                   label=f"{'steady state' if steady_mode else 'mean over the window'} {pull:.5g} N{band}")
+        if u is not None and not steady_mode and t0 is not None:
+            ax.fill_between([t0, x[-1]], pull - u, pull + u, color="tab:blue", alpha=0.15, lw=0)
+        ax.set_ylim(*_zoom(pull_h, pull, refs, max(spread, u or 0.0)))
+    trail = np.asarray(h["trailing_tension_N"], dtype=float)
+    low.plot(x, trail, color="tab:orange", lw=1.2, label="trailing-end tension")
+    finite = trail[np.isfinite(trail)]
+    if finite.size:
+        # a prescribed back tension is flat: show it as such, not its round-off magnified by an offset axis
+        low.set_ylim(*_zoom(finite, float(np.median(finite)), [float(finite.min()), float(finite.max())], 0.0))
+    low.ticklabel_format(axis="y", useOffset=False, style="plain")
+    low.set_ylabel("force [N]")
+    low.legend(loc="best", fontsize=7)
+    low.grid(alpha=0.3)
+    low.set_xlabel("static solve step (one steady state: no time axis)" if steady_mode else "time [s]")
+    ax.ticklabel_format(axis="y", useOffset=False, style="plain")
+    ax.set_ylabel("pulling force [N]")
     status = "" if s.get("status") in ("ok", "steady") else f" (status {s.get('status')})"
     if s.get("status") == "failed":
         status = f" (FAILED at t = {s.get('failed_at_s', float('nan')):.4g} s)"
-    ax.set_title(f"{s.get('name', '')}: pulling force "
-                 f"{'n/a' if pull is None else format(pull, '.4g')} N{status}")
+    what = "steady sliding state, pulling force" if steady_mode else "pulling force"
+    ax.set_title(f"{s.get('name', '')}: {what} "
+                 f"{'n/a' if pull is None else format(pull, '.5g')} N{status}", fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    ax.legend(loc="best", fontsize=7)
     save_figure(fig, path, bbox_inches="tight")
 
 
@@ -68,16 +110,22 @@ def plot_pressure(path, result) -> None:
             label=f"exucable, windowed over {s.get('pressure_window_m', float('nan')):.3g} m")
     ax.plot(pp["s_conduit_m"], pp["rope_windowed_pressure_N_per_m"], "k--", lw=1, label="rope (T/R and weight), windowed")
     top = 1.6 * max(float(np.max(pp["windowed_pressure_N_per_m"])), float(np.max(pp["rope_windowed_pressure_N_per_m"])), 1e-9)
+    loads = []
     for b in result.bends or []:
         ax.axvspan(b["s_conduit_start_m"], b["s_conduit_end_m"], color="b", alpha=0.05)
         for end in ("entry", "exit"):
             F = b[f"{end}_point_load_N"]
             if np.isfinite(F):
-                ax.annotate(f"{F:+.3g} N", (b[f"{end}_s_conduit_m"], 0.72 * top), fontsize=7, ha="center", rotation=90)
+                loads.append((b[f"{end}_s_conduit_m"], F))
+    # labels alternate between two heights, so that a bend's entry and exit labels (and a short bend's
+    # neighbours) do not overprint each other; the legend goes below the axes, clear of them
+    for k, (where, F) in enumerate(sorted(loads)):
+        ax.annotate(f"{F:+.3g} N", (where, (0.62 if k % 2 == 0 else 0.84) * top), fontsize=7, ha="center",
+                    va="center", rotation=90, bbox=dict(facecolor="white", alpha=0.8, edgecolor="none", pad=0.5))
     ax.set_ylim(0, top)
     ax.set_xlabel("s along the conduit [m]")
     ax.set_ylabel("sidewall bearing pressure [N/m]")
     ax.set_title(f"{s.get('name', '')}: sidewall pressure (bends shaded; point loads at bend ends)")
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", fontsize=8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
     save_figure(fig, path, bbox_inches="tight")

@@ -25,7 +25,8 @@ from exucable.errors import ScenarioError
 __all__ = [
     "ARRANGEMENTS", "CONDUCTOR_STRESS_IEC_Pa", "CONDUCTOR_STRESS_US_LB_PER_CMIL",
     "auto_arrangement", "check_arrangement", "check_fit", "weight_correction_factor", "sidewall_pressure_factor",
-    "jam_ratio", "jam_risk", "clearance_m", "max_tension_from_conductors_N", "JamAssessment",
+    "jam_ratio", "jam_risk", "clearance_m", "max_tension_from_conductors_N", "JamAssessment", "conduit_fill_percent",
+    "NEC_MAX_FILL_PERCENT",
 ]
 
 ARRANGEMENTS = ("single", "triangular", "cradled", "diamond")
@@ -207,6 +208,18 @@ def clearance_m(count: int, arrangement: str, duct_inner_diameter_m: float, cabl
     if count == 3:
         return (D - d) / 2.0 + (D - d) / 2.0 * math.sqrt(1.0 - (d / (2.0 * (D - d))) ** 2)
     return D - d - 2.0 * d * d / (D - d)
+
+
+#: Largest fill of a conduit by cables [%] by the number of cables: NFPA 70 (National Electrical Code),
+#: Chapter 9, Table 1 "Percent of Cross Section of Conduit and Tubing for Conductors and Cables": 53 % for
+#: one, 31 % for two, 40 % for more than two. Building wiring; utility ducts follow their own standards,
+#: so exucable checks fill only against ``limits.max_fill`` and quotes these for orientation.
+NEC_MAX_FILL_PERCENT = {1: 53.0, 2: 31.0, 3: 40.0}
+
+
+def conduit_fill_percent(count: int, duct_inner_diameter_m: float, cable_diameter_m: float) -> float:
+    """Conduit fill: the cables' cross-sections over the duct's, n·d²/D², in percent."""
+    return 100.0 * count * (cable_diameter_m / duct_inner_diameter_m) ** 2
 
 
 def max_tension_from_conductors_N(material: str, area_m2: float, conductors: int, rule: str = "iec") -> float:

@@ -63,7 +63,8 @@ class Field:
     attr : str
         Attribute of the section's dataclass, with its unit, e.g. ``"speed_m_per_s"``.
     kind : str
-        ``"float"``, ``"int"``, ``"bool"``, ``"str"``, ``"choice"``, ``"vector3"`` or ``"custom"``
+        ``"float"``, ``"int"``, ``"bool"``, ``"str"``, ``"strings"`` (an array of non-empty strings),
+        ``"choice"``, ``"vector3"`` or ``"custom"``
         (parsed by hand; only documented here).
     unit : str
         Unit as written in error messages (ASCII, e.g. ``"kg/m^3"``); ``""`` for none.
@@ -250,8 +251,9 @@ FIELDS: tuple[Field, ...] = (
       rule="`exucable plan`: also the pull-in history (tension at the rig vs pulled length), with `back_tension` "
            "as the reel's back tension"),
     # ---- gravity
-    F("gravity.g", "g_m_per_s2", "float", "m/s^2", unit_doc="m/s²", ge=0.0,
-      default_doc="required if the table is present", rule="≥ 0, acting along −z", le=1000.0, why="up to 100 g"),
+    F("gravity.g", "g_m_per_s2", "float", "m/s^2", 9.81, unit_doc="m/s²", ge=0.0,
+      rule="≥ 0, acting along −z (the paper's examples give 9.8, the industry files standard gravity 9.80665)",
+      le=1000.0, why="up to 100 g"),
     # ---- solver
     F("solver.end_time", "end_time_s", "float", "s", gt=0.0, rule="> 0", le=1.0e6, why="keeps the run's size finite"),
     F("solver.step", "step_s", "float", "s", 1.0e-2, gt=0.0,
@@ -341,9 +343,15 @@ FIELDS: tuple[Field, ...] = (
       default_doc="none", rule="> 0: smallest bend centreline radius as a multiple of the cable diameter", le=1000.0, why="up to 1000 diameters"),
     F("limits.min_clearance", "min_clearance_m", "float", "m", None, gt=0.0, ours=True, default_doc="none",
       rule="> 0: smallest clearance between the uppermost cable and the duct", le=1.0, why="up to 1 m"),
+    F("limits.max_fill", "max_fill_percent", "float", "%", None, gt=0.0, le=100.0, ours=True, default_doc="none",
+      rule="0 < f ≤ 100: largest conduit fill, the cables' cross-sections n·d² over the duct's D², in percent "
+           "(NEC Chapter 9 Table 1 allows 53 for one cable, 31 for two, 40 for three or more)"),
     # ---- display
     F("display.units", "units", "choice", "", "si", choices=("si", "imperial"), ours=True,
       rule="unit system of bare numbers in the file and of printed tables (see above); results files stay SI"),
+    F("display.point_names", "point_names", "strings", "", None, ours=True, default_doc="A, B, C, …",
+      rule="array of non-empty strings naming the route's points in route order: its start and the end of each "
+           "piece (one more than the pieces); `exucable plan` names sections and bends by them (`\"B–C\"`)"),
 )
 del F
 

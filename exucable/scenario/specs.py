@@ -120,6 +120,13 @@ def _coerce(f: Field, value):
             allowed = ", ".join(f'"{c}"' for c in f.choices)
             raise ScenarioError(key, f"must be one of {allowed}, got {_describe(value)}")
         return value
+    if f.kind == "strings":
+        if isinstance(value, str) or not isinstance(value, (list, tuple)):
+            raise ScenarioError(key, f"must be an array of strings, e.g. [\"A\", \"B\"], got {_describe(value)}")
+        for i, item in enumerate(value):
+            if not isinstance(item, str) or not item.strip():
+                raise ScenarioError(f"{key}[{i}]", f"must be a non-empty string, got {_describe(item)}")
+        return tuple(value)
     if f.kind == "vector3":
         return _vector3(key, value, f.unit, nonzero=f.nonzero, max_abs=f.max_abs, why=f.why)
     return value  # "custom": checked by the section's own code
@@ -677,6 +684,8 @@ class LimitsSpec(_Spec):
         Smallest bend radius as a multiple of the cable diameter [-].
     min_clearance_m : float or None
         Smallest clearance between the uppermost cable and the duct [m].
+    max_fill_percent : float or None
+        Largest conduit fill n·d²/D² [%].
     """
 
     _SECTION: ClassVar[str] = "limits"
@@ -690,6 +699,7 @@ class LimitsSpec(_Spec):
     max_sidewall_pressure_N_per_m: float | None = _default("limits.max_sidewall_pressure")
     min_bend_radius_multiple: float | None = _default("limits.min_bend_radius_multiple")
     min_clearance_m: float | None = _default("limits.min_clearance")
+    max_fill_percent: float | None = _default("limits.max_fill")
 
     def _check(self) -> None:
         group = ("conductor_material", "conductor_area_m2", "conductors")
@@ -714,11 +724,15 @@ class DisplaySpec(_Spec):
     units : str
         ``"si"`` or ``"imperial"``: unit system of bare numbers in the file (converted to SI when it
         is read) and of printed tables. Results files stay SI.
+    point_names : tuple of str or None
+        Names of the route's points in route order (its start, then the end of each piece), or None
+        for the default A, B, C, … (``exucable plan`` checks the count against the route).
     """
 
     _SECTION: ClassVar[str] = "display"
 
     units: str = _default("display.units")
+    point_names: tuple[str, ...] | None = _default("display.point_names")
 
 
 def _curved_turning_deg(conduit: ConduitSpec) -> list[float]:
@@ -858,6 +872,10 @@ class Scenario:
 
     def __post_init__(self, route):
         if route is not None:
+            if not hasattr(route, "to_spec"):
+                raise ScenarioError("route", f"must be an exucable.Route (Route(inner_radius=...).straight(...)"
+                                             f".bend(...)), got {_describe(route)}; survey points: "
+                                             "Route.from_survey(points, bend_radius, inner_radius)")
             if self.conduit is not None:
                 raise ScenarioError("conduit", "give either route or conduit, not both")
             object.__setattr__(self, "conduit", route.to_spec())
@@ -1015,8 +1033,17 @@ class Scenario:
         for part in ("cable", "contact", "solver"):
             for name in getattr(self, part).derived_keys:
                 d[part].pop(name, None)
+        top_level = {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver", "output",
+                      "limits", "display"}
         for key, value in changes.items():
             tokens = parse_key(key, key)
+            if len(tokens) == 1 and tokens[0] not in top_level:
+                # a key inside a table given bare (friction=0.3): name the dotted key it means
+                inside = [f.key for f in FIELDS if f.name == tokens[0]]
+                hint = (f"did you mean {' or '.join(repr(k) for k in inside)}? Pass it as "
+                        f"replace(**{{{inside[0]!r}: ...}})" if inside else
+                        "give a dotted key such as 'contact.friction'")
+                raise ScenarioError(key, f"not a top-level key; {hint}")
             if value is None and len(tokens) == 1 and tokens[0] in d:
                 del d[tokens[0]]
                 continue
@@ -1042,7 +1069,9 @@ def read_toml(path: Path, what: str = "scenario") -> dict:
         with open(path, "rb") as f:
             return tomllib.load(f)
     except FileNotFoundError:
-        raise ScenarioError("", f"{what} file not found: {path}") from None
+        hint = (" (or give a shipped scenario's name, e.g. paper_ex2_bend90; `exucable scenarios` lists them)"
+                if what == "scenario" else "")
+        raise ScenarioError("", f"{what} file not found: {path}{hint}") from None
     except IsADirectoryError:
         raise ScenarioError("", f"{what} path is a directory, not a file: {path}") from None
     except OSError as exc:
@@ -1063,8 +1092,9 @@ def load_scenario(path) -> Scenario:
     Parameters
     ----------
     path : str or Path
-        The scenario file. Relative paths inside it (``points_csv``) are resolved
-        against its directory.
+        The scenario file, or a shipped scenario's name (``"paper_ex2_bend90"``,
+        ``"fast/paper_ex2_bend90"``; :func:`exucable.data.resolve_scenario_path`). Relative paths
+        inside it (``points_csv``) are resolved against its directory.
 
     Returns
     -------
@@ -1075,7 +1105,9 @@ def load_scenario(path) -> Scenario:
     ScenarioError
         Missing or unreadable file, TOML syntax error (key ``""``), or any invalid value.
     """
-    path = Path(path)
+    from exucable.data import resolve_scenario_path
+
+    path = resolve_scenario_path(path)
     data = read_toml(path, "scenario")
     scenario = parse_scenario(data, path.parent, default_name=path.stem)
     object.__setattr__(scenario, "source_path", path.resolve())

@@ -162,7 +162,9 @@ def load_sweep(path) -> Sweep:
         Naming the sweep-file key at fault (``base``, ``vary."k"[i]``, ``set."k"``, ``unset[i]``,
         ``mode``, ...), before anything runs.
     """
-    path = Path(path)
+    from ..data import resolve_scenario_path
+
+    path = resolve_scenario_path(path)       # README's scenarios/sweeps/... paths work from anywhere
     data = read_toml(path, "sweep")
     sweep = parse_sweep(data, path.parent, default_name=path.stem)
     object.__setattr__(sweep, "source_path", path.resolve())
