@@ -166,8 +166,9 @@ FIELDS: tuple[Field, ...] = (
            "saw-tooth of axial force"),
     # ---- conduit (paper Sect. 2.3)
     F("cable.count", "count", "int", "", 1, ge=1, le=4, ours=True,
-      rule="integer 1…4: identical cables of this kind in the duct; they must fit the duct. `exucable plan` only "
-           "(`exucable run` simulates one cable)"),
+      rule="integer 1…4: identical cables of this kind in the duct; they must fit the duct. `exucable plan` uses "
+           "the calculators' formulas; `exucable run` simulates one ANCF cable each in steady mode (docs/results-format.md, "
+           "\"Several cables\")"),
     F("cable.arrangement", "arrangement", "choice", "", "auto",
       choices=("auto", "single", "triangular", "cradled", "diamond"), ours=True,
       rule="`single` (1), `triangular` (2, 3), `cradled` (3, 4), `diamond` (4); `auto`: 3 cables triangular for "
@@ -198,6 +199,9 @@ FIELDS: tuple[Field, ...] = (
     F("contact.damping", "damping", "float", "N s/m", 1.0e3, ge=0.0, rule="≥ 0"),
     F("contact.exponent", "exponent", "float", "", 1.5, ge=1.0, rule="≥ 1"),
     F("contact.friction", "friction", "float", "", 0.0, ge=0.0, rule="≥ 0 (kinetic μ)"),
+    F("contact.cable_friction", "cable_friction", "float", "", 0.0, ge=0.0, ours=True,
+      rule="≥ 0: kinetic μ between the cables of a bundle (`cable.count` > 1); 0 (default): frictionless, the "
+           "calculators' rigid-circle statics"),
     F("contact.static_friction", "static_friction", "float", "", None, ge=0.0, ours=True, default_doc="none",
       rule="≥ `friction`"),
     F("contact.stribeck_velocity", "stribeck_velocity_m_per_s", "float", "m/s", 0.01, gt=0.0, ours=True,
