@@ -129,3 +129,20 @@ def test_diamond_that_would_collapse_is_refused():
     with pytest.raises(ModelError) as err:
         arrangement_offsets(4, "diamond", 0.05, 0.012)
     assert "cable.arrangement" in str(err.value)
+
+
+def test_command_line_prints_the_bundle(tmp_path):
+    """`exucable run` on a scenario file with three cables: exit 0, the factor and the shares printed."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "three.toml"
+    path.write_text('name = "three"\n[cable]\nradius = 0.015\ndensity = 2000.0\nyoungs_modulus = 2e8\ncount = 3\n'
+                    'arrangement = "cradled"\nelements = 8\n[conduit]\ninner_radius = 0.0495\npath = [{straight = 4.0}]\n'
+                    '[contact]\nfriction = 0.3\ncheck_points_per_element = 8\n[pull]\nspeed = 0.1\nback_tension = 30.0\n'
+                    '[gravity]\ng = 9.81\n[solver]\nmode = "steady"\nend_time = 1.0\nsteady_lead_out = 0.0\n')
+    proc = subprocess.run([sys.executable, "-m", "exucable", "run", str(path), "--out", str(tmp_path / "out"),
+                           "--no-plots"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "3 cables cradled" in proc.stdout and "weight correction factor" in proc.stdout
+    assert proc.stdout.count("  cable ") == 3

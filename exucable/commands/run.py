@@ -104,7 +104,8 @@ def _print_bundle(s: dict, out_dir: Path) -> int:
         print(f"  straight {st['s_conduit_start_m']:.4g}-{st['s_conduit_end_m']:.4g} m: weight correction "
               f"{_f(st['weight_correction_factor'], '.5g')}")
     for c in b["cables"]:
-        print(f"  cable {c['cable']}: pull {_f(c['pull_share_N'])} N ({_f(100 * c['pull_share'], '.3g')} %), "
+        share = None if c["pull_share"] is None else 100.0 * c["pull_share"]
+        print(f"  cable {c['cable']}: pull {_f(c['pull_share_N'])} N ({_f(share, '.3g')} %), "
               f"wall {_f(c['wall_normal_force_N'], '.4g')} N, other cables {_f(c['cable_contact_force_N'], '.4g')} N")
     print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
           f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
