@@ -163,14 +163,15 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
     if sc.cable.count != 1:
-        raise ModelError("cable.count", f"the multibody model simulates one cable, got {sc.cable.count}; "
-                                        "plan several cables per duct with `exucable plan`")
-    _refuse_pulling_the_cable_out(sc)
+        solve = _solve_bundle
+    else:
+        _refuse_pulling_the_cable_out(sc)
+        solve = _solve
     _refuse_snapshot_times_in_steady_mode(sc)
     if out_dir is None:
-        return _solve(sc, quiet, steady_stop, refine, check_points_per_element)
+        return solve(sc, quiet, steady_stop, refine, check_points_per_element)
     with owned_out_dir(out_dir) as out:
-        result = _solve(sc, quiet, steady_stop, refine, check_points_per_element)
+        result = solve(sc, quiet, steady_stop, refine, check_points_per_element)
         write_results(out, result, plots=plots)
     return result
 
@@ -327,6 +328,56 @@ def _refuse_snapshot_times_in_steady_mode(sc) -> None:
     key = "output.snapshots" if out.snapshots_s else "output.snapshot_interval"
     raise ModelError(key, 'solver.mode = "steady" has no time: it always writes its steady state as the one '
                           "snapshot (snapshot_*.csv, time_s = 0); remove the key or use the dynamic mode")
+
+
+def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_element) -> RunResult:
+    """Several cables in one conduit (``cable.count`` > 1): one steady solve of the bundle
+    (:mod:`exucable.model.bundle`), its report in ``summary.json`` and each cable's tension in
+    ``cable_tensions.csv``; ``tension_profile.csv`` holds the bundle's, the sum over the cables
+    (no files here: :func:`run_scenario` writes them)."""
+    from .model.bundle import build_bundle_model, bundle_report, bundle_tension_profile, check_bundle_supported
+    from .solve.dynamic import Progress
+    from .solve.steady import solve_steady
+
+    if check_points_per_element is not None:
+        raise ModelError("contact.check_points_per_element", "several cables take the scenario's check points; "
+                         "set the key in the scenario instead")
+    check_bundle_supported(sc)
+    t_start = time.perf_counter()
+    model = build_bundle_model(sc, refine=refine)
+    build_s = time.perf_counter() - t_start
+    out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
+    h = out.history.arrays()
+    report = bundle_report(model)
+    cables = bundle_tension_profile(model)
+    total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
+    flags = []
+    if report["contacts_at_window_edge"]:
+        flags.append({"flag": "window_edge", "s_conduit_m": None, "time_s": None,
+                      "message": f"{report['contacts_at_window_edge']} cable-cable contacts at the broad phase's window "
+                                 "edge: the cables slid apart along the route further than it covers"})
+    status = out.status if out.status == "failed" or not flags else flags[0]["flag"]
+    message = out.message if not flags else "; ".join([out.message] + [f["message"] for f in flags])
+    summary = {
+        "name": sc.name,
+        "mode": "steady",
+        "status": status,
+        "message": message,
+        "flags": flags,
+        **{k: report[k] for k in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
+        "bundle": {k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
+        "steps": out.steps,
+        "newton_iterations": out.newton_iterations,
+        "wall_time_s": out.wall_time_s,
+        "build_time_s": build_s,
+        "mesh": model.mesh.to_dict() if model.mesh is not None else None,
+        "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
+        "scenario": sc.to_dict(),
+        "versions": versions(),
+    }
+    result = RunResult(summary=summary, history=h, tension_profile={"x_m": cables["x_m"], "tension_N": total},
+                       cable_tensions=cables, model=model)
+    return result
 
 
 def _refuse_pulling_the_cable_out(sc) -> None:

@@ -53,6 +53,8 @@ def main(args) -> int:
     res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
                        mode=args.mode)
     s = res.summary
+    if "bundle" in s:
+        return _print_bundle(s, out_dir)
     # the printout in the scenario's display units (the files stay SI)
     system = sc.display.units
     N = display_unit("force", system)
@@ -102,5 +104,34 @@ def main(args) -> int:
         for f in s["flags"]:
             print(f"  NOT TRUSTED ({f['flag']}): {f['message']}", file=sys.stderr)
         print(f"  status {s['status']}: do not use this result; what was computed is in {out_dir}/", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _print_bundle(s: dict, out_dir: Path) -> int:
+    """The report of a run of several cables (``cable.count`` > 1); exit status as for one cable."""
+    b = s["bundle"]
+    wcf = b["weight_correction_factor"]
+    print(f"{s['name']}: status {s['status']}, {b['count']} cables {b['arrangement']}, pulling force "
+          f"{_f(s['pull_force_N'])} N, back tension {_f(s['trailing_tension_N'])} N, max tension {_f(s['max_tension_N'])} N")
+    print(f"  weight correction factor {_f(wcf, '.5g')} (the calculators' {b['formula_weight_correction_factor']:.5g})")
+    for st in b["straights"]:
+        print(f"  straight {st['s_conduit_start_m']:.4g}-{st['s_conduit_end_m']:.4g} m: weight correction "
+              f"{_f(st['weight_correction_factor'], '.5g')}")
+    for c in b["cables"]:
+        share = None if c["pull_share"] is None else 100.0 * c["pull_share"]
+        print(f"  cable {c['cable']}: pull {_f(c['pull_share_N'])} N ({_f(share, '.3g')} %), "
+              f"wall {_f(c['wall_normal_force_N'], '.4g')} N, other cables {_f(c['cable_contact_force_N'], '.4g')} N")
+    print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
+          f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    print(f"  results in {out_dir}/")
+    for w in s.get("warnings", []):
+        print(f"  warning: {w}", file=sys.stderr)
+    if s["status"] == "failed":
+        print(f"  FAILED: {s['message']}", file=sys.stderr)
+        return 1
+    if s["status"] not in TRUSTED_STATUSES:
+        for f in s["flags"]:
+            print(f"  NOT TRUSTED ({f['flag']}): {f['message']}", file=sys.stderr)
         return 1
     return 0

@@ -10,6 +10,7 @@ Files
 ``history.csv``           ``time_s,pull_force_N,trailing_tension_N,max_tension_N`` and, with contact,
                           ``max_penetration_m,max_axis_offset_m,max_axis_offset_s_conduit_m``
 ``tension_profile.csv``   ``x_m,tension_N`` at the final time (x: material coordinate from the trailing end)
+``cable_tensions.csv``    several cables: ``x_m,cable_1_tension_N,...`` (``tension_profile.csv`` then holds their sum)
 ``contact_profile.csv``   ``s_conduit_m,normal_force_per_length_N_per_m,penetration_m`` (along the
                           scenario's conduit from its start)
 ``rope_profile.csv``      ``s_conduit_m,tension_N,sidewall_pressure_N_per_m`` of the rope reference
@@ -57,6 +58,7 @@ class RunResult:
     bends: list | None = None                # BEND_COLUMNS rows (exucable.post.pressure)
     pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
     snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.output.snapshots)
+    cable_tensions: dict | None = None  # several cables: x_m and cable_<k>_tension_N -> arrays
     model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
 
 
@@ -127,6 +129,8 @@ def _write_data(out: Path, result: RunResult) -> list[Path]:
         add_csv("history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
         if result.tension_profile is not None:
             add_csv("tension_profile.csv", PROFILE_COLUMNS, result.tension_profile)
+        if result.cable_tensions is not None:
+            add_csv("cable_tensions.csv", list(result.cable_tensions), result.cable_tensions)
         if result.contact_profile is not None:
             add_csv("contact_profile.csv", CONTACT_COLUMNS, result.contact_profile)
         if result.rope_profile is not None:

@@ -174,8 +174,9 @@ FIELDS: tuple[Field, ...] = (
            "saw-tooth of axial force"),
     # ---- conduit (paper Sect. 2.3)
     F("cable.count", "count", "int", "", 1, ge=1, le=4, ours=True,
-      rule="integer 1…4: identical cables of this kind in the duct; they must fit the duct. `exucable plan` only "
-           "(`exucable run` simulates one cable)"),
+      rule="integer 1…4: identical cables of this kind in the duct; they must fit the duct. `exucable plan` uses "
+           "the calculators' formulas; `exucable run` simulates one ANCF cable each in steady mode (docs/results-format.md, "
+           "\"Several cables\")"),
     F("cable.arrangement", "arrangement", "choice", "", "auto",
       choices=("auto", "single", "triangular", "cradled", "diamond"), ours=True,
       rule="`single` (1), `triangular` (2, 3), `cradled` (3, 4), `diamond` (4); `auto`: 3 cables triangular for "
@@ -206,6 +207,9 @@ FIELDS: tuple[Field, ...] = (
     F("contact.damping", "damping", "float", "N s/m", 1.0e3, ge=0.0, rule="≥ 0", le=1.0e12, why="far beyond any wall's damping"),
     F("contact.exponent", "exponent", "float", "", 1.5, ge=1.0, rule="≥ 1", le=5.0, why="Hertz exponents are 1 to 2.5"),
     F("contact.friction", "friction", "float", "", 0.0, ge=0.0, rule="≥ 0 (kinetic μ)", le=5.0, why="cable–duct friction is 0.1 to 1; e^(μθ) must stay finite"),
+    F("contact.cable_friction", "cable_friction", "float", "", 0.0, ge=0.0, ours=True,
+      rule="≥ 0: kinetic μ between the cables of a bundle (`cable.count` > 1); 0 (default): frictionless, the "
+           "calculators' rigid-circle statics", le=5.0, why="cable–cable friction is below 1"),
     F("contact.static_friction", "static_friction", "float", "", None, ge=0.0, ours=True, default_doc="none",
       rule="≥ `friction`", le=5.0, why="cable–duct friction is 0.1 to 1"),
     F("contact.stribeck_velocity", "stribeck_velocity_m_per_s", "float", "m/s", 0.01, gt=0.0, ge=1.0e-6, ours=True,

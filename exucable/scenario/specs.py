@@ -438,6 +438,8 @@ class ContactSpec(_Spec):
         Hertz exponent e [-].
     friction : float
         Kinetic (Coulomb) friction coefficient μ [-].
+    cable_friction : float
+        Kinetic friction coefficient between the cables of a bundle μ_c [-] (``cable.count`` > 1).
     static_friction : float or None
         Static friction coefficient μ_s ≥ μ [-], or None for no static peak.
     stribeck_velocity_m_per_s : float
@@ -467,6 +469,7 @@ class ContactSpec(_Spec):
     damping: float = _default("contact.damping")
     exponent: float = _default("contact.exponent")
     friction: float = _default("contact.friction")
+    cable_friction: float = _default("contact.cable_friction")
     static_friction: float | None = _default("contact.static_friction")
     stribeck_velocity_m_per_s: float = _default("contact.stribeck_velocity")
     friction_regularisation_velocity_m_per_s: float = _default("contact.friction_regularisation_velocity")

@@ -175,6 +175,9 @@ class PseudoTimeSpring:
         rho_a = model.properties.mass_per_length_kg_per_m
         m_node = rho_a * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
         L_node = np.maximum(np.concatenate([Le, [0.0]]), np.concatenate([[0.0], Le]))
+        # several cables meshed alike (exucable.model.bundle): their nodes one cable after another
+        cables = getattr(model.layout, "n_cables", 1)
+        m_node, L_node = np.tile(m_node, cables), np.tile(L_node, cables)
         self._q_ref = np.asarray(model.layout.coordinates, dtype=float).reshape(-1)
         self.n_nodes = len(m_node)
         self.n = 6 * self.n_nodes
@@ -195,7 +198,7 @@ class PseudoTimeSpring:
             m.Initialize(self.n, self.n, False)
         mbs = model.mbs
         self.object = mbs.AddObject(ObjectGenericODE2(
-            nodeNumbers=list(model.cable.nodes), massMatrix=empty[0], stiffnessMatrix=empty[1],
+            nodeNumbers=_spring_nodes(model), massMatrix=empty[0], stiffnessMatrix=empty[1],
             dampingMatrix=empty[2], forceUserFunction=self._force, jacobianUserFunction=self._jacobian,
             visualization={"show": False, "color": [-1.0, -1.0, -1.0, -1.0], "triangleMesh": [],
                            "showNodes": False, "graphicsDataUserFunction": 0}))
@@ -226,6 +229,14 @@ class PseudoTimeSpring:
             return m
         m.SetWithSparseMatrix(np.column_stack([self._rows[nz], self._cols[nz], vals[nz]]), self.n, self.n, False)
         return m
+
+
+def _spring_nodes(model) -> list:
+    """The nodes the pseudo-time spring acts on: the cable's, or every cable's of a bundle."""
+    cables = getattr(model, "cables", None)
+    if cables is not None:
+        return [n for c in cables for n in c.nodes]
+    return list(model.cable.nodes)
 
 
 class _StateStore:
@@ -275,8 +286,12 @@ def steady_forces(model, stations: tuple[TensionStations, TensionStations] | Non
 
     The static solver's Lagrange multipliers carry the opposite sign of the dynamic solver's
     (checked: the leading end's reaction then equals its tension EA·ε, tests/test_steady.py).
-    ``stations``: :func:`force_stations` of the model, when asked at many states.
+    ``stations``: :func:`force_stations` of the model, when asked at many states. A model of
+    several cables (:class:`exucable.model.bundle.BundleModel`) reports its own.
     """
+    own = getattr(model, "steady_forces", None)
+    if own is not None:
+        return own(stations)
     q, _ = model.coordinates()
     EA = model.axial_stiffness_N
     along, trailing = force_stations(model) if stations is None else stations

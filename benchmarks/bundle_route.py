@@ -1,0 +1,98 @@
+"""Whole-process wall time of a bundle run: three cables through a 100 m route with four bends, steady mode.
+
+    nice .venv/bin/python benchmarks/bundle_route.py [--count 3] [--arrangement triangular]
+        [--length 100] [--repeat 1] [--out DIR]
+
+Writes the scenario (four 90° bends of 5 m radius, two left, one up, one right, joined by equal straights;
+cables of 30 mm diameter, 1.4 kg/m, in a 100 mm duct; μ 0.3, back tension 300 N) and times
+``exucable run SCENARIO --no-plots`` in a fresh process per repeat (scenario → build → solve → files),
+next to the same route with one cable (``cable.count = 1``) timed in the same run, and prints the
+ratio, the bundle's pull force, its weight correction factor beside the calculators' and its status.
+Target (issue "Three cables in one conduit"): ≤ 60 s whole process. The machine is shared: compare
+the rows of one run with each other.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from exucable.io import atomic_write_text
+
+SCENARIO = """name = "bundle_route_{count}"
+[cable]
+radius = 0.015
+density = 2000.0
+youngs_modulus = 2e8
+count = {count}
+arrangement = "{arrangement}"
+[conduit]
+inner_radius = 0.05
+path = [{{straight = {straight}}}, {{bend = 90, radius = 5.0, turn = "left"}}, {{straight = {straight}}},
+        {{bend = 90, radius = 5.0, turn = "left"}}, {{straight = {straight}}}, {{bend = 30, radius = 5.0, turn = "up"}},
+        {{straight = {straight}}}, {{bend = 90, radius = 5.0, turn = "right"}}, {{straight = {straight}}}]
+[contact]
+friction = 0.3
+[pull]
+speed = 0.1
+back_tension = 300.0
+[gravity]
+g = 9.81
+[solver]
+mode = "steady"
+end_time = 1.0
+"""
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--count", type=int, default=3)
+    p.add_argument("--arrangement", default="triangular")
+    p.add_argument("--length", type=float, default=100.0, help="route length [m] (approximately)")
+    p.add_argument("--repeat", type=int, default=1)
+    p.add_argument("--out", default="out/bundle-benchmark")
+    args = p.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    bends_m = 3 * 0.5 * 3.14159265 * 5.0 + 3.14159265 / 6 * 5.0
+    straight = max(1.0, (args.length - bends_m) / 5.0)
+    exe = Path(sys.executable).with_name("exucable")
+    rows = {}
+    for count, arrangement in ((1, "single"), (args.count, args.arrangement)):
+        path = out / f"bundle_route_{count}.toml"
+        atomic_write_text(path, SCENARIO.format(count=count, arrangement=arrangement, straight=f"{straight:.6g}"))
+        rows[count] = {"times": []}
+    for _ in range(args.repeat):
+        for count in rows:        # interleaved: one cable, then the bundle
+            t0 = time.perf_counter()
+            proc = subprocess.run([str(exe), "run", str(out / f"bundle_route_{count}.toml"), "--out",
+                                   str(out / f"run_{count}"), "--no-plots", "--quiet"], capture_output=True, text=True)
+            rows[count]["times"].append(time.perf_counter() - t0)
+            rows[count]["exit"] = proc.returncode
+            rows[count]["summary"] = json.loads((out / f"run_{count}" / "summary.json").read_text())
+    one, many = rows[1], rows[args.count]
+    t1, tn = statistics.median(one["times"]), statistics.median(many["times"])
+    s1, sn = one["summary"], many["summary"]
+    b = sn["bundle"]
+    print(f"route {args.length:.0f} m (straights {straight:.4g} m, 4 bends), whole process, median of {args.repeat}:")
+    print(f"  1 cable : {t1:7.2f} s, status {s1['status']}, pull {s1['pull_force_N']:.6g} N, "
+          f"{s1['mesh']['elements']} elements, {s1['newton_iterations']} Newton iterations")
+    print(f"  {args.count} cables: {tn:7.2f} s, status {sn['status']}, pull {sn['pull_force_N']:.6g} N, "
+          f"{sn['mesh']['elements']} elements each, {sn['newton_iterations']} Newton iterations "
+          f"({sn['message']})")
+    print(f"  ratio bundle / one cable: {tn / t1:.2f}x; target ≤ 60 s: {'met' if tn <= 60.0 else 'NOT met'}")
+    print(f"  weight correction factor {b['weight_correction_factor']:.5g} (calculators' "
+          f"{b['formula_weight_correction_factor']:.5g}); per straight: "
+          + ", ".join(f"{st['weight_correction_factor']:.4g}" if st['weight_correction_factor'] is not None else "n/a"
+                      for st in b["straights"]))
+    print("  pull shares: " + ", ".join(f"{100 * c['pull_share']:.1f} %" for c in b["cables"]))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

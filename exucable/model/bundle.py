@@ -1,0 +1,581 @@
+"""Several cables pulled together through one conduit (``cable.count`` 2-4), in steady sliding.
+
+One ANCF cable per conductor, each with the scenario's cable data, laid along the conduit in the
+arrangement's cross-section (:func:`arrangement_offsets`) and pre-tensioned to the rope solution of
+one cable carrying its share. Each cable has its own wall contact (the cable-conduit kernel in its
+steady-sliding form) and one more coupling carries the contact between the cables
+(:class:`~exucable.contact.cable_pairs.CableContactKernel`).
+
+The pulling eye: in a steady solve the rig holds the eye where the start put it, so each cable's
+leading end is held at its place in the eye (its arrangement offset on the exit line); the pulling
+force is the sum of those reactions along the exit tangent, and each reaction is that cable's share.
+The back tension (``pull.back_tension``, the whole bundle's, as a calculator takes it) acts on the
+trailing ends in equal parts T_b/n: identical cables fed off one reel set or one brake.
+
+All cables have the same material length and trailing end place; through a bend the outer cable's
+path is longer, so its leading end sits a little short of the inner one's inside the eye (by the
+offset difference times the bend angle, millimetres to centimetres).
+
+Not covered yet, refused naming the key: the dynamic mode, a force-controlled pull,
+``solver.start_from``, the segmented wall.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import exudyn as exu
+
+from ..errors import ModelError
+from ..quasistatic import engineering as eng
+from ..post.tension import tension_at
+from .cable import CableHandles, CableProperties, add_cable, add_gravity
+from .coupling import ContactCoupling
+from .generic import add_user_force_object
+from .layout import CableLayout, lay_cable, plan_cable_mesh, steady_lead_out_m
+from .rig import Drive, add_drive, add_end_force
+
+__all__ = ["BundleModel", "arrangement_offsets", "build_bundle_model", "check_bundle_supported", "bundle_arrangement",
+           "bundle_report", "bundle_tension_profile", "straight_weight_correction"]
+
+
+def bundle_arrangement(scenario) -> str:
+    """The arrangement of the scenario's cables (``cable.arrangement``, ``"auto"`` resolved)."""
+    c = scenario.cable
+    D, d = 2.0 * scenario.conduit.inner_radius_m, 2.0 * c.radius_m
+    return eng.auto_arrangement(c.count, D, d) if c.arrangement == "auto" else c.arrangement
+
+
+def arrangement_offsets(count: int, arrangement: str, inner_radius_m: float, cable_radius_m: float) -> np.ndarray:
+    """Cable axes in the duct's cross-section as rigid circles at rest under gravity [m], shape (count, 2):
+    (horizontal, up) from the duct's axis.
+
+    With ρ = R - r and α = 2 asin(r/ρ) the angle between two touching cables on the wall, a cable on
+    the wall at φ from the bottom sits at (ρ sin φ, -ρ cos φ): triangular 2 at ±α/2; triangular 3 two
+    at ±α/2 and one on them; cradled 3 at 0, ±α; cradled 4 at ±α/2, ±3α/2; diamond one at 0, two at
+    ±α and one on those two.
+    """
+    rho = inner_radius_m - cable_radius_m
+    r = cable_radius_m
+    if not rho > r:
+        raise ModelError("conduit.inner_radius", f"a duct of inner radius {inner_radius_m:.4g} m holds no two cables "
+                         f"of radius {r:.4g} m side by side; use a larger duct or cable.count = 1")
+    alpha = 2.0 * math.asin(r / rho)
+
+    def wall(phi):
+        return [rho * math.sin(phi), -rho * math.cos(phi)]
+
+    def on_top(p, q):
+        # the circle resting on two touching-or-apart circles p, q symmetric about the vertical
+        half = abs(p[0] - q[0]) / 2.0
+        return [0.0, p[1] + math.sqrt(4.0 * r * r - half * half)]
+
+    if arrangement == "triangular" and count == 2:
+        pts = [wall(-alpha / 2), wall(alpha / 2)]
+    elif arrangement == "triangular" and count == 3:
+        a, b = wall(-alpha / 2), wall(alpha / 2)
+        pts = [a, b, on_top(a, b)]
+    elif arrangement == "cradled" and count == 3:
+        pts = [wall(-alpha), wall(0.0), wall(alpha)]
+    elif arrangement == "cradled" and count == 4:
+        pts = [wall(-1.5 * alpha), wall(-alpha / 2), wall(alpha / 2), wall(1.5 * alpha)]
+    elif arrangement == "diamond" and count == 4:
+        a, b = wall(-alpha), wall(alpha)
+        pts = [wall(0.0), a, b, on_top(a, b)]
+    else:
+        raise ModelError("cable.arrangement", f"{arrangement!r} is not an arrangement of {count} simulated cables; "
+                         "use triangular (2, 3), cradled (3, 4) or diamond (4)")
+    pts = np.asarray(pts, dtype=float)
+    if np.any(np.hypot(pts[:, 0], pts[:, 1]) > rho * (1.0 + 1e-9)):
+        raise ModelError("cable.arrangement", f"{arrangement!r}: the top cable does not fit the duct at D/d = "
+                         f"{inner_radius_m / cable_radius_m:.3g}; use the other arrangement")
+    gaps = np.hypot(*(pts[:, None, :] - pts[None, :, :]).transpose(2, 0, 1)) + np.eye(len(pts)) * 4.0 * r
+    if gaps.min() < 2.0 * r * (1.0 - 1e-9):
+        raise ModelError("cable.arrangement", f"{arrangement!r} does not stand at D/d = {inner_radius_m / cable_radius_m:.3g}: "
+                         "its cables would overlap (the top one falls onto the bottom one); use \"cradled\"")
+    return pts
+
+
+def check_bundle_supported(scenario) -> None:
+    """Refuse, naming the key, what the several-cables model does not cover yet."""
+    sc = scenario
+    if sc.solver.mode != "steady":
+        raise ModelError("solver.mode", f"cable.count = {sc.cable.count} is simulated in steady mode only; "
+                         'set solver.mode = "steady" (or cable.count = 1)')
+    if sc.pull.force_N is not None:
+        raise ModelError("pull.force", "several cables (cable.count > 1) are pulled by the rig's speed only; "
+                         "remove pull.force")
+    if not sc.solver.pretension:
+        raise ModelError("solver.pretension", "several cables start from the rope solution; set it to true")
+    if sc.contact.surface != "smooth":
+        raise ModelError("contact.surface", 'several cables need the smooth wall; set contact.surface = "smooth"')
+    if sc.contact.static_friction is not None:
+        raise ModelError("contact.static_friction", "several cables slide steadily: static friction does not act; "
+                         "remove contact.static_friction")
+
+
+def _cross_section_frame(centreline, s_m):
+    """Unit (horizontal, up) axes across the centreline at arc lengths ``s_m``, each shape (m, 3):
+    up = e_z without its tangential part (a vertical tangent takes e_x's instead)."""
+    from .layout import extended_tangent
+
+    t = extended_tangent(centreline, np.asarray(s_m, dtype=float))
+    up = np.array([0.0, 0.0, 1.0])[None, :] - t[:, 2:3] * t
+    norm = np.linalg.norm(up, axis=1)
+    vertical = norm < 1e-6
+    if np.any(vertical):
+        alt = np.array([1.0, 0.0, 0.0])[None, :] - t[:, 0:1] * t
+        up[vertical] = alt[vertical]
+        norm = np.linalg.norm(up, axis=1)
+    up /= norm[:, None]
+    horizontal = np.cross(t, up)
+    return horizontal, up
+
+
+@dataclass
+class BundleLayout:
+    """The cables' start together: ``coordinates`` (n_cables·(n_el + 1), 6) cable after cable,
+    ``element_length_m`` of one cable (all alike)."""
+
+    element_length_m: np.ndarray
+    cables: list
+    n_cables: int
+
+    @property
+    def coordinates(self) -> np.ndarray:
+        return np.concatenate([c.coordinates for c in self.cables], axis=0)
+
+
+class _Walls:
+    """The cables' wall kernels and their cable-cable kernel as one, for the steady solve."""
+
+    def __init__(self, walls, between):
+        self.walls = walls
+        self.between = between
+        self.n = walls[0].n_coordinates
+
+    @property
+    def n_check_points(self) -> int:
+        return self.walls[0].n_check_points
+
+    def set_friction_scale(self, scale: float) -> None:
+        for k in self.walls:
+            k.set_friction_scale(scale)
+        self.between.set_friction_scale(scale)
+
+    def point_segments(self, q) -> np.ndarray:
+        q = np.asarray(q, dtype=float).reshape(-1)
+        return np.concatenate([k.point_segments(q[i * self.n:(i + 1) * self.n]) for i, k in enumerate(self.walls)])
+
+
+class CableContactCoupling:
+    """Contact between the cables (:class:`~exucable.contact.cable_pairs.CableContactKernel`) as one
+    mass-free ``ObjectGenericODE2`` over every cable's nodes, exact sparse Jacobian."""
+
+    def __init__(self, mbs, nodes, reference_coordinates, kernel):
+        self.kernel = kernel
+        self.q_ref = np.ascontiguousarray(np.asarray(reference_coordinates, dtype=float).reshape(-1))
+        self.n = self.q_ref.size
+        self._last = None
+        self.evaluations = 0
+        self.object = add_user_force_object(mbs, nodes, self.n, self._force, self._jacobian)
+
+    def _evaluate(self, q):
+        qa = self.q_ref + np.asarray(q, dtype=float)
+        last = self._last
+        if last is not None and np.array_equal(last[0], qa):
+            return last[1]
+        res = self.kernel.evaluate(qa, jacobian=True)
+        self.evaluations += 1
+        self._last = (qa.copy(), res)
+        return res
+
+    def last_evaluation(self):
+        return self._last
+
+    def offer_evaluation(self, evaluation) -> None:
+        if evaluation is not None:
+            self._last = evaluation
+
+    def forget_evaluation(self) -> None:
+        self._last = None
+
+    def _force(self, mbs, t, item, q, q_t):
+        return self._evaluate(q).generalized_force
+
+    def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
+        # LHS derivative: the contact force is on the right-hand side, hence the minus sign
+        J = (-f_q * self._evaluate(q).jacobian).tocoo()
+        keep = J.data != 0.0   # Exudyn's sparse triplets must not contain zeros
+        m = exu.MatrixContainer()
+        if keep.any():
+            m.SetWithSparseMatrix(np.column_stack([J.row[keep].astype(float), J.col[keep].astype(float), J.data[keep]]),
+                                  self.n, self.n, False)
+        else:
+            m.Initialize(self.n, self.n, False)
+        return m
+
+
+class _Couplings:
+    """The wall couplings and the cable-cable coupling as one, for the steady solve's state store."""
+
+    def __init__(self, parts):
+        self.parts = parts
+
+    def last_evaluation(self):
+        return tuple(p.last_evaluation() for p in self.parts)
+
+    def offer_evaluation(self, evaluation) -> None:
+        if evaluation is not None:
+            for p, e in zip(self.parts, evaluation):
+                p.offer_evaluation(e)
+
+    def forget_evaluation(self) -> None:
+        for p in self.parts:
+            p.forget_evaluation()
+
+
+@dataclass(eq=False, repr=False)
+class BundleModel:
+    """Several cables in one conduit in an assembled Exudyn system (:func:`build_bundle_model`).
+
+    Attributes
+    ----------
+    scenario, mbs, system_container, conduit
+        As for :class:`~exucable.model.build.Model` (the conduit pull-oriented).
+    arrangement : str
+        The arrangement laid (``cable.arrangement``, ``auto`` resolved).
+    offsets_m : ndarray (n_cables, 2)
+        Each cable's axis at the start, (horizontal, up) from the duct axis [m].
+    cables : list of CableHandles
+    layout : BundleLayout
+    properties : CableProperties
+    walls : list of ContactKernel
+        Each cable's wall kernel (steady sliding).
+    between : CableContactKernel
+    lead_drives : list of Drive
+        The pulling eye's hold on each leading end.
+    rope : RopeSolution
+        One cable's share: friction μ times the calculators' weight correction, back tension T_b/n
+        (the start's tension and the solve's scale).
+    rope_alone : RopeSolution
+        One cable alone in the conduit with back tension T_b/n: the weight correction's denominator.
+    back_tension_N : float
+        The bundle's back tension [N] (each trailing end carries 1/n of it).
+    """
+
+    scenario: object
+    mbs: exu.MainSystem
+    system_container: exu.SystemContainer
+    conduit: object
+    arrangement: str
+    offsets_m: np.ndarray
+    cables: list
+    layout: BundleLayout
+    properties: CableProperties
+    walls: list
+    between: object
+    wall_couplings: list
+    between_coupling: CableContactCoupling
+    lead_drives: list
+    rope: object
+    rope_alone: object
+    back_tension_N: float
+    load_scale: object
+    mesh: object
+    lead_out_m: float
+    exit_tangent: np.ndarray
+    lead_drive: Drive | None = None
+    trail_drive: Drive | None = None
+    applied_pull_force_N: float | None = None
+    _ode2_index: np.ndarray | None = field(default=None)
+
+    def __repr__(self) -> str:
+        return (f"BundleModel({self.scenario.name!r}: {len(self.cables)} cables {self.arrangement}, "
+                f"{len(self.cables[0].elements)} elements each)")
+
+    @property
+    def n_cables(self) -> int:
+        return len(self.cables)
+
+    @property
+    def axial_stiffness_N(self) -> float:
+        return self.properties.axial_stiffness_N
+
+    @property
+    def kernel(self) -> _Walls:
+        return _Walls(self.walls, self.between)
+
+    @property
+    def coupling(self) -> _Couplings:
+        return _Couplings(self.wall_couplings + [self.between_coupling])
+
+    @property
+    def ode2_index(self) -> np.ndarray:
+        """The cables' coordinates in the system's ODE2 vector, cable after cable."""
+        if self._ode2_index is None:
+            self._ode2_index = np.concatenate([
+                np.arange(self.mbs.GetNodeODE2Index(n), self.mbs.GetNodeODE2Index(n) + 6)
+                for c in self.cables for n in c.nodes])
+        return self._ode2_index
+
+    def coordinates(self) -> tuple[np.ndarray, np.ndarray]:
+        """Absolute nodal coordinates and rates of all cables, each (n_cables·(n_el + 1), 6)."""
+        sd = self.mbs.systemData
+        q = np.asarray(sd.GetODE2Coordinates())[self.ode2_index]
+        v = np.asarray(sd.GetODE2Coordinates_t())[self.ode2_index]
+        return self.layout.coordinates + q.reshape(-1, 6), v.reshape(-1, 6)
+
+    def cable_coordinates(self) -> list[np.ndarray]:
+        """Each cable's absolute nodal coordinates (n_el + 1, 6)."""
+        q, _ = self.coordinates()
+        return np.split(q, self.n_cables)
+
+    def pull_shares_N(self) -> np.ndarray:
+        """Each cable's pull at the eye [N]: its leading end's reaction along the exit tangent
+        (the static solver's multipliers carry the opposite sign of the dynamic one's)."""
+        return np.array([-d.force_N(self.mbs) for d in self.lead_drives])
+
+    def steady_forces(self, stations=None) -> tuple[float, float, float]:
+        """Pulling force (the eye's), trailing tension (the bundle's) and largest cable tension [N]."""
+        Le = self.layout.element_length_m
+        x = np.concatenate([[0.0], np.cumsum(Le)])
+        tmax = max(float(np.max(tension_at(q, Le, self.axial_stiffness_N, x))) for q in self.cable_coordinates())
+        return float(np.sum(self.pull_shares_N())), self.back_tension_N * self.load_scale.end_force, tmax
+
+
+def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
+    """Build and assemble the Exudyn system of ``scenario``'s bundle (``cable.count`` > 1, steady mode).
+
+    Raises
+    ------
+    ModelError
+        A case the model does not cover (:func:`check_bundle_supported`), an arrangement that does
+        not fit, a cable longer than the conduit.
+    """
+    from ..contact import ContactKernel, ContactLaw
+    from ..contact.cable_pairs import CableContactKernel
+    from ..contact.steady import SteadySlidingKernel
+    from ..quasistatic.rope import solve_rope
+    from .build import LoadScale
+
+    sc = scenario
+    check_bundle_supported(sc)
+    n = sc.cable.count
+    c = sc.cable
+    arrangement = bundle_arrangement(sc)
+    offsets = arrangement_offsets(n, arrangement, sc.conduit.inner_radius_m, c.radius_m)
+    conduit = sc.build_conduit()
+    if sc.pull.direction == "reverse":
+        conduit = conduit.reversed()
+    centre = conduit.centreline
+    L_cable = sc.cable_length_m
+    if L_cable > centre.length_m * (1 + 1e-12):
+        raise ModelError("cable.length", f"cable of {L_cable:.6g} m is longer than the conduit "
+                         f"({centre.length_m:.6g} m); shorten it or extend the route")
+    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
+    w = c.mass_per_length_kg_per_m * g
+    D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * c.radius_m
+    wcf = eng.weight_correction_factor(n, arrangement, D, d)
+    back = sc.pull.back_tension_N / n
+
+    def share_rope(length_m, factor):
+        return solve_rope(centre, friction=sc.contact.friction * factor, weight_per_length_N_per_m=w,
+                          trailing_tension_N=back, cable_length_m=length_m)
+
+    lead_out = (float(sc.solver.steady_lead_out_m) if sc.solver.steady_lead_out_m is not None else
+                steady_lead_out_m(centre, c.bending_stiffness_N_m2, share_rope(L_cable, wcf).pull_force_N))
+    if lead_out >= L_cable:
+        raise ModelError("solver.steady_lead_out", f"{lead_out:.4g} m laid out past the exit leaves none of the "
+                         f"{L_cable:.4g} m cable in the conduit; give less than the cable's length")
+    rope = share_rope(L_cable - lead_out, wcf)
+    rope_alone = share_rope(L_cable - lead_out, 1.0)
+    mesh = plan_cable_mesh(sc, conduit, rope, refine)
+    n_el = mesh.elements
+
+    def tension_fn(s):
+        return np.interp(s, rope.s_conduit_m, rope.tension_N)
+
+    layouts = []
+    for h, v in offsets:
+        def offset_fn(s, h=h, v=v):
+            eh, ev = _cross_section_frame(centre, s)
+            return h * eh + v * ev
+        layouts.append(lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, tension_fn,
+                                 offset_fn, lead_out_m=lead_out))
+    Le = layouts[0].element_length_m
+    layout = BundleLayout(element_length_m=Le, cables=layouts, n_cables=n)
+
+    SC = exu.SystemContainer()
+    mbs = SC.AddSystem()
+    props = CableProperties(
+        mass_per_length_kg_per_m=c.mass_per_length_kg_per_m, axial_stiffness_N=c.axial_stiffness_N,
+        bending_stiffness_N_m2=c.bending_stiffness_N_m2, axial_damping_N_s=c.axial_damping_N_s,
+        bending_damping_N_m2_s=c.bending_damping_N_m2_s, integration=c.integration)
+    t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
+    t_entry = np.asarray(centre.tangent(centre.length_m - L_cable + lead_out), dtype=float)
+    load_scale = LoadScale()
+    ct = sc.contact
+    wall_law = ContactLaw(stiffness=ct.stiffness, damping=ct.damping, exponent=ct.exponent, friction=ct.friction,
+                          regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s,
+                          damping_onset_m=ct.damping_onset_m)
+    cables, walls, couplings, drives = [], [], [], []
+    for lay in layouts:
+        cable = add_cable(mbs, lay.coordinates, Le, props, lay.velocities, draw_radius_m=c.radius_m)
+        cables.append(cable)
+        if g > 0:
+            vec = [0.0, 0.0, -g]
+            loads = add_gravity(mbs, cable, vec)
+            load_scale.track(gravity_loads=loads, vectors={i: vec for i in loads})
+        if back > 0:
+            vec = list(-back * t_entry)
+            i = add_end_force(mbs, cable.nodes[0], vec)
+            load_scale.track(end_loads=[i], vectors={i: vec})
+        drives.append(add_drive(mbs, cable.nodes[-1], t_exit, 0.0))
+        kernel = SteadySlidingKernel(conduit.segments, Le, c.radius_m, wall_law, mesh.check_points_per_element,
+                                     rule=ct.check_point_rule, reference_spacing_m=ct.reference_spacing_m,
+                                     broad_phase=ct.broad_phase, surface=ct.surface, centreline=centre,
+                                     speed_m_per_s=sc.pull.speed_m_per_s)
+        walls.append(kernel)
+        couplings.append(ContactCoupling(mbs, cable.nodes, lay.coordinates, kernel))
+    between_law = ContactLaw(stiffness=ct.stiffness, damping=0.0, exponent=ct.exponent, friction=ct.cable_friction,
+                             regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s)
+    # the broad phase's window: one element either side, plus how far apart the cables' nodes of
+    # one index start along the route (the outer cable's longer path through bends)
+    s_nodes = np.stack([lay.node_s_m for lay in layouts])
+    drift = float(np.max(s_nodes.max(axis=0) - s_nodes.min(axis=0)))
+    k = mesh.check_points_per_element
+    window = k * (2 + int(math.ceil(drift / float(np.min(Le))))) + 2
+    between = CableContactKernel(n, Le, c.radius_m, between_law, k, ct.reference_spacing_m,
+                                 sc.pull.speed_m_per_s, window=window)
+    all_nodes = [nd for cable in cables for nd in cable.nodes]
+    between_coupling = CableContactCoupling(mbs, all_nodes, layout.coordinates, between)
+    mbs.Assemble()
+    return BundleModel(
+        scenario=sc, mbs=mbs, system_container=SC, conduit=conduit, arrangement=arrangement, offsets_m=offsets,
+        cables=cables, layout=layout, properties=props, walls=walls, between=between, wall_couplings=couplings,
+        between_coupling=between_coupling, lead_drives=drives, rope=rope, rope_alone=rope_alone,
+        back_tension_N=sc.pull.back_tension_N, load_scale=load_scale, mesh=mesh, lead_out_m=lead_out,
+        exit_tangent=t_exit)
+
+
+def straight_weight_correction(model: BundleModel, s_from_m: float, s_to_m: float) -> float | None:
+    """The bundle's weight correction factor emerging on a straight between ``s_from_m`` and
+    ``s_to_m`` of the pull-oriented conduit [-], or None where the cables' weight gives no friction.
+
+    On a straight of slope sin θ = t_z (t along the pull) the cables' tensions rise by
+    ΣΔT = n w (sin θ + w_c μ cos θ) Δs, so w_c = (ΣΔT/n - w sin θ Δs)/(μ w cos θ Δs): the bundle's
+    friction over what the same cables would have alone. Measured between two stations inside
+    the straight, away from the cables' ends and the bends' bending boundary layers; each cable's
+    station is its material point laid there at the start (the steady state moves it by its strain).
+    """
+    sc = model.scenario
+    g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
+    w = sc.cable.mass_per_length_kg_per_m * g
+    mu = sc.contact.friction
+    centre = model.conduit.centreline
+    t = np.asarray(centre.tangent(0.5 * (s_from_m + s_to_m)), dtype=float).reshape(3)
+    cos_t = math.sqrt(max(0.0, 1.0 - t[2] ** 2))
+    ds = s_to_m - s_from_m
+    if not (mu * w * cos_t * ds > 0.0):
+        return None
+    Le = model.layout.element_length_m
+    rise = 0.0
+    for lay, q in zip(model.layout.cables, model.cable_coordinates()):
+        x = np.interp([s_from_m, s_to_m], lay.node_s_m, lay.node_x_m)
+        T = tension_at(q, Le, model.axial_stiffness_N, x)
+        rise += float(T[1] - T[0])
+    n = model.n_cables
+    return (rise / n - w * t[2] * ds) / (mu * w * cos_t * ds)
+
+
+def bundle_report(model: BundleModel) -> dict:
+    """What a bundle's steady state says, in SI units (``summary.json``'s bundle keys).
+
+    ``pull_force_N`` (the eye's), ``trailing_tension_N`` (the bundle's back tension), ``max_tension_N``;
+    ``weight_correction_factor``: (F - T_b)/(n (F_1 - T_b/n)) with F_1 the rope pull force of one
+    cable alone with back tension T_b/n in the same extent (the bundle's friction over the cables'
+    alone, the whole route, ends included); ``formula_weight_correction_factor`` (the calculators');
+    ``straights``: per straight of at least four cable diameters inside the cable's extent, its
+    factor from the tension rise over its middle half (:func:`straight_weight_correction`);
+    ``cables``: per cable its pull share (N and fraction), trailing tension, largest tension, wall
+    normal force and contact force from the other cables (sums over its check points [N]), its start
+    offset in the duct.
+    """
+    sc = model.scenario
+    n = model.n_cables
+    shares = model.pull_shares_N()
+    F = float(np.sum(shares))
+    Tb = model.back_tension_N
+    alone = model.rope_alone.pull_force_N - Tb / n
+    D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
+    Le = model.layout.element_length_m
+    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
+    qs = model.cable_coordinates()
+    q_all = np.concatenate([q.reshape(-1) for q in qs])
+    between = model.between.contacts(q_all)
+    n_points = model.between.n_points
+    owner = between["index"] // n_points
+    push = np.linalg.norm(between["force"].reshape(-1, 3, 3), axis=2)      # |force| on P, B0, B1
+    from_others = np.zeros(n)
+    for col in range(3):
+        np.add.at(from_others, owner[:, col], push[:, col])
+    cables = []
+    for i, (q, k) in enumerate(zip(qs, model.walls)):
+        pts = k.points(q.reshape(-1), np.zeros(q.size))
+        T = tension_at(q, Le, model.axial_stiffness_N, x_nodes)
+        cables.append({
+            "cable": i + 1,
+            "pull_share_N": float(shares[i]),
+            "pull_share": float(shares[i] / F) if F != 0.0 else None,
+            "trailing_tension_N": Tb / n,
+            "max_tension_N": float(np.max(T)),
+            "wall_normal_force_N": float(np.sum(pts.normal_force_N)),
+            "cable_contact_force_N": float(from_others[i]),
+            "start_offset_horizontal_m": float(model.offsets_m[i, 0]),
+            "start_offset_up_m": float(model.offsets_m[i, 1]),
+        })
+    centre = model.conduit.centreline
+    lay0 = model.layout.cables[0]
+    s_lo, s_hi = float(np.min(lay0.node_s_m)), min(float(np.max(lay0.node_s_m)), centre.length_m)
+    straights = []
+    for piece in centre.pieces:
+        if piece.is_curved:
+            continue
+        a, b = max(piece.s_start_m, s_lo), min(piece.s_start_m + piece.length_m, s_hi)
+        if b - a < 4.0 * d:
+            continue
+        s0, s1 = piece.s_start_m, piece.s_start_m + piece.length_m
+        if sc.pull.direction == "reverse":      # along the scenario's conduit, as every file
+            s0, s1 = centre.length_m - s1, centre.length_m - s0
+        straights.append({"s_conduit_start_m": s0, "s_conduit_end_m": s1,
+                          "weight_correction_factor": straight_weight_correction(model, a + 0.25 * (b - a),
+                                                                                 a + 0.75 * (b - a))})
+    return {
+        "count": n,
+        "arrangement": model.arrangement,
+        "pull_force_N": F,
+        "trailing_tension_N": Tb,
+        "max_tension_N": max(c["max_tension_N"] for c in cables),
+        "weight_correction_factor": (F - Tb) / (n * alone) if alone > 0.0 else None,
+        "formula_weight_correction_factor": eng.weight_correction_factor(n, model.arrangement, D, d),
+        "rope_pull_force_one_cable_N": model.rope_alone.pull_force_N,
+        "contacts_at_window_edge": int(np.count_nonzero(between["edge"])),
+        "straights": straights,
+        "cables": cables,
+        "lead_out_m": model.lead_out_m,
+    }
+
+
+def bundle_tension_profile(model: BundleModel, points_per_element: int = 4) -> dict:
+    """``x_m`` (material coordinate from the trailing ends) and each cable's ``cable_<k>_tension_N`` [N]."""
+    from ..post.tension import profile_stations_m
+
+    Le = model.layout.element_length_m
+    x = profile_stations_m(Le, points_per_element)
+    out = {"x_m": x}
+    for i, q in enumerate(model.cable_coordinates()):
+        out[f"cable_{i + 1}_tension_N"] = tension_at(q, Le, model.axial_stiffness_N, x)
+    return out

@@ -1,0 +1,134 @@
+"""Tests of the cable-cable contact kernel (exucable/contact/cable_pairs.py).
+
+References independent of the kernel: the Hertz force between two parallel straight cables in
+closed form, Coulomb's friction on a known sliding velocity, Newton's third law, and central
+finite differences of the generalized force for the exact Jacobian. The compiled loop is checked
+equal to the numpy definition, as for the cable-conduit kernel (tests/test_contact_kernel.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from exucable.contact import ContactLaw
+from exucable.contact.cable_pairs import CableContactKernel, _pair_contacts, pair_contacts_reference
+
+R = 2.5e-3          # cable radius [m]
+H_REF = 1e-3        # reference spacing [m]
+LAW = ContactLaw(stiffness=1e6, damping=0.0, exponent=1.5, friction=0.3, regularisation_velocity_m_per_s=1e-3)
+
+
+def straight_cable(n_el, Le, y, z, rng=None, wobble=0.0):
+    """Nodal coordinates of a straight cable along x at (y, z), optionally perturbed [m, -]."""
+    x = np.concatenate([[0.0], np.cumsum(np.full(n_el, Le))])
+    q = np.zeros((n_el + 1, 6))
+    q[:, 0], q[:, 1], q[:, 2], q[:, 3] = x, y, z, 1.0
+    if rng is not None:
+        q[:, 1:3] += wobble * rng.normal(size=(n_el + 1, 2))
+        q[:, 4:6] += 0.02 * rng.normal(size=(n_el + 1, 2))
+        q[:, 0] += 0.1 * wobble * rng.normal(size=n_el + 1)
+    return q.reshape(-1)
+
+
+def bundle_q(rng, n_el=4, Le=0.05, wobble=1e-4):
+    """Three cables in a trefoil, pressed together by 0.1 mm, perturbed."""
+    gap = 2 * R - 1e-4
+    return np.concatenate([straight_cable(n_el, Le, 0.0, 0.0, rng, wobble),
+                           straight_cable(n_el, Le, gap, 0.0, rng, wobble),
+                           straight_cable(n_el, Le, gap / 2, gap * np.sqrt(3) / 2, rng, wobble)])
+
+
+def kernel(backend, n_el=4, Le=0.05, n_k=5, law=LAW, speed=0.1, window=None):
+    return CableContactKernel(3, np.full(n_el, Le), R, law, n_k, H_REF, speed, window=window, backend=backend)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_compiled_equals_numpy(seed):
+    q = bundle_q(np.random.default_rng(seed))
+    a, b = kernel("numpy").evaluate(q), kernel("numba").evaluate(q)
+    assert a.n_in_contact == b.n_in_contact > 0
+    scale = np.abs(a.generalized_force).max()
+    # same formulas, same order of operations up to numpy's vs the loop's sums: round-off only
+    np.testing.assert_allclose(b.generalized_force, a.generalized_force, rtol=0, atol=1e-11 * scale)
+    jscale = abs(a.jacobian).max()
+    assert abs(a.jacobian - b.jacobian).max() <= 1e-11 * jscale
+
+
+@pytest.mark.parametrize("backend", ["numpy", "numba"])
+def test_jacobian_matches_central_differences(backend):
+    """∂Q/∂q exact (positions, slopes and the steady-sliding velocity V ∂r/∂x), friction on."""
+    q = bundle_q(np.random.default_rng(5))
+    k = kernel(backend)
+    J = k.evaluate(q).jacobian.toarray()
+    h = 1e-9    # central differences: truncation ~h² |Q'''|, round-off ~1e-16 |Q|/h; both < 1e-7 relative here
+    fd = np.empty_like(J)
+    for i in range(q.size):
+        dq = np.zeros_like(q)
+        dq[i] = h
+        fd[:, i] = (k.evaluate(q + dq, False).generalized_force - k.evaluate(q - dq, False).generalized_force) / (2 * h)
+    assert np.abs(J - fd).max() <= 1e-6 * np.abs(J).max()
+
+
+def test_parallel_cables_hertz_force_per_length():
+    """Two straight parallel cables pressed by δ: each carries (K/h_ref) δ^e per metre, opposite."""
+    n_el, Le, delta = 6, 0.1, 2e-5
+    q = np.concatenate([straight_cable(n_el, Le, 0.0, 0.0), straight_cable(n_el, Le, 2 * R - delta, 0.0)])
+    for backend in ("numpy", "numba"):
+        k = CableContactKernel(2, np.full(n_el, Le), R, LAW, 4, H_REF, 0.1, backend=backend)
+        c = k.contacts(q)
+        assert len(c["t"]) == n_el * 4        # every check point of cable 0 touches cable 1
+        np.testing.assert_allclose(c["penetration_m"], delta, rtol=1e-9)
+        Q = k.evaluate(q, False).generalized_force.reshape(2, n_el + 1, 6)
+        per_m = LAW.stiffness / H_REF * delta ** LAW.exponent
+        # the check points cover the length; the y-force on each cable's positions sums to ∓ per_m·L
+        np.testing.assert_allclose(Q[0, :, 1].sum(), -per_m * n_el * Le, rtol=1e-9)
+        np.testing.assert_allclose(Q[1, :, 1].sum(), per_m * n_el * Le, rtol=1e-9)
+        assert np.abs(Q[:, :, [0, 2]]).max() < 1e-9 * per_m
+
+
+def test_friction_opposes_relative_sliding_with_coulomb_magnitude():
+    """Cable 0 slides along x at 0.1 m/s past cable 1 at rest: friction μ f_n against it, on
+    cable 1 the reaction; the point kernel is given the velocities directly."""
+    n_pts = 5
+    X = np.zeros((2 * n_pts, 3))
+    X[:n_pts, 0] = X[n_pts:, 0] = np.linspace(0.0, 0.04, n_pts)
+    X[n_pts:, 1] = 2 * R - 1e-5
+    U = np.zeros_like(X)
+    U[:n_pts, 0] = 0.1
+    weight = np.full(n_pts, 10.0)
+    ref = pair_contacts_reference(X, U, 2, n_pts, 2, 2 * R, weight, LAW)
+    f_n = 10.0 * LAW.stiffness * 1e-5 ** 1.5
+    eps = LAW.regularisation_velocity_m_per_s
+    mu_eff = LAW.friction * 0.1 / np.sqrt(0.1 ** 2 + eps ** 2)
+    np.testing.assert_allclose(ref["force"][:, 0], -mu_eff * f_n, rtol=1e-12)     # on the sliding point
+    np.testing.assert_allclose(ref["force"][:, 1], -f_n, rtol=1e-12)               # pushed away from cable 1
+    total = ref["force"].reshape(-1, 3, 3).sum(axis=1)                              # P, B0, B1 together
+    assert np.abs(total).max() < 1e-12 * f_n                                        # action = reaction
+    m = 2 * n_pts
+    out = (np.zeros((m, 3), np.int64), np.zeros(m), np.zeros(m), np.zeros((m, 9)), np.zeros((m, 9, 9)),
+           np.zeros((m, 9, 9)), np.zeros(m, np.bool_))
+    count = _pair_contacts(X, U, 2, n_pts, 2, 2 * R, weight, LAW.stiffness, LAW.exponent, LAW.friction, eps ** 2, True,
+                           *out)
+    assert count == len(ref["t"])
+    np.testing.assert_allclose(out[3][:count], ref["force"], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(out[4][:count], ref["jac_x"], rtol=1e-10, atol=1e-9)
+    np.testing.assert_allclose(out[5][:count], ref["jac_u"], rtol=1e-10, atol=1e-12)
+
+
+def test_forces_balance_between_cables():
+    """Newton's third law over the whole bundle: the contact forces on all positions sum to zero."""
+    q = bundle_q(np.random.default_rng(9))
+    Q = kernel("numba").evaluate(q, False).generalized_force.reshape(-1, 6)
+    assert np.abs(Q[:, :3].sum(axis=0)).max() < 1e-10 * np.abs(Q[:, :3]).max()
+
+
+def test_windowed_search_equals_the_full_search():
+    """The broad phase (segments within the window of the same index) finds the contacts a search
+    over every segment finds, when the cables lie side by side."""
+    q = bundle_q(np.random.default_rng(3), n_el=10, Le=0.02)
+    near = kernel("numba", n_el=10, Le=0.02).contacts(q)
+    full = kernel("numba", n_el=10, Le=0.02, window=10 * 5).contacts(q)
+    np.testing.assert_array_equal(near["index"], full["index"])
+    np.testing.assert_allclose(near["force"], full["force"], rtol=0, atol=0)
+    assert not near["edge"].any()
