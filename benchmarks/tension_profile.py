@@ -2,7 +2,8 @@
 study routes like issue 23's (steady mode).
 
 For each route: the pulling force, the physical band [smallest, largest] tension — the smaller of the back
-tension and the rope reference's smallest tension, the larger of the pulling force and the rope's largest —
+tension and the rope reference's smallest tension, the larger of the pulling force (in dynamic mode also
+the rig's force in the final state, which the profile belongs to) and the rope's largest —
 then the range of N = EA·ε of the ANCF elements at 4 stations per element (the profile before: paper Eq. 24
 read off the strain) and of the profile written now (the equilibrium of the cable's loads,
 ``exucable.post.tension.equilibrium_tension``), each as its excursion beyond the band in % of the pull (0 =
@@ -98,7 +99,10 @@ def main() -> None:
             x, strain_N = tension_profile(q, m.layout.element_length_m, m.axial_stiffness_N)
             N = r.tension_profile["tension_N"]
             rope = m.rope.tension_N
-            lo, hi = min(m.back_tension_N, float(np.min(rope))), max(pull, float(np.max(rope)))
+            hi = max(pull, float(np.max(rope)))
+            if args.mode == "dynamic":
+                hi = max(hi, m.pull_force_N(float(m.mbs.systemData.GetTime())))
+            lo = min(m.back_tension_N, float(np.min(rope)))
             change = ""
             if before is not None:
                 xb, eb, nb = before
