@@ -297,9 +297,9 @@ def equilibrium_tension(coordinates, element_length_m, loads: CableLoads, x_m) -
     Le = np.asarray(element_length_m, dtype=float)
     length = float(np.sum(Le))
     x = np.clip(np.asarray(x_m, dtype=float), 0.0, length)
-    G = _loads_up_to(loads, Le, x)
+    G = _loads_up_to(loads, Le, np.append(x, length))     # the stations', then all the loads'
+    G, total = G[:-1], G[-1]
     if loads.leading_force_N is not None:
-        total = _loads_up_to(loads, Le, [length])[0]
         from_lead = np.asarray(loads.leading_force_N, dtype=float)[None, :] + total[None, :] - G
     if loads.trailing_force_N is not None:
         from_trail = -np.asarray(loads.trailing_force_N, dtype=float)[None, :] - G
