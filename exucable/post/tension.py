@@ -1,9 +1,10 @@
-"""Tension post-processing (paper Sect. 2.6, Eq. 24: N = EA·ε) and the steady-state detector.
+"""Tension post-processing (paper Sect. 2.6, Eq. 24) and the steady-state detector.
 
 Pure numpy on nodal coordinates, so the same code serves live recording during a run and
-post-processing of saved states; a test checks it against Exudyn's own ``ForceLocal`` output.
-The strain is the ANCF cable's axial strain ε = |r'(x)| − 1 (paper Eq. 11), r' = ∂r/∂x along the
-unstretched (material) coordinate x.
+post-processing of saved states. Two readings of the axial force: N = EA·ε of the ANCF cable's axial
+strain ε = |r'(x)| − 1 (paper Eq. 11; r' = ∂r/∂x along the unstretched, material coordinate x; a test
+checks it against Exudyn's own ``ForceLocal`` output), and :func:`equilibrium_tension`, the one the
+results report, from the balance of the cable's loads (EA·ε spikes next to the point loads at bend ends).
 """
 
 from __future__ import annotations
@@ -272,12 +273,15 @@ def equilibrium_tension(coordinates, element_length_m, loads: CableLoads, x_m) -
     cubic Hermite element (paper Eqs. 5-6) cannot bend and keep |r'| smooth at once, and Exudyn's
     reduced (Lobatto) quadrature ties ε down at three points per element only, so EA·ε between
     and even at them carries the element's error (CommScope A–H, steady: −99…416 N at a pull of
-    291 N). The internal force F(x) of the cut at x instead follows exactly from the loads on
-    either side: from the trailing end F = −F_trail − G(x), from the leading end
-    F = F_lead + G(L) − G(x), G(x) the resultant of the loads on [0, x] (contact forces at the
-    check points, weight, inertia −ρA·r̈, nodal dampers). Its tangential part t·F, t = r'/|r'|, is
-    the tension; it jumps only where a check point's friction acts and converges to the
-    continuum's axial force as the mesh is refined. With both ends' forces known the two are
+    291 N; read at the Lobatto points alone it stays within 0…290.4 N but is up to 6.5 N off the
+    loads' balance, 11.4 N at half the elements). The internal force F(x) of the cut at x instead
+    follows exactly from the loads on either side: from the trailing end F = −F_trail − G(x),
+    from the leading end F = F_lead + G(L) − G(x), G(x) the resultant of the loads on [0, x]
+    (contact forces at the check points, weight, inertia −ρA·r̈, nodal dampers). Its tangential
+    part t·F, t = r'/|r'|, is the tension; it jumps only where a check point's friction acts (and
+    where a stiff cable lands on the wall at an angle, the normal force having a part along it),
+    and converges to the continuum's axial force as the mesh is refined (reference/README.md,
+    "The tension profile"). With both ends' forces known the two are
     blended linearly in x, so that N meets both ends' forces exactly (their difference is the
     solve's residual, :func:`load_imbalance_N`); with one, that one is used.
 
