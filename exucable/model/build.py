@@ -222,7 +222,8 @@ class CableInConduit:
         Le = np.asarray(self.layout.element_length_m, dtype=float)
         x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
         if self.kernel is not None:
-            pts = self.kernel.points(q.reshape(-1), v.reshape(-1))
+            # a steady state's rates may be nan (unknown): its kernel takes them from q anyway
+            pts = self.kernel.points(q.reshape(-1), np.nan_to_num(v).reshape(-1))
             point_x = x_nodes[pts.element] + pts.xi * Le[pts.element]
             f_n, f_t = pts.normal_force_N, pts.friction_force_N
             solved = getattr(self.coupling, "solved_onset", None)

@@ -109,7 +109,9 @@ class SnapshotRecorder:
         for c, v in columns.items():
             self.rows[name][c].extend(np.broadcast_to(np.asarray(v), (n,)).tolist())
 
-    def _record(self, t, q, v, step, pull_force_N, a, reactions):
+    def _record(self, t, q, v, step, pull_force_N, a=None, reactions=None):
+        """One snapshot of state (t, q, v); ``a`` the nodal accelerations (None: a static state) and
+        ``reactions`` the drives' forces at t (:meth:`Model.drive_reactions_N`; None: the model's now)."""
         m = self.model
         lay = m.layout
         Le = np.asarray(lay.element_length_m, dtype=float)
@@ -125,7 +127,7 @@ class SnapshotRecorder:
         self._append("snapshot_nodes.csv", **nodes)
         xi = np.asarray(TENSION_XI)
         x = (lay.node_x_m[:-1, None] + xi[None, :] * Le[:, None]).ravel()
-        loads = m.loads(state=(t, q, v, a, reactions))
+        loads = m.loads(state=(t, q, v, a, m.drive_reactions_N() if reactions is None else reactions))
         if loads.trailing_force_N is None and loads.leading_force_N is None:
             N = tension_at(q, Le, m.axial_stiffness_N, x)     # both ends held by reactions
         else:
