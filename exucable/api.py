@@ -229,8 +229,8 @@ class History:
 
 @dataclass(frozen=True)
 class TensionProfile:
-    """Axial force N = EA·ε along the cable at the final time (paper Eq. 24), as
-    ``tension_profile.csv``.
+    """Axial force N along the cable at the final time (paper Eq. 24), as ``tension_profile.csv``:
+    from the equilibrium of the cable's loads (:func:`exucable.post.tension.equilibrium_tension`).
 
     Attributes
     ----------
@@ -305,6 +305,17 @@ class Result:
     def trailing_tension_N(self) -> float:
         """Mean trailing-end tension in the steady window [N]."""
         return _number(self.summary.get("trailing_tension_N"))
+
+    @property
+    def max_tension_N(self) -> float:
+        """Largest tension along the cable [N] (``summary["max_tension_N"]``)."""
+        return _number(self.summary.get("max_tension_N"))
+
+    @property
+    def max_sidewall_pressure_N_per_m(self) -> float:
+        """Largest windowed sidewall pressure [N/m]: the contact force within s ± w/2 over the window
+        w (``summary["pressure_window_m"]``), the calculators' SWBP; NaN without contact."""
+        return _number(self.summary.get("max_sidewall_pressure_N_per_m"))
 
     @property
     def rope_pull_force_N(self) -> float:

@@ -19,7 +19,7 @@ from .output.outdir import owned_out_dir
 from .output.results import RunResult, write_results
 from .scenario.specs import Scenario, load_scenario
 from .post.pressure import bend_table, default_window_m, pressure_profile
-from .post.tension import SteadyState, detect_steady_state, tension_at, tension_profile
+from .post.tension import SteadyState, detect_steady_state, profile_stations_m
 from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile"]
@@ -46,12 +46,15 @@ def check_point_loads(model) -> dict | None:
 
 
 def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | None, float]:
-    """Sidewall bearing pressure along the conduit from :func:`check_point_loads`.
+    """The check points' line loads along the conduit from :func:`check_point_loads`.
 
     One row per check point in order of ``s_conduit_m`` along the scenario's conduit (normal force per unit
     length [N/m] = the point's force over its share of the element, penetration [m]); beyond
-    ``max_rows`` points, consecutive points are averaged in equal groups (pressure: mean,
-    penetration: max). Also returns the largest per-point pressure [N/m].
+    ``max_rows`` points, consecutive points are averaged in equal groups (line load: mean,
+    penetration: max). Also returns the largest per-point line load [N/m]: at a bend end it grows
+    as the elements shrink and with the contact stiffness (a concentrated load spread over one
+    point's share), so it is not the sidewall pressure an engineer sets against a cable's limit
+    (that is the windowed pressure, :mod:`exucable.post.pressure`).
     """
     if points is None:
         return None, 0.0
@@ -70,11 +73,12 @@ def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | N
 
 
 def cable_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
-    """The cable's tension at its nodes [N] and their places along the scenario's conduit [m]."""
+    """The cable's tension at its nodes [N] (from its loads' equilibrium, :meth:`Model.tension_N`) and
+    their places along the scenario's conduit [m]."""
     q, _ = model.coordinates()
     Le = model.layout.element_length_m
     x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
-    T = tension_at(q, Le, model.axial_stiffness_N, x_nodes)
+    T = model.tension_N(x_nodes)
     _, s = AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)(q[:, :3])
     return conduit_s(model, s), T
 
@@ -97,8 +101,9 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
     i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
     info = {"pressure_window_m": w,
             "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
-            "max_windowed_sidewall_pressure_N_per_m": float(prof["windowed_pressure_N_per_m"][i]),
-            "max_windowed_sidewall_pressure_s_conduit_m": float(prof["s_conduit_m"][i]),
+            # the calculators' SWBP: contact force within s ± w/2 over w, converged under refinement
+            "max_sidewall_pressure_N_per_m": float(prof["windowed_pressure_N_per_m"][i]),
+            "max_sidewall_pressure_s_conduit_m": float(prof["s_conduit_m"][i]),
             "rope_max_windowed_sidewall_pressure_N_per_m": float(np.max(prof["rope_windowed_pressure_N_per_m"]))}
     return info, bends, prof
 
@@ -226,10 +231,16 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         # extent, evaluated at the window's mean time): remove that drift first
         pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"],
                                     st.from_s if np.isfinite(st.from_s) else 0.0) if len(h["time_s"]) else None
-    q, _ = model.coordinates()
-    x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
+    # the cable's tension from the equilibrium of its loads (exucable.post.tension.equilibrium_tension):
+    # EA·ε of the elements oscillates next to the concentrated loads at bend ends
+    x = profile_stations_m(model.layout.element_length_m)
+    N = model.tension_N(x)
+    if sp.mode == "steady" and len(h["time_s"]):
+        # the result's row is the converged state's; the pseudo-time steps before it are not in
+        # equilibrium and keep EA·ε's maximum (the recovery's contact pass each step would cost more)
+        h["max_tension_N"][-1] = float(np.max(N))
     points = check_point_loads(model)
-    cprof, peak_pressure = contact_profile(points)
+    cprof, peak_line_load = contact_profile(points)
     rope = model.rope
     pressure_info, bends, pressure_prof = _pressure(model, points, rope)
     summary = {
@@ -265,12 +276,15 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         "wall_time_s": out.wall_time_s,
         "build_time_s": build_s,
         "kernel_time_s": model.coupling.kernel_time_s if model.coupling is not None else 0.0,
-        "max_sidewall_pressure_N_per_m": peak_pressure,
+        # one check point's normal force over its share of the element: depends on the mesh and
+        # the contact stiffness at a bend end; kept for cross-checks, not for a cable's limit
+        "max_check_point_line_load_N_per_m": peak_line_load if points is not None else None,
         "rope_pull_force_N": refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
         "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
         "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
         "rope_clearance_pull_force_N": refs.get("rope_clearance_pull_force_N"),
         "reference_pulled_out_m": refs.get("pulled_out_m"),
+        "max_sidewall_pressure_N_per_m": None,     # without contact or rope; else pressure_info's
         **pressure_info,
         "bends": bends,
         "mesh": model.mesh.to_dict() if model.mesh is not None else None,

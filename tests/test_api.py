@@ -37,6 +37,8 @@ def test_issue_code_block_gives_the_capstan():
     tp = res.tension_profile
     assert tp.s_m[0] == 0 and tp.s_m[-1] == pytest.approx(route.length_m)
     assert tp.tension_N[0] == pytest.approx(150.0, rel=2e-2)
+    assert res.max_tension_N >= np.max(tp.tension_N) - 1e-9     # the steady window ends in this state
+    assert res.max_sidewall_pressure_N_per_m > 0.0
     q, v = res.model.coordinates()
     assert q.shape == (sc.cable.elements + 1, 6)
     assert res.model.kernel is not None and res.model.mbs is not None

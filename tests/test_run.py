@@ -36,6 +36,12 @@ def test_run_writes_the_documented_results(tmp_path):
     w = 1000 * np.pi * 0.0025**2 * 9.8
     mid = (contact["s_conduit_m"] > 10) & (contact["s_conduit_m"] < 40)
     np.testing.assert_allclose(contact["normal_force_per_length_N_per_m"][mid], w * np.cos(np.pi / 6), rtol=1e-3)
+    # one sidewall-pressure name: the windowed pressure's maximum; the single point's peak named apart
+    pressure = read_csv(tmp_path / "pressure_profile.csv")
+    assert s["max_sidewall_pressure_N_per_m"] == pytest.approx(np.max(pressure["windowed_pressure_N_per_m"]), rel=1e-12)
+    assert s["max_check_point_line_load_N_per_m"] == pytest.approx(np.max(contact["normal_force_per_length_N_per_m"]),
+                                                                    rel=1e-12)     # < 5000 points: one row each
+    assert "max_windowed_sidewall_pressure_N_per_m" not in s
     for png in ("pull_force.png", "tension_profile.png"):
         assert (tmp_path / png).stat().st_size > 5000
     assert not list(tmp_path.glob(".*.tmp"))                   # atomic writes leave no temp files

@@ -19,12 +19,13 @@ from exudyn.itemInterface import MarkerNodePosition, ObjectJointSpherical
 from ..errors import ModelError, ScenarioError
 from ..scenario.mesh import MeshPlan
 from ..quasistatic.extent import reference_drift_N_per_s
-from ..post.tension import tension_at
+from ..post.tension import CableLoads, check_point_forces_N, equilibrium_tension, tension_at
 from .cable import CableHandles, CableProperties, add_cable, add_gravity
 from .layout import CableLayout, InitialLayout, initial_layout
 from .recorder import Recorder, earliest_steady_s
 from .rig import (
     Drive,
+    drive_force_vector_N,
     Guide,
     add_drive,
     add_end_force,
@@ -132,6 +133,12 @@ class CableInConduit:
     recorder: Recorder | None = None
     # how fast the flexible reference's pulling force moves as the cable leaves its conduit [N/s]
     reference_drift_N_per_s: float = 0.0
+    # what holds each end ("rig", "force", "reel", "joined"; "back_tension", "brake", "joined"),
+    # the Exudyn loads on each end's node and the cable's weight loads (for the tension's equilibrium)
+    leading_end: str = "rig"
+    trailing_end: str = "back_tension"
+    end_loads: dict = field(default_factory=lambda: {"leading": [], "trailing": []})
+    gravity_loads: tuple = ()
     _ode2_index: np.ndarray | None = field(default=None)
 
     def __repr__(self) -> str:
@@ -188,11 +195,129 @@ class CableInConduit:
             return self.applied_pull_force_N * self.load_factor(t)
         return self.leading_tension_N()
 
+    def loads(self, state: tuple | None = None) -> CableLoads:
+        """Every external force on the cable (see :func:`exucable.post.tension.equilibrium_tension`):
+        the contact forces at the check points, the weight, the inertia of a dynamic state, the
+        dampers' and the guide's nodal forces, and each end's force (the rig's or brake's
+        reaction, back tension or applied pull; None for an end joined to the user's own model).
+
+        ``state``: ``(t, q, v, a, reactions)`` — time [s], absolute coordinates, rates and
+        accelerations, each (n_el + 1, 6), and the drives' reactions (:meth:`drive_reactions_N`,
+        interpolated by the caller) — instead of the system's current state (a snapshot between
+        two steps). The contact forces are the kernel's at that state; at the current state of a
+        dynamic run they are those the solver applied, with the damping onset held at the step's
+        start value (:class:`exucable.contact.law.ContactLaw`), so that the loads balance.
+        """
+        mbs = self.mbs
+        sd = mbs.systemData
+        static = self.scenario.solver.mode == "steady"
+        if state is None:
+            q, v = self.coordinates()
+            t = float(sd.GetTime())
+            acc = None if static else np.asarray(sd.GetODE2Coordinates_tt())[self.ode2_index].reshape(-1, 6)
+        else:
+            t, q, v, acc, reactions = state
+            q, v = np.asarray(q, dtype=float).reshape(-1, 6), np.asarray(v, dtype=float).reshape(-1, 6)
+            acc = None if static or acc is None else np.asarray(acc, dtype=float).reshape(-1, 6)
+        Le = np.asarray(self.layout.element_length_m, dtype=float)
+        x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
+        if self.kernel is not None:
+            # a steady state's rates may be nan (unknown): its kernel takes them from q anyway
+            pts = self.kernel.points(q.reshape(-1), np.nan_to_num(v).reshape(-1))
+            point_x = x_nodes[pts.element] + pts.xi * Le[pts.element]
+            f_n, f_t = pts.normal_force_N, pts.friction_force_N
+            solved = getattr(self.coupling, "solved_onset", None)
+            if state is None and not static and solved is not None:
+                f_n, f_t = _with_held_onset(self.kernel, pts, solved)
+            point_f = check_point_forces_N(pts.normal, f_n, f_t, pts.velocity_m_per_s)
+        else:
+            point_x, point_f = np.zeros(0), np.zeros((0, 3))
+        g = np.asarray(mbs.GetLoadValues(self.gravity_loads[0]), dtype=float) if self.gravity_loads else np.zeros(3)
+        if state is not None and self.gravity_loads and self.scenario.pull.ramp_time_s > 0.0 and not static:
+            g = np.asarray(self.load_scale.vector(self.gravity_loads[0]), dtype=float) * self.load_factor(t)
+        q_rel = (q - self.layout.coordinates).reshape(-1)
+        nodal = np.zeros((len(q), 6))
+        if self.startup_damper is not None:
+            nodal += np.asarray(self.startup_damper.force(t, v.reshape(-1)), dtype=float).reshape(-1, 6)
+        if self.exit_span_damper is not None:
+            nodal += np.asarray(self.exit_span_damper.force(t, q_rel, v.reshape(-1)), dtype=float).reshape(-1, 6)
+        if self.guide is not None:
+            P = self._guide_projection()
+            k = self.guide.node_index
+            nodal[k, :3] += -self.guide.k * P @ q_rel.reshape(-1, 6)[k, :3] - self.guide.c * P @ v[k, :3]
+
+        def end_force(end: str, kind: str, drive):
+            if kind == "joined":
+                return None
+            if drive is not None and state is not None:
+                return reactions[end]
+            f = np.zeros(3)
+            for i in self.end_loads[end]:
+                if state is None:
+                    f += np.asarray(mbs.GetLoadValues(i), dtype=float)
+                else:   # the load at the snapshot's time: its vector times the ramp
+                    f += np.asarray(self.load_scale.vector(i), dtype=float) * (
+                        self.load_factor(t) if self.scenario.pull.ramp_time_s > 0.0 and not static else 1.0)
+            if drive is not None:
+                f += drive_force_vector_N(mbs, drive, static)
+            return f
+
+        return CableLoads(point_x_m=point_x, point_force_N=point_f, node_force_N=nodal[:, :3],
+                          line_load_N_per_m=self.properties.mass_per_length_kg_per_m * g,
+                          mass_per_length_kg_per_m=self.properties.mass_per_length_kg_per_m, acceleration=acc,
+                          trailing_force_N=end_force("trailing", self.trailing_end, self.trail_drive),
+                          leading_force_N=end_force("leading", self.leading_end, self.lead_drive))
+
+    def drive_reactions_N(self) -> dict:
+        """The force [N] of each end's drive (the rig or reel, the brake) on the cable now, as a
+        vector: ``{"leading": ..., "trailing": ...}``, None at an end without a drive."""
+        static = self.scenario.solver.mode == "steady"
+        return {end: None if d is None else drive_force_vector_N(self.mbs, d, static)
+                for end, d in (("leading", self.lead_drive), ("trailing", self.trail_drive))}
+
+    def _guide_projection(self) -> np.ndarray:
+        """I − d dᵀ of the guide's direction d (the exit tangent)."""
+        d = np.asarray(self.start.exit_tangent, dtype=float)
+        d = d / np.linalg.norm(d)
+        return np.eye(3) - np.outer(d, d)
+
+    def tension_N(self, x_m) -> np.ndarray:
+        """The cable's tension [N] at material stations ``x_m`` [m] from the trailing end, now: from
+        the equilibrium of its loads (:func:`exucable.post.tension.equilibrium_tension`, the
+        paper's Eq. 24 without the element's strain error), or EA·ε where neither end's force is
+        known (both ends joined to the user's own model)."""
+        q, _ = self.coordinates()
+        Le = self.layout.element_length_m
+        loads = self.loads()
+        if loads.trailing_force_N is None and loads.leading_force_N is None:
+            return tension_at(q, Le, self.axial_stiffness_N, x_m)
+        return equilibrium_tension(q, Le, loads, x_m)
+
     def trailing_reaction_N(self) -> float | None:
         """Brake force at the trailing end of a force-controlled pull [N] (None otherwise)."""
         if self.trail_drive is None:
             return None
         return -self.trail_drive.force_N(self.mbs)
+
+
+def _with_held_onset(kernel, pts, onset) -> tuple[np.ndarray, np.ndarray]:
+    """The check points' weighted normal and friction forces [N] with the damping onset g held at
+    ``onset`` (per point) instead of g(δ) of the state: f = w·max(0, Kδ^e + C·g·δ̇), the friction
+    scaled with f (it is μ·f times a function of the slip). A point that the held onset brings into
+    force from none gets no friction (its slip direction was not evaluated; a point leaving the
+    wall that fast carries a vanishing force)."""
+    law = kernel.law
+    delta = np.nan_to_num(np.asarray(pts.penetration_m, dtype=float), nan=-1.0)
+    n = np.nan_to_num(np.asarray(pts.normal, dtype=float))
+    rate = np.sum(n * np.asarray(pts.velocity_m_per_s, dtype=float), axis=1)
+    w = (kernel.element_length_m[:, None] * kernel.omega[None, :]).reshape(-1) / kernel.reference_spacing_m
+    touch = delta > 0.0
+    raw = np.where(touch, law.stiffness * np.maximum(delta, 0.0) ** law.exponent
+                   + law.damping * np.asarray(onset, dtype=float).reshape(-1) * rate, 0.0)
+    f_held = w * np.maximum(raw, 0.0)
+    f_now = np.asarray(pts.normal_force_N, dtype=float)
+    scale = np.divide(f_held, f_now, out=np.zeros_like(f_held), where=f_now > 0.0)
+    return f_held, np.asarray(pts.friction_force_N, dtype=float) * scale
 
 
 class LoadScale:
@@ -213,6 +338,10 @@ class LoadScale:
             self._gravity_loads.append((i, vectors[i]))
         for i in end_loads:
             self._end_loads.append((i, vectors[i]))
+
+    def vector(self, load: int) -> list:
+        """The unscaled vector of a tracked load (Exudyn load index ``load``)."""
+        return dict(self._gravity_loads + self._end_loads)[load]
 
     def apply(self, mbs, gravity: float, end_force: float) -> None:
         """Set the factors and rewrite the loads' vectors."""
@@ -342,6 +471,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         gravity_vector = [0.0, 0.0, -g]
         loads = add_gravity(mbs, cable, gravity_vector, factor)
         h.load_scale.track(gravity_loads=loads, vectors={i: gravity_vector for i in loads})
+        h.gravity_loads = tuple(loads)
     speed = sc.pull.speed_m_per_s
     rig_speed = 0.0 if steady else speed
     t_exit, t_entry = start.exit_tangent, start.entry_tangent
@@ -350,6 +480,10 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         vec = list(vec)
         i = add_end_force(mbs, node, vec, factor)
         h.load_scale.track(end_loads=[i], vectors={i: vec})
+        h.end_loads["leading" if node == lead_node else "trailing"].append(i)
+
+    h.leading_end = leading if isinstance(leading, str) else "reel" if isinstance(leading, ReelOnto) else "joined"
+    h.trailing_end = trailing if isinstance(trailing, str) else "joined"
 
     if leading == "rig":
         h.lead_drive = add_drive(mbs, lead_node, t_exit, rig_speed, ramp_time)

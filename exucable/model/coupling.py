@@ -41,6 +41,8 @@ class ContactCoupling:
         Kernel passes made by :meth:`start_step` (its state was not the last pass's).
     held_onset : ndarray or None
         The damping onset g [-] per check point, held within the current step.
+    solved_onset : ndarray or None
+        The onset the last accepted step was solved with (the one before :attr:`held_onset`).
     jacobian_with_force : bool
         Compute the Jacobian blocks already in the force call (default; False: only when asked,
         two kernel passes per Newton iteration, for the benchmarks' comparison).
@@ -73,6 +75,7 @@ class ContactCoupling:
         # the damping onset g per check point, held within a step at its value in the step's
         # start state (ContactLaw's notes); None before the first start_step
         self.held_onset = None
+        self.solved_onset = None
         self.onset_evaluations = 0
 
     def start_step(self, mbs, t):
@@ -93,6 +96,8 @@ class ContactCoupling:
         else:
             res = self._evaluate(t, qa, va, jacobian=False)
             self.onset_evaluations += 1
+        # the onset the state just accepted was solved with (its loads' balance needs it)
+        self.solved_onset = self.held_onset
         self.held_onset = self.kernel.damping_onset(res.penetration_m)
         self._last = None  # evaluated with the onset held before
 

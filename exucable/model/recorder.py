@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..post.tension import detect_steady_state, tension_at, tension_profile
+from ..post.tension import detect_steady_state, profile_stations_m
 from ..post.trust import AxisGauge, cable_sample_points
 
 __all__ = ["History", "Recorder", "earliest_steady_s", "expected_drift_N_per_s", "record_state", "steady_quantity"]
@@ -58,23 +58,28 @@ def expected_drift_N_per_s(cable) -> float:
 
 
 def record_state(cable, t: float, history: History, gauge: AxisGauge | None = None) -> None:
-    """Append the current pulling force, trailing tension and maximum tension to ``history``, and
+    """Append the current pulling force, trailing tension and maximum tension (from the equilibrium
+    of the cable's loads, :meth:`exucable.model.build.CableInConduit.tension_N`) to ``history``, and
     (with a contact kernel) the largest penetration [m] and the cable axis's largest distance from
     the conduit's axis [m] with its place s [m] along the scenario's conduit (``gauge``:
     :class:`exucable.post.trust.AxisGauge` of the pull-oriented conduit)."""
     q, v = cable.coordinates()
-    EA = cable.axial_stiffness_N
-    _, N = tension_profile(q, cable.layout.element_length_m, EA, points_per_element=2)
+    # the tension from the equilibrium of the cable's loads, at the tension profile's stations
+    # (exucable.post.tension.equilibrium_tension; EA·ε spikes next to the bend ends' point loads)
+    N = cable.tension_N(profile_stations_m(cable.layout.element_length_m))
     trail = cable.trailing_reaction_N()
     if trail is None:
-        trail = float(tension_at(q, cable.layout.element_length_m, EA, [0.0])[0])
+        trail = float(N[0])
     history.time_s.append(float(t))
     history.pull_force_N.append(cable.pull_force_N(t))
     history.trailing_tension_N.append(float(trail))
     history.max_tension_N.append(float(np.max(N)))
     pen = offset = s_off = float("nan")
     if cable.kernel is not None:
-        pen = float(cable.kernel.evaluate(q.reshape(-1), v.reshape(-1)).max_penetration_m)
+        # the tension's contact pass at this state (kept by the kernel) has every point's δ
+        delta = cable.kernel.points(q.reshape(-1), v.reshape(-1)).penetration_m
+        found = np.isfinite(delta)
+        pen = float(np.max(delta[found])) if found.any() else -np.inf
         if gauge is not None:
             d, s = gauge(cable_sample_points(q, cable.layout.element_length_m))
             # beyond the conduit's ends the cable is free (feed, pulling line): not the wall's business

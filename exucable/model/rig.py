@@ -19,7 +19,7 @@ from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, MarkerN
                                   ObjectConnectorCoordinateVector)
 
 __all__ = ["Drive", "Guide", "add_guide", "add_reel", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
-           "smooth_ramp", "ramped_displacement"]
+           "smooth_ramp", "ramped_displacement", "drive_force_vector_N"]
 
 
 def smooth_ramp(t: float, ramp_time_s: float) -> float:
@@ -57,6 +57,17 @@ class Drive:
     def force_N(self, mbs) -> float:
         lam = np.array([mbs.GetObjectOutput(c, exu.OutputVariableType.Force) for c in self.constraints])
         return float(self.sign * (lam @ self.direction))
+
+
+def drive_force_vector_N(mbs, drive, static: bool = False) -> np.ndarray:
+    """The force [N] a :class:`Drive` or :class:`TangentialDrive` exerts on its node, as a vector:
+    the multipliers of all three coordinates (the lateral ones hold the end on the rig's line).
+    ``static``: the static solver's multipliers carry the opposite sign of the dynamic solver's."""
+    flip = -1.0 if static else 1.0
+    if isinstance(drive, TangentialDrive):
+        return flip * drive.force_N(mbs) * drive.direction
+    lam = np.array([mbs.GetObjectOutput(c, exu.OutputVariableType.Force) for c in drive.constraints], dtype=float)
+    return flip * drive.sign * lam
 
 
 def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: float = 0.0) -> Drive:

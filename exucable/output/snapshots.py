@@ -9,11 +9,12 @@ values):
     h00 = 2s³ − 3s² + 1, h10 = s³ − 2s² + s, h01 = −2s³ + 3s², h11 = s³ − s²,
 
 and q̇(t) its time derivative (error O(Δt⁴) in q, O(Δt³) in q̇; exact when t is a step end).
-Every quantity of the snapshot is then evaluated at that state: tension N = EA·ε (paper Eq. 24)
-at ξ = 0, ¼, ½, ¾, 1 of every element (both ends, so the jump of N between elements, the mesh's
-own error, is visible), the contact forces by the kernel (Eqs. 14-23), so a reader that
-evaluates the contact law at the snapshot's nodal state gets the same forces to round-off.
-The pulling force (a Lagrange multiplier, known only at step ends) is interpolated linearly.
+Every quantity of the snapshot is then evaluated at that state: the tension N (paper Eq. 24) at
+ξ = 0, ¼, ½, ¾, 1 of every element, from the equilibrium of the cable's loads at that state
+(:func:`exucable.post.tension.equilibrium_tension`: the contact forces, weight and inertia, the
+accelerations and the drives' reactions interpolated linearly between the step ends), the contact forces by the kernel (Eqs. 14-23), so a reader that evaluates the
+contact law at the snapshot's nodal state gets the same forces to round-off. The pulling force (a
+Lagrange multiplier, known only at step ends) is interpolated linearly.
 
 A steady solve (``solver.mode = "steady"``) has no time: its one state is written as one snapshot
 at ``time_s = 0`` (:meth:`SnapshotRecorder.record_steady_state`), whose ``vel_*`` columns are the
@@ -38,7 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from .formats import SNAPSHOT_FILES
-from ..post.tension import hermite_derivative_weights
+from ..post.tension import equilibrium_tension, tension_at
 
 __all__ = ["SnapshotRecorder", "SNAPSHOT_FILES", "TENSION_XI", "hermite_in_time"]
 
@@ -75,10 +76,17 @@ class SnapshotRecorder:
         self.pending = [float(t) for t in sorted(times_s)]
         self.rows = {name: {c: [] for c in cols} for name, cols in SNAPSHOT_FILES.items()}
         q, v = model.coordinates()
-        self._prev = (0.0, q, v, float("nan"))
+        a = self._accelerations()
+        r = model.drive_reactions_N()
+        self._prev = (0.0, q, v, float("nan"), a, r)
         if self.pending and self.pending[0] <= 0.0:
-            self._record(0.0, q, v, (0.0, 0.0), float("nan"))
+            self._record(0.0, q, v, (0.0, 0.0), float("nan"), a, r)
             self.pending.pop(0)
+
+    def _accelerations(self) -> np.ndarray:
+        """The solver's nodal accelerations of the cable now, (n_el + 1, 6)."""
+        m = self.model
+        return np.asarray(m.mbs.systemData.GetODE2Coordinates_tt())[m.ode2_index].reshape(-1, 6)
 
     @property
     def recorded_s(self) -> list[float]:
@@ -89,14 +97,17 @@ class SnapshotRecorder:
         if not self.pending:
             return
         q, v = self.model.coordinates()
-        t0, q0, v0, f0 = self._prev
+        a = self._accelerations()
+        r = self.model.drive_reactions_N()
+        t0, q0, v0, f0, a0, r0 = self._prev
         while self.pending and self.pending[0] <= t + 1e-12 * max(1.0, t):
             tk = self.pending.pop(0)
             qk, vk = hermite_in_time(min(tk, t), t0, q0, v0, t, q, v)
             frac = 1.0 if t <= t0 else (min(tk, t) - t0) / (t - t0)
             f = pull_force_N if frac == 1.0 else f0 + frac * (pull_force_N - f0)
-            self._record(tk, qk, vk, (t0, t), f)
-        self._prev = (t, q, v, pull_force_N)
+            rk = {end: None if r[end] is None else r0[end] + frac * (r[end] - r0[end]) for end in r}
+            self._record(tk, qk, vk, (t0, t), f, a0 + frac * (a - a0), rk)
+        self._prev = (t, q, v, pull_force_N, a, r)
 
     def record_steady_state(self, pull_force_N: float) -> None:
         """Record the model's current state as the steady state: one snapshot at time 0 [s] with
@@ -111,7 +122,9 @@ class SnapshotRecorder:
         for c, v in columns.items():
             self.rows[name][c].extend(np.broadcast_to(np.asarray(v), (n,)).tolist())
 
-    def _record(self, t, q, v, step, pull_force_N):
+    def _record(self, t, q, v, step, pull_force_N, a=None, reactions=None):
+        """One snapshot of state (t, q, v); ``a`` the nodal accelerations (None: a static state) and
+        ``reactions`` the drives' forces at t (:meth:`Model.drive_reactions_N`; None: the model's now)."""
         m = self.model
         lay = m.layout
         Le = np.asarray(lay.element_length_m, dtype=float)
@@ -126,14 +139,14 @@ class SnapshotRecorder:
             nodes[f"slope_rate_{c}_1_per_s"] = v[:, 3 + k]
         self._append("snapshot_nodes.csv", **nodes)
         xi = np.asarray(TENSION_XI)
-        xi_e, L_e = np.broadcast_arrays(xi[None, :], Le[:, None])
-        w = hermite_derivative_weights(xi_e, L_e)                          # (n_el, m, 4)
-        d = (w[..., 0, None] * q[:-1, None, :3] + w[..., 1, None] * q[:-1, None, 3:]
-             + w[..., 2, None] * q[1:, None, :3] + w[..., 3, None] * q[1:, None, 3:])
-        N = m.axial_stiffness_N * (np.linalg.norm(d, axis=2) - 1.0)
+        x = (lay.node_x_m[:-1, None] + xi[None, :] * Le[:, None]).ravel()
+        loads = m.loads(state=(t, q, v, a, m.drive_reactions_N() if reactions is None else reactions))
+        if loads.trailing_force_N is None and loads.leading_force_N is None:
+            N = tension_at(q, Le, m.axial_stiffness_N, x)     # both ends held by reactions
+        else:
+            N = equilibrium_tension(q, Le, loads, x)
         self._append("snapshot_tension.csv", time_s=t, element=np.repeat(np.arange(n_el), len(xi)),
-                     xi=np.tile(xi, n_el), x_m=(lay.node_x_m[:-1, None] + xi[None, :] * Le[:, None]).ravel(),
-                     tension_N=N.ravel())
+                     xi=np.tile(xi, n_el), x_m=x, tension_N=N)
         if m.kernel is None:
             return
         # the steady kernel takes its velocities from q; nan rates must not reach the dynamic one

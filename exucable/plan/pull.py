@@ -344,7 +344,7 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     """One direction's plan entry from the multibody model, the rope's values kept beside.
 
     The scenario is run in ``engine``'s solver mode with ``pull.direction = name`` (the reverse pull is
-    the reversed route). Section tensions are the cable's tension (EA·ε at its nodes) interpolated at
+    the reversed route). Section tensions are the cable's tension (from its loads' equilibrium, at its nodes) interpolated at
     the section boundaries along the conduit (``s_conduit_m``); a bend's SWBP is the peak of the
     windowed sidewall pressure over the bend (:mod:`exucable.post.pressure`: the contact forces of the check
     points within ±w/2, over w), with the bend body's mean windowed pressure and the point loads at

@@ -84,7 +84,7 @@ def plot_tension_profile(path, result) -> None:
     p = result.tension_profile
     fig = new_figure(figsize=(7, 4))
     ax = fig.subplots()
-    ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N = EA·ε)")
+    ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N from the equilibrium of its loads)")
     rp = result.rope_profile
     if rp is not None and "x_m" in result.extras:
         ax.plot(result.extras["x_m"], rp["tension_N"], "k--", lw=1, label="rope reference")

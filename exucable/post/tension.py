@@ -1,9 +1,10 @@
-"""Tension post-processing (paper Sect. 2.6, Eq. 24: N = EA·ε) and the steady-state detector.
+"""Tension post-processing (paper Sect. 2.6, Eq. 24) and the steady-state detector.
 
 Pure numpy on nodal coordinates, so the same code serves live recording during a run and
-post-processing of saved states; a test checks it against Exudyn's own ``ForceLocal`` output.
-The strain is the ANCF cable's axial strain ε = |r'(x)| − 1 (paper Eq. 11), r' = ∂r/∂x along the
-unstretched (material) coordinate x.
+post-processing of saved states. Two readings of the axial force: N = EA·ε of the ANCF cable's axial
+strain ε = |r'(x)| − 1 (paper Eq. 11; r' = ∂r/∂x along the unstretched, material coordinate x; a test
+checks it against Exudyn's own ``ForceLocal`` output), and :func:`equilibrium_tension`, the one the
+results report, from the balance of the cable's loads (EA·ε spikes next to the point loads at bend ends).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["axial_strain", "tension_at", "tension_profile", "profile_stations_m", "TensionStations", "SteadyState",
+           "CableLoads", "equilibrium_tension", "load_imbalance_N", "check_point_forces_N", "hermite_integral_weights",
            "detect_steady_state", "hermite_derivative_weights"]
 
 
@@ -182,3 +184,153 @@ def detect_steady_state(time_s, force_N, min_window_s: float, rel_tolerance: flo
             stats = st
         step //= 2
     return SteadyState(True, float(t[lo]), *stats)
+
+
+def hermite_integral_weights(xi: np.ndarray, length_m: np.ndarray) -> np.ndarray:
+    """Weights of [r_i, r'_i, r_j, r'_j] in ∫₀^{ξL} r dx, the integral of the position from the
+    element's start to element coordinate ξ ∈ [0, 1] (antiderivatives of N1…N4 of
+    :func:`hermite_derivative_weights`, times L). Shape (m, 4) [m, m²]."""
+    xi = np.asarray(xi, dtype=float)
+    L = np.asarray(length_m, dtype=float)
+    return np.stack([L * (xi - xi**3 + 0.5 * xi**4), L * L * (0.5 * xi**2 - 2.0 / 3.0 * xi**3 + 0.25 * xi**4),
+                     L * (xi**3 - 0.5 * xi**4), L * L * (-xi**3 / 3.0 + 0.25 * xi**4)], axis=-1)
+
+
+@dataclass(frozen=True)
+class CableLoads:
+    """Every external force on a cable at one state, for :func:`equilibrium_tension`.
+
+    Attributes
+    ----------
+    point_x_m : ndarray (p,)
+        Material coordinates of concentrated loads (the contact check points) [m].
+    point_force_N : ndarray (p, 3)
+        Their forces on the cable [N] (contact normal force and friction).
+    node_force_N : ndarray (n_el + 1, 3)
+        Forces on the nodes' positions [N] (dampers, a guide), zeros when none.
+    line_load_N_per_m : ndarray (3,)
+        A uniform load per unit of material length [N/m] (the weight ρA·g).
+    mass_per_length_kg_per_m : float
+        ρA [kg/m], for the inertia −ρA·r̈ of ``acceleration``.
+    acceleration : ndarray (n_el + 1, 6) or None
+        Nodal accelerations [m/s², 1/s²] (None: a static state).
+    trailing_force_N, leading_force_N : ndarray (3,) or None
+        The force on the cable's trailing (x = 0) and leading (x = L) end [N] (back tension, the
+        rig's reaction); None where the end's force is not known.
+    """
+
+    point_x_m: np.ndarray
+    point_force_N: np.ndarray
+    node_force_N: np.ndarray
+    line_load_N_per_m: np.ndarray
+    mass_per_length_kg_per_m: float
+    acceleration: np.ndarray | None
+    trailing_force_N: np.ndarray | None
+    leading_force_N: np.ndarray | None
+
+
+def _loads_up_to(loads: CableLoads, element_length_m, x_m) -> np.ndarray:
+    """G(x): the resultant [N] of every load on the material [0, x] but the ends' forces, shape (m, 3)."""
+    Le = np.asarray(element_length_m, dtype=float)
+    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
+    x = np.asarray(x_m, dtype=float)
+    # concentrated loads at x_p <= x, summed in order of x_p
+    order = np.argsort(loads.point_x_m, kind="stable")
+    cum = np.vstack([np.zeros((1, 3)), np.cumsum(loads.point_force_N[order], axis=0)])
+    G = cum[np.searchsorted(loads.point_x_m[order], x, side="right")]
+    node_cum = np.vstack([np.zeros((1, 3)), np.cumsum(loads.node_force_N, axis=0)])
+    G = G + node_cum[np.searchsorted(x_nodes, x, side="right")]
+    G = G + np.clip(x, 0.0, x_nodes[-1])[:, None] * np.asarray(loads.line_load_N_per_m, dtype=float)[None, :]
+    if loads.acceleration is not None:
+        # −ρA ∫₀ˣ r̈ dx: whole elements before x, then the part of x's own element (cubic Hermite, exact)
+        a = np.asarray(loads.acceleration, dtype=float)
+        whole = hermite_integral_weights(np.ones(len(Le)), Le)
+        per_element = (whole[:, 0, None] * a[:-1, :3] + whole[:, 1, None] * a[:-1, 3:]
+                       + whole[:, 2, None] * a[1:, :3] + whole[:, 3, None] * a[1:, 3:])
+        before = np.vstack([np.zeros((1, 3)), np.cumsum(per_element, axis=0)])
+        e, xi = _locate(x, Le)
+        w = hermite_integral_weights(xi, Le[e])
+        part = (w[:, 0, None] * a[e, :3] + w[:, 1, None] * a[e, 3:] + w[:, 2, None] * a[e + 1, :3]
+                + w[:, 3, None] * a[e + 1, 3:])
+        G = G - loads.mass_per_length_kg_per_m * (before[e] + part)
+    return G
+
+
+def load_imbalance_N(loads: CableLoads, element_length_m) -> np.ndarray | None:
+    """The sum [N] of every force on the cable, inertia included (0 in equilibrium; None when an
+    end's force is unknown): what a solve's tolerance and the dynamic run's step leave."""
+    if loads.trailing_force_N is None or loads.leading_force_N is None:
+        return None
+    total = _loads_up_to(loads, element_length_m, [float(np.sum(element_length_m))])[0]
+    return total + np.asarray(loads.trailing_force_N) + np.asarray(loads.leading_force_N)
+
+
+def equilibrium_tension(coordinates, element_length_m, loads: CableLoads, x_m) -> np.ndarray:
+    """Axial force N(x) [N] from the equilibrium of the cable's external loads: N = t(x)·F(x).
+
+    The paper's Eq. 24 reads N = EA·ε off the ANCF cable's strain. Next to a concentrated contact
+    load (a stiff cable landing on a bend's end) that strain oscillates along the element: the
+    cubic Hermite element (paper Eqs. 5-6) cannot bend and keep |r'| smooth at once, and Exudyn's
+    reduced (Lobatto) quadrature ties ε down at three points per element only, so EA·ε between
+    and even at them carries the element's error (CommScope A–H, steady: −99…416 N at a pull of
+    291 N; read at the Lobatto points alone it stays within 0…290.4 N but is up to 6.5 N off the
+    loads' balance, 11.4 N at half the elements). The internal force F(x) of the cut at x instead
+    follows exactly from the loads on either side: from the trailing end F = −F_trail − G(x),
+    from the leading end F = F_lead + G(L) − G(x), G(x) the resultant of the loads on [0, x]
+    (contact forces at the check points, weight, inertia −ρA·r̈, nodal dampers). Its tangential
+    part t·F, t = r'/|r'|, is the tension; it jumps only where a check point's friction acts (and
+    where a stiff cable lands on the wall at an angle, the normal force having a part along it),
+    and converges to the continuum's axial force as the mesh is refined (reference/README.md,
+    "The tension profile"). With both ends' forces known the two are
+    blended linearly in x, so that N meets both ends' forces exactly (their difference is the
+    solve's residual, :func:`load_imbalance_N`); with one, that one is used.
+
+    Parameters
+    ----------
+    coordinates : array_like (n_el + 1, 6)
+        Absolute nodal coordinates [m, -].
+    element_length_m : array_like (n_el,)
+        Unstretched element lengths [m].
+    loads : CableLoads
+        The loads at this state; at least one end's force must be known.
+    x_m : array_like (m,)
+        Stations along the cable from the trailing end [m].
+    """
+    if loads.trailing_force_N is None and loads.leading_force_N is None:
+        raise ValueError("equilibrium_tension needs the force on at least one end of the cable")
+    Le = np.asarray(element_length_m, dtype=float)
+    length = float(np.sum(Le))
+    x = np.clip(np.asarray(x_m, dtype=float), 0.0, length)
+    G = _loads_up_to(loads, Le, np.append(x, length))     # the stations', then all the loads'
+    G, total = G[:-1], G[-1]
+    if loads.leading_force_N is not None:
+        from_lead = np.asarray(loads.leading_force_N, dtype=float)[None, :] + total[None, :] - G
+    if loads.trailing_force_N is not None:
+        from_trail = -np.asarray(loads.trailing_force_N, dtype=float)[None, :] - G
+    if loads.leading_force_N is None:
+        F = from_trail
+    elif loads.trailing_force_N is None:
+        F = from_lead
+    else:
+        w = (x / length)[:, None]
+        F = (1.0 - w) * from_trail + w * from_lead
+    q = np.asarray(coordinates, dtype=float).reshape(-1, 6)
+    e, xi = _locate(x, Le)
+    wd = hermite_derivative_weights(xi, Le[e])
+    d = wd[:, 0, None] * q[e, :3] + wd[:, 1, None] * q[e, 3:] + wd[:, 2, None] * q[e + 1, :3] + wd[:, 3, None] * q[e + 1, 3:]
+    t = d / np.linalg.norm(d, axis=1)[:, None]
+    return np.sum(t * F, axis=1)
+
+
+def check_point_forces_N(normal, normal_force_N, friction_force_N, velocity_m_per_s) -> np.ndarray:
+    """Each check point's force on the cable [N], shape (n, 3), from the kernel's per-point state
+    (:meth:`exucable.contact.ContactKernel.points`): −w·f_n·n minus the friction along the sliding
+    direction v_τ/|v_τ|, v_τ = v − (v·n)n (paper Eqs. 17-23). Σ_k S(ξ_k)ᵀ F_k is the kernel's
+    generalized force; points out of contact (no force, NaN normal) give 0."""
+    n = np.nan_to_num(np.asarray(normal, dtype=float))
+    v = np.asarray(velocity_m_per_s, dtype=float)
+    tau = v - np.sum(v * n, axis=1)[:, None] * n
+    slip = np.linalg.norm(tau, axis=1)
+    along = np.divide(tau, slip[:, None], out=np.zeros_like(tau), where=slip[:, None] > 0.0)
+    return (-np.asarray(normal_force_N, dtype=float)[:, None] * n
+            - np.asarray(friction_force_N, dtype=float)[:, None] * along)
