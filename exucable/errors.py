@@ -1,7 +1,7 @@
 """Error types. User errors (bad input) derive from :class:`ExucableError`; the CLI
 prints their message without a traceback and exits with status 2."""
 
-__all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError"]
+__all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError", "LogError"]
 
 
 class ExucableError(Exception):
@@ -54,3 +54,16 @@ class SolverError(ExucableError):
     def __init__(self, message: str, time_s: float | None = None):
         self.time_s = time_s
         super().__init__(message if time_s is None else f"{message} (at simulated time t = {time_s:.6g} s)")
+
+
+class LogError(ExucableError):
+    """A tension recorder's log cannot be read or fitted (``exucable fit``).
+
+    ``key`` names the offending column, row or flag, e.g. ``"column 'tension'"``, ``"row 12"`` or
+    ``"--tare"``.
+    """
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        self.message = message
+        super().__init__(f"{key}: {message}" if key else message)

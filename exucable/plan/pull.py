@@ -39,7 +39,8 @@ from exucable.scenario.specs import Scenario, load_scenario, parse_scenario
 from exucable.post.trust import TRUSTED_STATUSES
 from exucable.scenario.units import SYSTEMS
 
-__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES"]
+__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "pull_in_rope",
+           "ENGINES"]
 
 ENGINES = ("rope", "steady", "dynamic")
 
@@ -189,6 +190,42 @@ def _pull_in_history(curve: Centreline, rope, n: int = 201) -> dict:
     grid = np.unique(np.concatenate([np.linspace(0.0, L, n), [p.s_end_m for p in curve.pieces]]))
     grid = np.clip(grid, 0.0, rope.cable_length_m)
     return {"pulled_length_m": grid.tolist(), "pull_force_N": np.asarray(rope.tension_at(grid)).tolist()}
+
+
+def pull_in_rope(scenario: Scenario, spec: PlanSpec, direction: str = "forward", friction: float | None = None,
+                 bend_friction: float | None = None):
+    """The rope of a full pull in ``direction`` with plan's conventions, whose tension profile is the
+    pull-in history (see :func:`_pull_in_history`).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    spec : PlanSpec
+        Number of cables and arrangement (weight correction factor w_c, which multiplies the friction
+        on straights, and in bends with ``spec.weight_correction_in_bends``).
+    direction : {"forward", "reverse"}
+    friction : float, optional
+        Friction coefficient μ [-] (default ``contact.friction``).
+    bend_friction : float, optional
+        A separate μ [-] for bends and helices (default: ``friction``).
+
+    Returns
+    -------
+    exucable.quasistatic.rope.RopeSolution
+        ``tension_at(x)`` is the head tension [N] with the head x metres into the conduit.
+    """
+    d = 2.0 * scenario.cable.radius_m
+    D = 2.0 * scenario.conduit.inner_radius_m
+    arrangement = eng.auto_arrangement(spec.count, D, d) if spec.arrangement == "auto" else spec.arrangement
+    wc = eng.weight_correction_factor(spec.count, arrangement, D, d)
+    mu = scenario.contact.friction if friction is None else float(friction)
+    g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
+    w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
+    mu_b = mu if bend_friction is None else float(bend_friction)
+    # in bends: w_c μ (IEEE 1185, AEIC CG5, Polywater) or μ (SEC TES-P-104.05's worked example)
+    mu_bend = wc * mu_b if spec.weight_correction_in_bends else mu_b
+    return solve_rope(scenario.build_conduit().centreline, wc * mu, w_total, scenario.pull.back_tension_N,
+                      direction, bend_friction=mu_bend)
 
 
 def _check(name, value, limit, where, quantity, lower_is_better=True) -> dict:
@@ -364,16 +401,13 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     clearance = eng.clearance_m(spec.count, arrangement, D, d)
     g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
     w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
-    mu_eff = wc * scenario.contact.friction
-    # in bends: w_c μ (IEEE 1185, AEIC CG5, Polywater) or μ (SEC TES-P-104.05's worked example)
-    mu_bend = None if spec.weight_correction_in_bends else scenario.contact.friction
     back = scenario.pull.back_tension_N
     centreline = scenario.build_conduit().centreline
 
     directions = {}
     for name in ("forward", "reverse"):
         curve = centreline if name == "forward" else centreline.reversed()
-        rope = solve_rope(centreline, mu_eff, w_total, back, name, bend_friction=mu_bend)
+        rope = pull_in_rope(scenario, spec, name)
         rows = _sections(curve, rope, w_total, swbp_factor)
         bends = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
         entry = {
