@@ -35,11 +35,12 @@ from exucable.plan.pull import PlanSpec, plan_spec, pull_in_rope
 from exucable.quasistatic import engineering as eng
 from exucable.scenario.specs import Scenario
 
-__all__ = ["FrictionFit", "RopeFamily", "fit_friction", "block_length", "GRID_STEP", "ONE_COEFFICIENT_P", "CONFIDENCE"]
+__all__ = ["FrictionFit", "RopeFamily", "fit_friction", "block_length", "GRID_STEP", "FINE_BELOW", "ONE_COEFFICIENT_P", "CONFIDENCE"]
 
-#: Step of the μ grid on which the rope is solved [-]; between, a cubic spline in μ (relative error of the
-#: interpolated history < 1e-6 against a direct solve on the industry routes, tests/test_fit.py).
+#: Step of the μ grid on which the rope is solved [-], a fifth of it below :data:`FINE_BELOW`; between, a
+#: cubic spline in μ (error of the interpolated history against a direct solve: tests/test_fit.py).
 GRID_STEP = 0.025
+FINE_BELOW = 0.1
 #: Below this p-value the halves' coefficients differ by more than the log's noise explains.
 ONE_COEFFICIENT_P = 0.01
 #: Confidence of the reported intervals.
@@ -163,8 +164,12 @@ class RopeFamily:
         self.spec = spec or plan_spec(scenario)
         self.direction = direction or scenario.pull.direction
         self.mu_max = float(mu_max)
-        nodes = np.arange(0.0, mu_max + 0.5 * GRID_STEP, GRID_STEP)
-        self.nodes = nodes if nodes[-1] >= mu_max else np.append(nodes, mu_max)
+        # finer below FINE_BELOW: there the wall's load turns from the weight to T/R as μ grows, a bend
+        # within a step of μ
+        fine = np.arange(0.0, min(FINE_BELOW, mu_max), GRID_STEP / 5)
+        coarse = np.arange(fine[-1] + GRID_STEP / 5, mu_max + 0.5 * GRID_STEP, GRID_STEP)
+        nodes = np.concatenate([fine, coarse[coarse <= mu_max + 1e-12]])
+        self.nodes = nodes if nodes[-1] >= mu_max - 1e-12 else np.append(nodes, mu_max)
         self.ropes = [pull_in_rope(scenario, self.spec, self.direction, friction=float(mu)) for mu in self.nodes]
         self.route_length_m = float(self.ropes[0].cable_length_m)
         d = 2.0 * scenario.cable.radius_m

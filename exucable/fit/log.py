@@ -19,7 +19,8 @@ Cleaning, in this order, each reported in :attr:`PullLog.report`:
   describe) are left out of the fit (``stops``);
 - *spikes*: moving rows further than ``spike_threshold`` robust standard deviations (1.4826 × the median
   absolute deviation) from their running median over :data:`SPIKE_WINDOW` rows (a Hampel filter: a
-  snatch of the line, a breakaway after a stop, a logger glitch) are left out of the fit (``spikes``).
+  snatch of the line, a breakaway after a stop, a logger glitch), and than ``spike_threshold`` times the
+  median step between readings, are left out of the fit (``spikes``).
 """
 
 from __future__ import annotations
@@ -275,8 +276,10 @@ def parse_pull_log(text: str, *, length_column=None, force_column=None, time_col
         y = force[idx]
         r = y - median_filter(y, size=SPIKE_WINDOW, mode="nearest")
         scale = 1.4826 * float(np.median(np.abs(r - np.median(r))))
-        # a floor for noiseless logs, where the running median's corner at a bend is no spike
-        limit = max(spike_threshold * scale, 1e-3 * float(np.max(np.abs(y))))
+        # floors for nearly noiseless logs, where the running median lags a steep rise by a step or two:
+        # a spike must also stand out by the threshold in typical steps between readings
+        step = float(np.median(np.abs(np.diff(y))))
+        limit = max(spike_threshold * scale, spike_threshold * step, 1e-3 * float(np.max(np.abs(y))))
         spike[idx[np.abs(r) > limit]] = True
     used = moving & ~spike
 
