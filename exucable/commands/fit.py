@@ -46,6 +46,9 @@ def add_arguments(p) -> None:
     p.add_argument("--bootstrap", type=int, default=999, help="bootstrap resamples for the interval (default 999)")
     p.add_argument("--interval", choices=tuple(RESAMPLERS), default="block",
                    help="how residuals are resampled: circular blocks (default) or an AR sieve")
+    p.add_argument("--separate", action="store_true",
+                   help="also fit one friction for straights and one for bends, with a check that the log can tell "
+                        "them apart")
     p.add_argument("--seed", type=int, default=0, help="seed of the resampling (default 0)")
     p.add_argument("--units", choices=SYSTEMS, default=None,
                    help="units of the printed values and figures (default: the scenario's display.units)")
@@ -117,6 +120,16 @@ def _print_fit(fit, units: str) -> None:
         verdict = "explains the log" if one["explains"] else "does NOT explain the log"
         print(f"one coefficient {verdict}: halves (split at {_q(one['split_pulled_length_m'], 'length', units)}) "
               f"{one['first_half_friction']:.4f} and {one['second_half_friction']:.4f}, p = {one['p_value']:.3g}")
+    sb = fit.straights_and_bends
+    if sb is not None:
+        if "friction_straights_interval" in sb:
+            (a, b), (c, d) = sb["friction_straights_interval"], sb["friction_bends_interval"]
+            print(f"straights {sb['friction_straights']:.4f} [{a:.4f}, {b:.4f}], bends {sb['friction_bends']:.4f} "
+                  f"[{c:.4f}, {d:.4f}], correlation {sb['correlation']:+.2f}: "
+                  + ("told apart, " + ("they differ" if sb["differ"] else "no difference shown") if sb["separable"]
+                     else sb["reason"]))
+        else:
+            print(f"straights and bends: {sb['reason']}")
     e = fit.expected
     word = "forecast" if fit.partial else "at the fitted friction"
     if fit.partial:
@@ -156,7 +169,7 @@ def main(args) -> int:
 
     def fit_once(log):
         return fit_friction(scenario, log, family=family, bootstrap=args.bootstrap, seed=args.seed,
-                            method=args.interval)
+                            method=args.interval, separate=args.separate)
 
     if not args.watch:
         fit = fit_once(read_pull_log(args.log, **read_kwargs))

@@ -35,7 +35,7 @@ from exucable.plan.pull import PlanSpec, plan_spec, pull_in_rope
 from exucable.quasistatic import engineering as eng
 from exucable.scenario.specs import Scenario
 
-__all__ = ["FrictionFit", "RopeFamily", "fit_friction", "block_length", "GRID_STEP", "FINE_BELOW", "ONE_COEFFICIENT_P", "CONFIDENCE"]
+__all__ = ["FrictionFit", "RopeFamily", "fit_friction", "SEPARABLE_CORRELATION", "SEPARABLE_HALF_WIDTH", "block_length", "GRID_STEP", "FINE_BELOW", "ONE_COEFFICIENT_P", "CONFIDENCE"]
 
 #: Step of the μ grid on which the rope is solved [-], a fifth of it below :data:`FINE_BELOW`; between, a
 #: cubic spline in μ (error of the interpolated history against a direct solve: tests/test_fit.py).
@@ -245,6 +245,12 @@ class FrictionFit:
         (each ``*_N`` / ``*_N_per_m`` with ``*_interval_*``), and per given limit, where it would be reached.
     log : dict
         The log's cleaning report (:attr:`exucable.fit.log.PullLog.report`) and rows beyond the route.
+    warnings : list of str
+    straights_and_bends : dict or None
+        With ``separate``: ``friction_straights``, ``friction_bends`` with ``*_interval``, their
+        ``correlation``, ``bends_minus_straights_interval``, ``separable`` (the log tells them apart: correlation
+        within ±:data:`SEPARABLE_CORRELATION`, each half-width within :data:`SEPARABLE_HALF_WIDTH` of its
+        value), ``differ`` (separable and the difference's interval excludes 0), ``reason`` when not separable.
     """
 
     friction: float
@@ -265,6 +271,7 @@ class FrictionFit:
     expected: dict
     log: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
+    straights_and_bends: dict | None = None
 
     def to_json(self) -> dict:
         """The content of ``fit.json``."""
@@ -284,6 +291,8 @@ class FrictionFit:
             "log": self.log,
             "warnings": self.warnings,
         }
+        if self.straights_and_bends is not None:
+            out["straights_and_bends"] = self.straights_and_bends
         if self.partial:
             out["forecast_pull_force_N"] = self.expected["pull_force_N"]
             out["forecast_pull_force_interval_N"] = self.expected["pull_force_interval_N"]
@@ -303,9 +312,66 @@ def _limit_reached(x: np.ndarray, values: np.ndarray, limit: float) -> float | N
     return float(x0 + (limit - v0) / (v1 - v0) * (x1 - x0)) if v1 != v0 else float(x1)
 
 
+#: Straights and bends are told apart when their estimates' correlation is at most this in magnitude ...
+SEPARABLE_CORRELATION = 0.95
+#: ... and each 95 % interval's half-width is at most this fraction of its estimate.
+SEPARABLE_HALF_WIDTH = 0.5
+
+
+def _straights_and_bends(family: RopeFamily, x: np.ndarray, y: np.ndarray, mu_hat: float, series: np.ndarray,
+                         in_use: np.ndarray, r_series_of, method: str, bootstrap: int, seed: int) -> dict:
+    """μ on straights and μ in bends (bends and helices) fitted apart, with the check that the log can
+    tell them apart.
+
+    Least squares on the rope directly (scipy's ``least_squares``, from μ̂ for both); the interval from the
+    same resampling as the one-coefficient fit, refitted in the model linearised at the optimum
+    (θ* = θ̂ + (JᵀJ)⁻¹Jᵀr*: the rope is smooth in μ and the intervals are narrow against its curvature).
+    """
+    from scipy.optimize import least_squares
+
+    sc, spec, direction = family.scenario, family.spec, family.direction
+
+    def model(theta):
+        rope = pull_in_rope(sc, spec, direction, friction=float(theta[0]), bend_friction=float(theta[1]))
+        return np.asarray(rope.tension_at(np.clip(x, 0.0, rope.cable_length_m)))
+
+    out = {"separable": False}
+    res = least_squares(lambda th: model(th) - y, x0=[mu_hat, mu_hat], bounds=([0.0, 0.0], [family.mu_max] * 2),
+                        diff_step=1e-4, x_scale=0.1)
+    theta = res.x
+    J = res.jac
+    fitted = model(theta)
+    JtJ = J.T @ J
+    out.update(friction_straights=float(theta[0]), friction_bends=float(theta[1]),
+               residual_std_N=float(np.std(y - fitted)))
+    if np.linalg.cond(JtJ) > 1e12:
+        out["reason"] = "the log does not reach a bend, or has no straight: one of the two does not act on it"
+        return out
+    R, _ = RESAMPLERS[method](r_series_of(fitted), int(bootstrap), np.random.default_rng(seed))
+    tare_shift = np.median(R[:, ~in_use], axis=1) if (~in_use).any() else np.zeros(R.shape[0])
+    Rstar = R[:, in_use] - tare_shift[:, None]
+    star = theta[None, :] + np.linalg.solve(JtJ, J.T @ Rstar.T).T        # (B, 2)
+    alpha = 1.0 - CONFIDENCE
+    q = [alpha / 2, 1 - alpha / 2]
+    iv = np.quantile(star, q, axis=0)                                     # (2, 2)
+    corr = float(np.corrcoef(star.T)[0, 1])
+    diff_iv = np.quantile(star[:, 1] - star[:, 0], q)
+    half = 0.5 * (iv[1] - iv[0])
+    separable = bool(abs(corr) <= SEPARABLE_CORRELATION and np.all(half <= SEPARABLE_HALF_WIDTH * np.maximum(theta, 1e-12)))
+    out.update(friction_straights_interval=[float(v) for v in iv[:, 0]],
+               friction_bends_interval=[float(v) for v in iv[:, 1]],
+               correlation=corr, bends_minus_straights_interval=[float(v) for v in diff_iv],
+               separable=separable,
+               differ=bool(separable and (diff_iv[0] > 0 or diff_iv[1] < 0)))
+    if not separable:
+        out["reason"] = (f"the estimates are correlated {corr:+.2f}, or an interval is wider than "
+                         f"±{SEPARABLE_HALF_WIDTH:.0%} of its value: the log cannot tell straights from bends")
+    return out
+
+
 def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = None, direction: str | None = None,
                  mu_max: float = 1.0, bootstrap: int = 999, seed: int = 0, route_points: int = 241,
-                 family: RopeFamily | None = None, method: str = "block") -> FrictionFit:
+                 family: RopeFamily | None = None, method: str = "block", separate: bool = False) -> FrictionFit:
     """Fit the friction coefficient to a log against the rope's pull-in history; forecast the rest.
 
     Parameters
@@ -330,6 +396,8 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
         The rope solved on the μ grid for this scenario (built from the arguments above if not given).
     method : {"block", "ar"}
         How the residuals are resampled: circular blocks (Politis & White's length) or an AR sieve.
+    separate : bool
+        Also fit μ on straights and μ in bends apart (:attr:`FrictionFit.straights_and_bends`).
 
     Returns
     -------
@@ -413,6 +481,15 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
         warnings.append("too few rows in a half of the log to test whether one coefficient explains it")
     if lo <= 1e-12:
         warnings.append("the interval reaches μ = 0: the log cannot tell this friction from none")
+    separate_fit = None
+    if separate:
+        def r_series_of(model_values):
+            r = log.pull_force_N[series].copy()
+            r[in_use] -= model_values
+            return r - r.mean()
+
+        separate_fit = _straights_and_bends(family, x, y, mu_hat, series, in_use, r_series_of, method,
+                                            bootstrap, seed)
 
     # the route's curve and band; the readings' band adds their scatter (resampled residuals' quantiles)
     curve_hat = route.at(mu_hat)
@@ -466,4 +543,5 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
                        residual_std_N=float(np.std(resid)), resampling={"method": method, ("block_length_rows" if method == "block" else "ar_order"): b}, bootstrap_samples=int(bootstrap),
                        engine="rope", direction=direction, partial=partial, pulled_length_m=x, pull_force_N=y,
                        fitted_N=fitted, residual_N=resid, curve=curve, forecast=forecast, expected=expected,
-                       log=dict(log.report, rows_outside_route=int(off_route.sum())), warnings=warnings)
+                       log=dict(log.report, rows_outside_route=int(off_route.sum())), warnings=warnings,
+                       straights_and_bends=separate_fit)

@@ -22,8 +22,8 @@ def synthetic_log(scenario: Scenario, friction: float, *, seed: int = 0, speed_m
                   sample_interval_s: float = 1.0, until_m: float | None = None, noise_N: float = 0.0,
                   drift_N: float = 0.0, drift_time_s: float = 60.0, stops: int = 0, stop_s: float = 30.0,
                   spikes: int = 0, spike_N: float = 0.0, tare_N: float = 0.0, lead_in_s: float = 0.0,
-                  friction_after: tuple[float, float] | None = None, spec: PlanSpec | None = None,
-                  direction: str | None = None) -> dict:
+                  friction_after: tuple[float, float] | None = None, bend_friction: float | None = None,
+                  spec: PlanSpec | None = None, direction: str | None = None) -> dict:
     """A synthetic log in SI: ``time_s``, ``pulled_length_m``, ``pull_force_N`` arrays.
 
     Parameters
@@ -47,6 +47,8 @@ def synthetic_log(scenario: Scenario, friction: float, *, seed: int = 0, speed_m
         Number of single-reading spikes and their size [N] (sign random).
     tare_N : float
         Offset [N] added to every reading, read alone during ``lead_in_s`` seconds before the winch moves.
+    bend_friction : float, optional
+        A different true μ [-] in bends and helices.
     friction_after : (float, float), optional
         ``(x_m, mu)``: from head position x_m [m] on, the head tension grows as if the friction were mu
         (the friction changed in time: the log's slope steps there).
@@ -61,7 +63,7 @@ def synthetic_log(scenario: Scenario, friction: float, *, seed: int = 0, speed_m
     rng = np.random.default_rng(seed)
     spec = spec or plan_spec(scenario)
     direction = direction or scenario.pull.direction
-    rope = pull_in_rope(scenario, spec, direction, friction=friction)
+    rope = pull_in_rope(scenario, spec, direction, friction=friction, bend_friction=bend_friction)
     L = rope.cable_length_m
     end = L if until_m is None else min(float(until_m), L)
     x = np.arange(0.0, end + 1e-9, speed_m_per_s * sample_interval_s)
