@@ -284,3 +284,15 @@ def test_straights_and_bends_apart_only_when_the_log_can_tell(commscope):
     assert sb["friction_straights"] == pytest.approx(0.30, abs=0.02)
     assert sb["friction_bends"] == pytest.approx(0.45, abs=0.03)
     assert "straights_and_bends" in fit.to_json()
+
+
+def test_the_command_watches_until_the_log_goes_quiet(tmp_path, capsys):
+    """--watch on a log nobody writes to: one fit, then it stops after --timeout, its files written."""
+    out = tmp_path / "w"
+    status = cli_main(["fit", str(COMMSCOPE), str(ROOT / "examples" / "pull_log_commscope_a_h.csv"), "--tare", "auto",
+                       "--out", str(out), "--bootstrap", "99", "--watch", "--poll", "0.05", "--timeout", "0.3",
+                       "--no-plots"])
+    printed = capsys.readouterr().out
+    assert status == 0, printed
+    assert "has not changed for 0.3 s: watch stopped" in printed
+    assert json.loads((out / "fit.json").read_text())["partial"] is True

@@ -73,8 +73,9 @@ def _read_kwargs(args) -> dict:
                 speed_m_per_s=speed, tare=args.tare, spike_threshold=args.spike_threshold)
 
 
-def write_fit(out_dir, fit, title: str = "", units: str = "si", plots: bool = True) -> list[Path]:
-    """Write the fit's files into ``out_dir`` (each atomically, ``fit.json`` last); return their paths."""
+def write_fit(out_dir, fit, title: str = "", units: str = "si", plots: bool = True, log=None) -> list[Path]:
+    """Write the fit's files into ``out_dir`` (each atomically, ``fit.json`` last); return their paths.
+    ``log`` (the :class:`~exucable.fit.log.PullLog`) adds its left-out readings to the figure."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     c = fit.curve
@@ -93,7 +94,11 @@ def write_fit(out_dir, fit, title: str = "", units: str = "si", plots: bool = Tr
         f_unit, l_unit = display_unit("force", units), display_unit("length", units)
         scale = dict(force_factor=UNITS[f_unit][1], force_unit=f_unit, length_factor=UNITS[l_unit][1],
                      length_unit=l_unit)
-        plot_fit_band(out / "fit_band.png", fit, title=title, **scale)
+        left = None
+        if log is not None:
+            out_rows = (log.stopped | log.spike) & ~log.tare_rows
+            left = (log.pulled_length_m[out_rows], log.pull_force_N[out_rows])
+        plot_fit_band(out / "fit_band.png", fit, title=title, left_out=left, **scale)
         plot_fit_residuals(out / "fit_residuals.png", fit, **scale)
         paths += [out / "fit_band.png", out / "fit_residuals.png"]
     paths.append(write_json(out / "fit.json", fit.to_json(), indent=1))
@@ -172,9 +177,10 @@ def main(args) -> int:
                             method=args.interval, separate=args.separate)
 
     if not args.watch:
-        fit = fit_once(read_pull_log(args.log, **read_kwargs))
+        log = read_pull_log(args.log, **read_kwargs)
+        fit = fit_once(log)
         _print_fit(fit, spec.units)
-        write_fit(out, fit, title, spec.units, plots=not args.no_plots)
+        write_fit(out, fit, title, spec.units, plots=not args.no_plots, log=log)
         print(f"written: {out}/fit.json, fit_curve.csv, fit_residuals.csv"
               f"{', forecast.csv' if fit.partial else ''}{'' if args.no_plots else ', fit_band.png, fit_residuals.png'}")
         return _status(fit)
@@ -192,7 +198,7 @@ def main(args) -> int:
                 print(f"\n[{update.log.report['readable_rows']} rows, head at "
                       f"{_q(float(update.log.pulled_length_m.max()), 'length', spec.units)}]", flush=True)
                 _print_fit(last, spec.units)
-                write_fit(out, last, title, spec.units, plots=not args.no_plots)
+                write_fit(out, last, title, spec.units, plots=not args.no_plots, log=update.log)
             if update.stop == "ended":
                 print("the pull has ended: watch stopped", flush=True)
             elif update.stop == "timeout":

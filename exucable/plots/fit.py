@@ -10,11 +10,12 @@ __all__ = ["plot_fit_band", "plot_fit_residuals"]
 
 
 def plot_fit_band(path, fit, title: str = "", force_factor: float = 1.0, force_unit: str = "N",
-                  length_factor: float = 1.0, length_unit: str = "m") -> None:
+                  length_factor: float = 1.0, length_unit: str = "m", left_out=None) -> None:
     """Head tension against pulled length: the log's used and left-out readings, the model at the fitted
     friction, the band of its 95 % interval and the band where 95 % of readings should fall; for a
-    partial log the forecast to the end. Values are divided by ``force_factor`` / ``length_factor``
-    (SI per display unit) for display."""
+    partial log the forecast to the end; ``left_out``: (pulled length [m], reading [N]) of the readings
+    left out as stops and spikes. Values are divided by ``force_factor`` / ``length_factor`` (SI per
+    display unit) for display."""
     c = fit.curve
     X = np.asarray(c["pulled_length_m"]) / length_factor
     fig = new_figure(figsize=(8, 4.5))
@@ -28,6 +29,9 @@ def plot_fit_band(path, fit, title: str = "", force_factor: float = 1.0, force_u
             label=f"rope, fitted friction {fit.friction:.3f}")
     ax.plot(np.asarray(fit.pulled_length_m) / length_factor, np.asarray(fit.pull_force_N) / force_factor, ".",
             ms=2.5, color="k", label="log (used)")
+    if left_out is not None and len(left_out[0]):
+        ax.plot(np.asarray(left_out[0]) / length_factor, np.asarray(left_out[1]) / force_factor, "x", ms=3,
+                color="tab:gray", label="left out (stops, spikes)")
     if fit.forecast is not None:
         f = fit.forecast
         fx = np.asarray(f["pulled_length_m"]) / length_factor
