@@ -296,3 +296,11 @@ def test_the_command_watches_until_the_log_goes_quiet(tmp_path, capsys):
     assert status == 0, printed
     assert "has not changed for 0.3 s: watch stopped" in printed
     assert json.loads((out / "fit.json").read_text())["partial"] is True
+
+
+def test_a_force_controlled_scenario_is_refused_naming_the_key(commscope):
+    from exucable.errors import ScenarioError
+
+    scenario, _ = commscope
+    with pytest.raises(ScenarioError, match=r"^pull\.force: .*pull\.back_tension"):
+        RopeFamily(scenario.replace(**{"pull.force": "100 N"}))

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from exucable.errors import LogError
+from exucable.errors import LogError, ScenarioError
 from exucable.fit.log import PullLog
 from exucable.plan.pull import PlanSpec, plan_spec, pull_in_rope
 from exucable.quasistatic import engineering as eng
@@ -160,6 +160,9 @@ class RopeFamily:
                  mu_max: float = 1.0):
         if not (np.isfinite(mu_max) and mu_max > 0):
             raise LogError("--mu-max", f"must be > 0, got {mu_max}")
+        if scenario.pull.force_N is not None:
+            raise ScenarioError("pull.force", "a pull-in history starts from the reel's back tension; give "
+                                              "pull.back_tension instead of a prescribed pull.force")
         self.scenario = scenario
         self.spec = spec or plan_spec(scenario)
         self.direction = direction or scenario.pull.direction
