@@ -25,6 +25,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "converge": ("exucable.commands.converge", "run a scenario on refined meshes and extrapolate its result"),
     "export": ("exucable.commands.export", "write a scenario's exact discrete problem for another solver"),
     "plan": ("exucable.commands.plan", "plan a pull: both directions, section tables, limit checks, HTML report"),
+    "fit": ("exucable.commands.fit", "fit the friction coefficient to a tension recorder's log and forecast the rest of the pull"),
     "compile": ("exucable.commands.compile", "compile the contact kernels into numba's cache now (the first run would do it)"),
 }
 

@@ -1,7 +1,8 @@
 """Error types. User errors (bad input) derive from :class:`ExucableError`; the CLI
 prints their message without a traceback and exits with status 2."""
 
-__all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError", "OutputError"]
+__all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "SolverError", "OutputError",
+           "LogError"]
 
 
 class ExucableError(Exception):
@@ -72,3 +73,16 @@ class OutputError(ExucableError):
         self.path = str(path)
         self.message = message
         super().__init__(f"{self.path}: {message}")
+
+
+class LogError(ExucableError):
+    """A tension recorder's log cannot be read or fitted (``exucable fit``).
+
+    ``key`` names the offending column, row or flag, e.g. ``"column 'tension'"``, ``"row 12"`` or
+    ``"--tare"``.
+    """
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        self.message = message
+        super().__init__(f"{key}: {message}" if key else message)

@@ -272,6 +272,8 @@ def json_safe(obj):
         return v if math.isfinite(v) else None
     if isinstance(obj, (np.integer,)):
         return int(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
     if isinstance(obj, np.ndarray):
         return json_safe(obj.tolist())
     if isinstance(obj, Path):

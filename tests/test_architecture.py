@@ -125,6 +125,7 @@ STAGES = [
     {"run"},
     {"api"},
     {"plan", "sweep"},
+    {"fit"},
     {"validation"},
     {"commands"},
     {"cli", "__init__"},

@@ -40,8 +40,8 @@ from exucable.post.trust import TRUSTED_STATUSES
 from exucable.scenario.units import SYSTEMS
 from exucable.output.versions import versions
 
-__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "ENGINES",
-           "CHECKS", "point_names"]
+__all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "pull_in_rope",
+           "ENGINES", "CHECKS", "point_names"]
 
 ENGINES = ("rope", "steady", "dynamic")
 
@@ -239,6 +239,42 @@ def _pull_in_history(curve: Centreline, rope, n: int = 201) -> dict:
 #: The rope solver's argument names (its errors' keys) → the scenario keys a plan gives them from.
 _PLAN_ROPE_KEYS = {"friction": "contact.friction", "bend_friction": "contact.friction",
                    "trailing_tension_N": "pull.back_tension", "weight_per_length_N_per_m": "cable.mass_per_length"}
+
+
+def pull_in_rope(scenario: Scenario, spec: PlanSpec, direction: str = "forward", friction: float | None = None,
+                 bend_friction: float | None = None):
+    """The rope of a full pull in ``direction`` with plan's conventions, whose tension profile is the
+    pull-in history (see :func:`_pull_in_history`).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    spec : PlanSpec
+        Number of cables and arrangement (weight correction factor w_c, which multiplies the friction
+        on straights, and in bends with ``spec.weight_correction_in_bends``).
+    direction : {"forward", "reverse"}
+    friction : float, optional
+        Friction coefficient μ [-] (default ``contact.friction``).
+    bend_friction : float, optional
+        A separate μ [-] for bends and helices (default: ``friction``).
+
+    Returns
+    -------
+    exucable.quasistatic.rope.RopeSolution
+        ``tension_at(x)`` is the head tension [N] with the head x metres into the conduit.
+    """
+    d = 2.0 * scenario.cable.radius_m
+    D = 2.0 * scenario.conduit.inner_radius_m
+    arrangement = eng.auto_arrangement(spec.count, D, d) if spec.arrangement == "auto" else spec.arrangement
+    wc = eng.weight_correction_factor(spec.count, arrangement, D, d)
+    mu = scenario.contact.friction if friction is None else float(friction)
+    g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
+    w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
+    mu_b = mu if bend_friction is None else float(bend_friction)
+    # in bends: w_c μ (IEEE 1185, AEIC CG5, Polywater) or μ (SEC TES-P-104.05's worked example)
+    mu_bend = wc * mu_b if spec.weight_correction_in_bends else mu_b
+    return solve_rope(scenario.build_conduit().centreline, wc * mu, w_total, scenario.pull.back_tension_N,
+                      direction, bend_friction=mu_bend)
 
 
 def _check(name, value, limit, where, quantity, lower_is_better=True) -> dict:
@@ -465,9 +501,6 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     clearance = eng.clearance_m(spec.count, arrangement, D, d)
     g = scenario.gravity.g_m_per_s2 if scenario.gravity is not None else 0.0
     w_total = spec.count * scenario.cable.mass_per_length_kg_per_m * g
-    mu_eff = wc * scenario.contact.friction
-    # in bends: w_c μ (IEEE 1185, AEIC CG5, Polywater) or μ (SEC TES-P-104.05's worked example)
-    mu_bend = None if spec.weight_correction_in_bends else scenario.contact.friction
     back = scenario.pull.back_tension_N
     centreline = scenario.build_conduit().centreline
     names = point_names(scenario, len(centreline.pieces))
@@ -476,7 +509,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     for name in ("forward", "reverse"):
         curve = centreline if name == "forward" else centreline.reversed()
         try:
-            rope = solve_rope(centreline, mu_eff, w_total, back, name, bend_friction=mu_bend)
+            rope = pull_in_rope(scenario, spec, name)
         except ModelError as exc:
             # the rope solver names its own arguments; the user knows the scenario's keys
             raise ModelError(_PLAN_ROPE_KEYS.get(exc.key, exc.key), exc.message) from None
