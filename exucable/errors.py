@@ -6,7 +6,15 @@ __all__ = ["ExucableError", "ScenarioError", "GeometryError", "ModelError", "Sol
 
 
 class ExucableError(Exception):
-    """Base class of every error caused by the user's input or a failed run."""
+    """Base class of every error caused by the user's input or a failed run.
+
+    Subclasses whose constructor takes other arguments than the message keep those arguments, so
+    that an error raised in a worker process (a sweep's or a benchmark's pool) is pickled back to
+    the parent as the same error instead of failing to unpickle (which hangs the pool).
+    """
+
+    def __reduce__(self):
+        return type(self), getattr(self, "_init_args", self.args)
 
 
 class ScenarioError(ExucableError):
@@ -21,6 +29,7 @@ class ScenarioError(ExucableError):
     """
 
     def __init__(self, key: str, message: str):
+        self._init_args = (key, message)
         self.key = key
         self.message = message
         super().__init__(f"{key}: {message}" if key else message)
@@ -34,6 +43,7 @@ class GeometryError(ExucableError):
     """
 
     def __init__(self, key: str, message: str):
+        self._init_args = (key, message)
         self.key = key
         self.message = message
         super().__init__(f"{key}: {message}" if key else message)
@@ -44,6 +54,7 @@ class ModelError(ExucableError):
     than its conduit, elements too long to resolve the bends)."""
 
     def __init__(self, key: str, message: str):
+        self._init_args = (key, message)
         self.key = key
         self.message = message
         super().__init__(f"{key}: {message}" if key else message)
@@ -53,6 +64,7 @@ class SolverError(ExucableError):
     """The time integration failed; ``time_s`` is the simulated time where it happened."""
 
     def __init__(self, message: str, time_s: float | None = None):
+        self._init_args = (message, time_s)
         self.time_s = time_s
         super().__init__(message if time_s is None else f"{message} (at simulated time t = {time_s:.6g} s)")
 
@@ -70,6 +82,7 @@ class OutputError(ExucableError):
     """
 
     def __init__(self, path, message: str):
+        self._init_args = (str(path), message)
         self.path = str(path)
         self.message = message
         super().__init__(f"{self.path}: {message}")
@@ -83,6 +96,7 @@ class LogError(ExucableError):
     """
 
     def __init__(self, key: str, message: str):
+        self._init_args = (key, message)
         self.key = key
         self.message = message
         super().__init__(f"{key}: {message}" if key else message)

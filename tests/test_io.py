@@ -86,3 +86,18 @@ def test_files_get_the_users_umask_as_open_would_give_them(tmp_path, mask):
     assert expected == 0o666 & ~mask
     for name in ("a.txt", "b.txt"):
         assert stat.S_IMODE(os.stat(tmp_path / name).st_mode) == expected, name
+
+
+def test_errors_survive_a_round_trip_through_pickle():
+    """An error raised in a worker process reaches the parent as the same error (an error that
+    cannot be unpickled hangs a multiprocessing pool)."""
+    import pickle
+
+    from exucable.errors import GeometryError, LogError, ModelError, OutputError, ScenarioError, SolverError
+
+    for err in (ScenarioError("cable.radius", "must be > 0"), GeometryError("path[1]", "does not fit"),
+                ModelError("cable.elements", "too coarse"), LogError("--tare", "no readings"),
+                OutputError("/tmp/x", "not a directory"), SolverError("diverged", 0.25)):
+        back = pickle.loads(pickle.dumps(err))
+        assert type(back) is type(err) and str(back) == str(err)
+        assert getattr(back, "key", None) == getattr(err, "key", None)
