@@ -41,7 +41,8 @@ SCRIPTS = {
     "studies/rope_difference_study.py": "| case | gravity | c [mm] | c/R | EJ [N m²]",
 }
 
-# the slowest smoke runs (each several processes importing Exudyn and numba, or whole sweeps): run with -m slow
+# the slowest smoke runs, 10-35 s each on the shared 2-core machine (several processes each importing
+# Exudyn and numba, or an industry route of hundreds of elements): run with -m slow
 SLOW = {"benchmarks/naive_baseline.py", "benchmarks/run_examples.py", "benchmarks/sweep_scaling.py",
         "benchmarks/industry_suite.py", "studies/industry_dynamic.py"}
 
