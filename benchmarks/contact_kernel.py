@@ -11,7 +11,8 @@ wall by the clearance plus 0.1 mm, so nearly every check point is in contact and
   for the contact search alone (nearest segment of every check point) and for whole evaluations
   (which add the force law and the Jacobians, the same work either way).
 
-Run: ``.venv/bin/python benchmarks/contact_kernel.py`` (about 15 s, plus compilation on first use).
+Run: ``.venv/bin/python benchmarks/contact_kernel.py`` (about 15 s, plus compilation on first use);
+``--quick``: 10 elements x 50 check points, 10 segments per bend, one repeat (a smoke run).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+import argparse  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -37,7 +39,7 @@ R_CONDUIT = 3.5e-3  # NOTES.md common parameters
 R_CABLE = 2.5e-3
 
 
-def route():
+def route(segments_per_bend=SEGMENTS_PER_BEND):
     """Centreline of straight 6 m, 90° bend (+y), straight 5 m, 60° bend up, straight 4 m, 90° bend.
 
     Returns the polyline vertices (on the centreline), their arc lengths, a function giving
@@ -65,7 +67,7 @@ def route():
             b /= np.linalg.norm(b)
             length = size * angle
             table.append((s0, length, kind, p.copy(), t.copy(), b, size))
-            for phi in np.linspace(0.0, angle, SEGMENTS_PER_BEND + 1)[1:]:
+            for phi in np.linspace(0.0, angle, segments_per_bend + 1)[1:]:
                 verts.append(p + size * (1 - np.cos(phi)) * b + size * np.sin(phi) * t)
                 s_verts.append(s0 + size * phi)
             p = verts[-1].copy()
@@ -96,11 +98,11 @@ def route():
     return np.array(verts), np.array(s_verts), at, s0
 
 
-def cable_state(at, total_length, rng):
+def cable_state(at, total_length, rng, n_elements=N_ELEMENTS):
     """Nodes shifted from the centreline to the wall side by the clearance + 0.1 mm, sliding."""
     gap = R_CONDUIT - R_CABLE
-    length = total_length / N_ELEMENTS
-    s_nodes = np.linspace(0.0, total_length, N_ELEMENTS + 1)
+    length = total_length / n_elements
+    s_nodes = np.linspace(0.0, total_length, n_elements + 1)
     pts, tans, nors = at(s_nodes)
     pos = pts + (gap + 1.0e-4) * nors
     q = np.hstack([pos, tans]).reshape(-1)
@@ -118,22 +120,27 @@ def median_time(fn, repeats):
     return float(np.median(times))
 
 
-def main():
-    verts, s_verts, at, total = route()
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true",
+                    help="10 elements x 50 check points, 10 segments per bend, one repeat (a smoke run)")
+    args = ap.parse_args(argv)
+    n_elements, check_points, per_bend = (10, 50, 10) if args.quick else (N_ELEMENTS, CHECK_POINTS, SEGMENTS_PER_BEND)
+    verts, s_verts, at, total = route(per_bend)
     segments = Segments(verts, s_verts, R_CONDUIT)
     rng = np.random.default_rng(4)
-    q, q_t, length = cable_state(at, total, rng)
+    q, q_t, length = cable_state(at, total, rng, n_elements)
     law = ContactLaw(stiffness=1e6, damping=1e3, exponent=1.5, friction=0.3, damping_onset_m=0.0)  # Eq. 18
-    n_points = N_ELEMENTS * CHECK_POINTS
-    print(f"Example-4-size case: {N_ELEMENTS} elements x {CHECK_POINTS} check points = {n_points} "
+    n_points = n_elements * check_points
+    print(f"{'smoke-run' if args.quick else 'Example-4-size'} case: {n_elements} elements x {check_points} check points = {n_points} "
           f"points, {segments.count} segments, route {total:.2f} m")
 
     kernels = {}
     t0 = time.perf_counter()
     for backend in ("numba", "numpy"):
         for bp in ("aabb", "none"):
-            kernels[backend, bp] = ContactKernel(segments, length, R_CABLE, law, CHECK_POINTS,
-                                                 n_elements=N_ELEMENTS, broad_phase=bp,
+            kernels[backend, bp] = ContactKernel(segments, length, R_CABLE, law, check_points,
+                                                 n_elements=n_elements, broad_phase=bp,
                                                  backend=backend)
     kernels["numba", "aabb"].evaluate(q, q_t, jacobian=True)  # compile or load the cache
     kernels["numba", "none"].evaluate(q, q_t, jacobian=True)
@@ -150,7 +157,7 @@ def main():
           f"{np.abs(res.generalized_force - brute.generalized_force).max():.1e} N")
 
     rows = []
-    for backend, repeats in (("numba", 30), ("numpy", 3)):
+    for backend, repeats in (("numba", 1 if args.quick else 30), ("numpy", 1 if args.quick else 3)):
         for jac in (False, True):
             for bp in ("aabb", "none"):
                 if backend == "numpy" and bp == "none" and not jac:
@@ -165,11 +172,12 @@ def main():
         timing[backend, bp, jac] = t
         what = "forces + Jacobians" if jac else "forces"
         print(f"{backend:8s} {bp:12s} {what:20s} {1e3 * t:9.2f} {n_points / t:10.3g}")
-    fast_aabb, fast_none = kernels["numba", "aabb"]._fast, kernels["numba", "none"]._fast
+    fast_aabb, fast_none = kernels["numba", "aabb"]._impl, kernels["numba", "none"]._impl
     assert np.array_equal(fast_aabb.nearest_segments(q), fast_none.nearest_segments(q))
-    t_sweep = median_time(lambda: fast_aabb.sweep.candidates(q), 30)
-    t_search = median_time(lambda: fast_aabb.nearest_segments(q), 30)
-    t_search_bf = median_time(lambda: fast_none.nearest_segments(q), 10)
+    reps = 1 if args.quick else 30
+    t_sweep = median_time(lambda: fast_aabb.sweep.candidates(q), reps)
+    t_search = median_time(lambda: fast_aabb.nearest_segments(q), reps)
+    t_search_bf = median_time(lambda: fast_none.nearest_segments(q), 1 if args.quick else 10)
     off, _ = fast_aabb.candidates(q)
     counts = np.diff(off)
     print(f"candidate segments per element: mean {counts.mean():.2f}, max {counts.max()} "

@@ -4,6 +4,7 @@ runs them.
 
     nice .venv/bin/python benchmarks/industry_suite.py [--mode steady] [--mode dynamic] [--refined]
         [--example NAME] [--out DIR] [--json FILE]
+    nice .venv/bin/python benchmarks/industry_suite.py --quick   # one route, steady, default mesh, into a temporary folder
 
 Prints one row per route, mode and mesh level: elements, wall time of the solve and of the whole run
 (model build, references and output included), the pulling force and the run's status. The machine is
@@ -15,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -29,10 +31,23 @@ def main(argv=None) -> int:
     p.add_argument("--example", action="append", metavar="NAME", help="only scenario files containing NAME")
     p.add_argument("--out", default="out/industry-benchmark")
     p.add_argument("--json", default=None, help="also write the rows here")
+    p.add_argument("--quick", action="store_true",
+                   help="the Gera worked example only, steady mode, default mesh, results in a temporary folder")
     args = p.parse_args(argv)
     examples = load_industry_examples()
+    if args.quick:
+        args.example, args.mode, args.refined = ["gera"], ["steady"], False
     if args.example:
         examples = [e for e in examples if any(n in e["scenario"] for n in args.example)]
+    if args.quick:
+        with tempfile.TemporaryDirectory() as tmp:
+            args.out = tmp
+            return run(args, examples)
+    return run(args, examples)
+
+
+def run(args, examples) -> int:
+    """Time each of ``examples`` in each of ``args.mode``; print a row per mesh level."""
     rows = []
     print(f"{'example':<42} {'mode':<8} {'level':>5} {'elements':>8} {'solve [s]':>10} {'run [s]':>8} "
           f"{'pull force [N]':>15} status", flush=True)

@@ -1,4 +1,4 @@
-"""exucable against a naive Exudyn implementation of the same problem (issue 15), in one run.
+"""exucable against a naive Exudyn implementation of the same problem, in one run.
 
 The naive implementation is what a first Exudyn model of paper Example 2 looks like
 (``../shared/notes/exudyn-findings.md``, first row of its table): the 90° bend (R 0.5 m between
@@ -17,8 +17,9 @@ whole process, as a user runs it. Both are timed here, in this run, each in its 
 
     nice .venv/bin/python benchmarks/naive_baseline.py            # ~2 min (the baseline: ~100 s)
     nice .venv/bin/python benchmarks/naive_baseline.py --repeat 5
+    nice .venv/bin/python benchmarks/naive_baseline.py --quick   # smoke run: baseline over 0.5 ms, fast Example 2, once
 
-Targets (issue 15): whole process ≥ 50×, simulation alone ≥ 150×.
+Targets: whole process ≥ 50×, simulation alone ≥ 150×.
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE_2 = ROOT / "scenarios" / "paper_ex2_bend90.toml"
+EXAMPLE_2_FAST = ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml"
 
 # the naive model's departures from the scenario file, as dotted scenario keys
 NAIVE_OVERRIDES = {
@@ -73,7 +75,7 @@ model = build_model(sc)
 s = exu.SimulationSettings()              # Exudyn's defaults: modified Newton, dense solver
 ti = s.timeIntegration
 ti.endTime = sc.solver.end_time_s
-ti.numberOfSteps = int(round(sc.solver.end_time_s / sc.solver.step_s))   # steps <= 1e-3 s
+ti.numberOfSteps = max(1, int(round(sc.solver.end_time_s / sc.solver.step_s)))   # steps <= 1e-3 s
 ti.adaptiveStep = True
 ti.verboseMode = 0
 s.solution.file.write = False
@@ -92,8 +94,10 @@ print("@@RESULT " + json.dumps(dict(ok=bool(ok), wall_time_s=wall, steps=int(sol
 """
 
 
-def run_naive() -> dict:
-    code = _NAIVE_CHILD.format(root=str(ROOT), path=str(EXAMPLE_2), overrides=NAIVE_OVERRIDES,
+def run_naive(end_time_s: float | None = None) -> dict:
+    """The naive model in a child process (``end_time_s`` [s] overrides its simulated time)."""
+    overrides = dict(NAIVE_OVERRIDES, **({} if end_time_s is None else {"solver.end_time": end_time_s}))
+    code = _NAIVE_CHILD.format(root=str(ROOT), path=str(EXAMPLE_2), overrides=overrides,
                                parent=str(EXAMPLE_2.parent))
     t0 = time.perf_counter()
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -106,10 +110,10 @@ def run_naive() -> dict:
     return r
 
 
-def run_exucable(out_dir: Path) -> dict:
+def run_exucable(out_dir: Path, scenario: Path = EXAMPLE_2) -> dict:
     exe = Path(sys.executable).with_name("exucable")
     t0 = time.perf_counter()
-    out = subprocess.run([str(exe), "run", str(EXAMPLE_2), "--out", str(out_dir), "--quiet", "--no-plots"],
+    out = subprocess.run([str(exe), "run", str(scenario), "--out", str(out_dir), "--quiet", "--no-plots"],
                          capture_output=True, text=True)
     whole = time.perf_counter() - t0
     if out.returncode != 0:
@@ -123,14 +127,20 @@ def run_exucable(out_dir: Path) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=3, help="exucable runs (median taken) [3]")
+    ap.add_argument("--quick", action="store_true",
+                    help="smoke run: the baseline over 0.5 ms, the fast Example 2, one exucable run before and after "
+                         "(the ratios then compare unequal runs: they only show that the code path works)")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.repeat = 1
+    scenario = EXAMPLE_2_FAST if args.quick else EXAMPLE_2
     load = os.getloadavg()[0]
-    print(f"# exucable vs the naive Exudyn baseline (paper Example 2), load average {load:.1f} "
-          f"on {os.cpu_count()} cores\n", flush=True)
+    print(f"# exucable vs the naive Exudyn baseline (paper Example 2{', smoke run' if args.quick else ''}), "
+          f"load average {load:.1f} on {os.cpu_count()} cores\n", flush=True)
     with tempfile.TemporaryDirectory() as tmp:
-        ours = [run_exucable(Path(tmp) / f"run{i}") for i in range(args.repeat)]
-        naive = run_naive()
-        ours += [run_exucable(Path(tmp) / f"run{i}") for i in range(args.repeat, 2 * args.repeat)]
+        ours = [run_exucable(Path(tmp) / f"run{i}", scenario) for i in range(args.repeat)]
+        naive = run_naive(5e-4 if args.quick else None)
+        ours += [run_exucable(Path(tmp) / f"run{i}", scenario) for i in range(args.repeat, 2 * args.repeat)]
     whole = statistics.median(r["whole_process_s"] for r in ours)
     sim = statistics.median(r["wall_time_s"] for r in ours)
     o = ours[0]
@@ -138,11 +148,14 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|")
     print(f"| naive Exudyn (40 × 10, numpy kernel) | {naive['whole_process_s']:.1f} | {naive['wall_time_s']:.1f} | "
           f"{naive['end_time_s']:.3g} | {naive['steps']} | {naive['newton_iterations']} | {naive['pull_force_N']:.2f} |")
-    print(f"| exucable run (40 × 200), median of {len(ours)} | {whole:.2f} | {sim:.2f} | {o['end_time_s']:.3g} | "
+    mesh = "fast variant" if args.quick else "40 × 200"
+    print(f"| exucable run ({mesh}), median of {len(ours)} | {whole:.2f} | {sim:.2f} | {o['end_time_s']:.3g} | "
           f"{o['steps']} | {o['newton_iterations']} | {o['pull_force_N']:.2f} |")
     wholes = ", ".join(f"{r['whole_process_s']:.2f}" for r in ours)
     sims = ", ".join(f"{r['wall_time_s']:.2f}" for r in ours)
     print(f"\nexucable runs: whole process {wholes} s; simulation {sims} s (before and after the baseline)")
+    if args.quick:
+        print("\nsmoke run: the two rows simulate different times; the ratios below only show the code path works")
     print(f"\nratio, whole process: {naive['whole_process_s'] / whole:.0f}x (target >= 50x)")
     print(f"ratio, simulation alone: {naive['wall_time_s'] / sim:.0f}x (target >= 150x)")
     print(f"capstan reference T1 = 205.37 N; load average now {os.getloadavg()[0]:.1f}")

@@ -1,4 +1,4 @@
-"""Where the time of a Newton iteration goes, and how far it is from the limit (issue 15, part 4).
+"""Where the time of a Newton iteration goes, and how far it is from the limit.
 
 For each case (the paper's four examples at their fidelity, and a 100 m route), in its own process:
 
@@ -13,7 +13,12 @@ For each case (the paper's four examples at their fidelity, and a 100 m route), 
   state) × the Newton iterations the run needed, and the run's simulation time over that limit.
 
     nice .venv/bin/python benchmarks/newton_cost.py            # ~3 min on 2 idle cores
-    nice .venv/bin/python benchmarks/newton_cost.py --quick    # Ex. 2 and 3 only
+    nice .venv/bin/python benchmarks/newton_cost.py --ex23     # Ex. 2 and 3 only
+    nice .venv/bin/python benchmarks/newton_cost.py --quick    # smoke run: the fast Example 2 only
+
+Exudyn's timers need ``show.computationTime`` and the solver object, which ``simulate`` builds inside:
+each case's process swaps ``solver_settings`` and Exudyn's solver class for the run and restores them
+after (the case runs in a process of its own, so nothing else sees the swap).
 
 The machine is shared and noisy: the table is one run; compare shares and ratios, not seconds.
 """
@@ -80,8 +85,6 @@ def _case(args):
         s.show.computationTime = True     # fills solver.timer (and prints it: discarded)
         return s
 
-    solve.solver_settings = settings
-    solve.exu.MainSolverImplicitSecondOrder = TimedSolver
     from exucable.model.build import build_model
 
     model = build_model(sc)
@@ -94,9 +97,12 @@ def _case(args):
     devnull = os.open(os.devnull, os.O_WRONLY)
     saved = os.dup(1)
     os.dup2(devnull, 1)          # Exudyn prints its timer statistics on stdout
+    base_solver = exu.MainSolverImplicitSecondOrder
+    solve.solver_settings, exu.MainSolverImplicitSecondOrder = settings, TimedSolver
     try:
         out = solve.simulate(model)
     finally:
+        solve.solver_settings, exu.MainSolverImplicitSecondOrder = base, base_solver
         os.dup2(saved, 1)
         os.close(devnull)
     timer = solvers[-1].timer
@@ -127,11 +133,14 @@ def run_case(label, source, end_time=None):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--quick", action="store_true", help="Examples 2 and 3 only")
+    ap.add_argument("--ex23", action="store_true", help="Examples 2 and 3 only")
+    ap.add_argument("--quick", action="store_true", help="smoke run: the fast (coarse) Example 2 only")
     args = ap.parse_args(argv)
     sc = ROOT / "scenarios"
     cases = [("Ex. 2 bend", sc / "paper_ex2_bend90.toml", None), ("Ex. 3 helix", sc / "paper_ex3_helix.toml", None)]
-    if not args.quick:
+    if args.quick:
+        cases = [("Ex. 2 bend, fast variant", sc / "fast" / "paper_ex2_bend90.toml", None)]
+    elif not args.ex23:
         cases = [("Ex. 1 incline", sc / "paper_ex1_incline.toml", None)] + cases + [
             ("Ex. 4 spatial", sc / "paper_ex4_spatial.toml", None), ("100 m route (0.1 s)", ROUTE_100M, None)]
     print(f"# Cost per Newton iteration — {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start\n")

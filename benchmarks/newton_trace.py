@@ -1,4 +1,4 @@
-"""Where a dynamic run's Newton iterations go (issue 15, part 1), measured in one run.
+"""Where a dynamic run's Newton iterations go, measured in one run.
 
 Runs a scenario with Exudyn's ``timeIntegration.verboseMode = 2`` in a child process, parses the
 per-iteration residuals that Exudyn prints, and reports per scenario:
@@ -14,6 +14,11 @@ per-iteration residuals that Exudyn prints, and reports per scenario:
     .venv/bin/python benchmarks/newton_trace.py scenarios/paper_ex3_helix.toml
     .venv/bin/python benchmarks/newton_trace.py scenarios/paper_ex4_spatial.toml --end-time 0.1 \
         --exudyn newton.numericalDifferentiation.forODE2=True
+    .venv/bin/python benchmarks/newton_trace.py --quick      # smoke run: the fast Example 2 over 0.05 s
+
+The verbose mode and the overrides are Exudyn settings that ``simulate`` builds inside, and
+``--solve`` names module settings of :mod:`exucable.solve.dynamic`: the child process swaps them in
+for its one run and restores them after (nothing outside that child sees them).
 
 Prints a Markdown summary (and ``--json`` the parsed steps).
 """
@@ -59,12 +64,17 @@ def settings(sp):
             obj = getattr(obj, h)
         setattr(obj, last, value)
     return s
+saved = dict(solver_settings=base, **{{name: getattr(solve, name) for name in {solve_attrs!r}}})
 solve.solver_settings = settings
 for name, value in {solve_attrs!r}.items():
     setattr(solve, name, value)
-t0 = time.perf_counter()
-model = build_model(sc)
-out = solve.simulate(model)
+try:
+    t0 = time.perf_counter()
+    model = build_model(sc)
+    out = solve.simulate(model)
+finally:
+    for name, value in saved.items():
+        setattr(solve, name, value)
 c = model.coupling
 h = out.history
 print("@@RESULT " + json.dumps(dict(status=out.status, steps=out.steps, newton=out.newton_iterations,
@@ -168,7 +178,7 @@ def print_summary(label, s) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scenario", nargs="+")
+    ap.add_argument("scenario", nargs="*", help="scenario files (required unless --quick)")
     ap.add_argument("--end-time", type=float, default=None, help="override solver.end_time [s]")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="dotted scenario key")
     ap.add_argument("--exudyn", action="append", default=[], metavar="KEY=VALUE",
@@ -176,7 +186,14 @@ def main(argv=None) -> int:
     ap.add_argument("--solve", action="append", default=[], metavar="NAME=VALUE",
                     help="module setting of exucable.solve.dynamic (e.g. PREDICTOR=zero)")
     ap.add_argument("--json", default=None, help="write the parsed attempts here")
+    ap.add_argument("--quick", action="store_true",
+                    help="smoke run: scenarios/fast/paper_ex2_bend90.toml over 0.05 s (unless given)")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.scenario = args.scenario or [str(ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml")]
+        args.end_time = 0.05 if args.end_time is None else args.end_time
+    if not args.scenario:
+        ap.error("scenario: give at least one scenario file (or --quick)")
     ov = {k: _value(v) for k, v in (s.split("=", 1) for s in args.set)}
     ex = {k: _value(v) for k, v in (s.split("=", 1) for s in args.exudyn)}
     sv = {k: _value(v) for k, v in (s.split("=", 1) for s in args.solve)}

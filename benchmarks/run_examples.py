@@ -1,4 +1,4 @@
-"""Speed of the paper's examples at full fidelity (issue 7), measured in one run.
+"""Speed of the paper's examples at full fidelity, measured in one run.
 
 For each example: wall time, simulated time, steps, Newton iterations per step, Jacobian
 updates, the time shares of the contact kernel / Exudyn / Python, and peak memory (each example in
@@ -8,7 +8,7 @@ over a shorter time, and the brute-force / broad-phase ratio of the time per New
 Example 2, with the fitted exponent (expected ≈ 1: linear).
 
     .venv/bin/python benchmarks/run_examples.py            # everything (~10 min on 2 cores)
-    .venv/bin/python benchmarks/run_examples.py --quick    # fewer sizes, shorter runs
+    .venv/bin/python benchmarks/run_examples.py --quick    # smoke run: fast Ex. 2 and 4, two sizes, short runs
 
 Prints a Markdown table per part; machine noise is real (shared machines): compare ratios
 measured within one run, not absolute seconds across runs.
@@ -99,18 +99,24 @@ def python_overhead_s(n_calls):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true")
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true",
+                    help="smoke run: the fast Examples 2 and 4, two sizes per growth table, 0.01 s runs")
     args = ap.parse_args()
-    print(f"# exucable examples at paper fidelity — {platform.processor() or platform.machine()}, "
+    fidelity = "their fast variants (smoke run)" if args.quick else "paper fidelity"
+    print(f"# exucable examples at {fidelity} — {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} cores, Python {platform.python_version()}\n")
     examples = [("Ex. 1 incline", "paper_ex1_incline.toml"), ("Ex. 2 bend 90°", "paper_ex2_bend90.toml"),
                 ("Ex. 3 helix", "paper_ex3_helix.toml"), ("Ex. 4 spatial", "paper_ex4_spatial.toml")]
+    folder = ROOT / "scenarios"
+    if args.quick:   # the coarse variants of the two examples the later parts use
+        folder = folder / "fast"
+        examples = [examples[1], examples[3]]
     print("| example | status | wall [s] | simulated [s] | steps | Newton/step | Jacobians | kernel | Exudyn+Python | peak [MiB] | result [N] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     results = {}
     for name, f in examples:
-        r = run(ROOT / "scenarios" / f)
+        r = run(folder / f)
         results[name] = r
         solve = r["wall_s"] - r["build_s"]
         share_k = r["kernel_s"] / solve if solve > 0 else 0.0
@@ -123,10 +129,10 @@ def main():
           f"(measured with a trivial force function): ~{overhead:.2f} s")
 
     # broad phase against brute force on Example 4, same shortened duration
-    T = 0.02 if args.quick else 0.05
+    T = 0.01 if args.quick else 0.05
     print(f"\n## Broad phase, Example 4 over {T} s (steady stop off)\n")
-    a = run(ROOT / "scenarios/paper_ex4_spatial.toml", {}, steady_stop=False, end_time=T)
-    b = run(ROOT / "scenarios/paper_ex4_spatial.toml", {"contact.broad_phase": "none"}, steady_stop=False, end_time=T)
+    a = run(folder / "paper_ex4_spatial.toml", {}, steady_stop=False, end_time=T)
+    b = run(folder / "paper_ex4_spatial.toml", {"contact.broad_phase": "none"}, steady_stop=False, end_time=T)
     ka, kb = a["kernel_s"] / max(a["user_calls"], 1), b["kernel_s"] / max(b["user_calls"], 1)
     print("| broad phase | wall [s] | steps | kernel ms/call |\n|---|---|---|---|")
     print(f"| aabb | {a['wall_s']:.1f} | {a['steps']} | {1e3 * ka:.2f} |")
@@ -134,17 +140,18 @@ def main():
     print(f"\nbrute force / broad phase: wall {b['wall_s'] / a['wall_s']:.1f}x, kernel per call {kb / ka:.1f}x")
 
     # growth with elements and check points (Example 2, fixed short duration)
-    T = 0.05 if args.quick else 0.1
+    T = 0.01 if args.quick else 0.1
     print(f"\n## Cost growth, Example 2 over {T} s\n")
     for label, key, values, base in (
-            ("elements", "cable.elements", [25, 50, 100] if args.quick else [25, 50, 100, 200], {"contact.check_points_per_element": 100}),
+            ("elements", "cable.elements", [20, 40] if args.quick else [25, 50, 100, 200],
+             {"contact.check_points_per_element": 20 if args.quick else 100}),
             ("check points per element", "contact.check_points_per_element",
-             [50, 200, 800] if args.quick else [50, 100, 200, 400, 800], {"cable.elements": 40})):
+             [20, 40] if args.quick else [50, 100, 200, 400, 800], {"cable.elements": 20 if args.quick else 40})):
         rows = []
         for v in values:
             ov = dict(base)
             ov[key] = v
-            r = run(ROOT / "scenarios/paper_ex2_bend90.toml", ov, steady_stop=False, end_time=T)
+            r = run(folder / "paper_ex2_bend90.toml", ov, steady_stop=False, end_time=T)
             rows.append((v, r))
         print(f"| {label} | wall [s] | Newton its | ms per Newton iteration | kernel ms/call |\n|---|---|---|---|---|")
         per = []

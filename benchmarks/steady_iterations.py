@@ -1,4 +1,4 @@
-"""Newton iterations and kernel passes of the steady solve, case by case (issue 11), in one run.
+"""Newton iterations and kernel passes of the steady solve, case by case, in one run.
 
 For each case (the paper's examples and their coarse variants, Fig. 12's coils and the coarse
 sweep's, the industry worked pulls, the 100 m study route, the 100 m and, with ``--long``, 1 km
@@ -8,13 +8,15 @@ passes, the solve's wall time, the pulling force and whether the exact-step cont
 (Newton iterations > steps tried: a one-iteration step takes exactly one).
 
 ``--set NAME=VALUE`` overrides a constant of :mod:`exucable.solve.steady` (e.g. ``RATE_FALL=16``)
-to compare a rule across all cases; ``--tight`` also solves each case to 1/1000 of the stop
+to compare a rule across all cases (the solver takes no settings object: the constant is set for
+this script's solves and restored after them); ``--tight`` also solves each case to 1/1000 of the stop
 tolerance and prints how far the pulling force moves (how converged it is); ``--trace CASE``
 prints, for each accepted pseudo-time step of one case, its residual and the check points whose
 contact state (δ > 0) still differs from the converged one.
 
     nice .venv/bin/python benchmarks/steady_iterations.py [--only ex4,ex3] [--long] [--tight]
     nice .venv/bin/python benchmarks/steady_iterations.py --trace ex4
+    nice .venv/bin/python benchmarks/steady_iterations.py --quick     # smoke run: ex2-coarse only
 """
 
 from __future__ import annotations
@@ -115,12 +117,28 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="override a constant of exucable.solve.steady")
     ap.add_argument("--trace", metavar="CASE", help="per-step residual and contact state of one case")
+    ap.add_argument("--quick", action="store_true", help="smoke run: the case ex2-coarse only")
     args = ap.parse_args(argv)
+    if args.quick and not args.only:
+        args.only = "ex2-coarse"
+    overrides = {}
     for item in args.set:
         key, value = item.split("=", 1)
         if not hasattr(solve_steady_module, key):
             ap.error(f"--set {item}: exucable.solve.steady has no {key}")
-        setattr(solve_steady_module, key, type(getattr(solve_steady_module, key))(float(value)))
+        overrides[key] = type(getattr(solve_steady_module, key))(float(value))
+    saved = {key: getattr(solve_steady_module, key) for key in overrides}
+    for key, value in overrides.items():
+        setattr(solve_steady_module, key, value)
+    try:
+        return run(ap, args)
+    finally:
+        for key, value in saved.items():
+            setattr(solve_steady_module, key, value)
+
+
+def run(ap, args) -> int:
+    """The table (or the trace) of the cases ``args`` names."""
     table = cases(long=args.long or (args.only is not None and "bench-1km" in args.only))
     if args.trace:
         if args.trace not in table:

@@ -23,7 +23,8 @@ Then, if ``--example4`` is given, steady Example 4 against dynamic Example 4 (``
 (scenario → build → solve → result files), and their ratio, in this one run.
 
 Run: ``nice .venv/bin/python benchmarks/steady_scale.py [--lengths 10 100 1000] [--dynamic-max 100]
-[--tolerance-check] [--mesh-check] [--example4]``.
+[--tolerance-check] [--mesh-check] [--example4]``; ``--quick``: the 10 m route in both modes only (a smoke
+run: no fit).
 """
 
 from __future__ import annotations
@@ -163,7 +164,7 @@ def tolerance_check(length_m: float) -> str:
             f"{f1:.6f} N at {t1:g} ({s1} steps, {n1} Newton): change {100 * (f1 / f0 - 1):+.2e} %")
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--lengths", type=float, nargs="+", default=[10.0, 100.0, 1000.0])
     ap.add_argument("--dynamic-max", type=float, default=100.0,
@@ -176,7 +177,10 @@ def main() -> None:
     ap.add_argument("--mesh-check", action="store_true",
                     help="solve the longest route again in steady mode with twice the elements")
     ap.add_argument("--case", nargs=3, metavar=("LENGTH_M", "MODE", "ELEMENTS_PER_M"), help=argparse.SUPPRESS)
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="smoke run: the 10 m route in both modes only")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.lengths, args.dynamic_max = [10.0], 10.0
     if args.case:
         print(json.dumps(one_case(float(args.case[0]), args.case[1], float(args.case[2]))))
         return

@@ -12,7 +12,8 @@ Prints the best wall time of ``--repeat`` interleaved rounds, cases per minute a
 1-worker throughput ratio, all measured in this one run. The machine's load average is printed too: on a shared machine the ratio can only
 be as good as the idle cores.
 
-Run: ``.venv/bin/python benchmarks/sweep_scaling.py [--cases 4] [--repeat 2]`` (about a minute).
+Run: ``.venv/bin/python benchmarks/sweep_scaling.py [--cases 4] [--repeat 2]`` (about a minute);
+``--quick``: 2 cases, one round (a smoke run).
 """
 
 from __future__ import annotations
@@ -64,12 +65,15 @@ def timed_inline(sweep) -> tuple[float, int]:
     return wall, ok
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", type=int, default=4, help="cases in the sweep (default 4)")
     ap.add_argument("--repeat", type=int, default=2,
                     help="rounds; each configuration's best round is reported (default 2)")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="smoke run: 2 cases, one round")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.cases, args.repeat = 2, 1
     sweep = make_sweep(args.cases)
     n = len(sweep.cases)
     print(f"sweep of {n} cases on {BASE.relative_to(ROOT)}; cores available: {len(os.sched_getaffinity(0))}; "

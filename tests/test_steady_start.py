@@ -5,7 +5,7 @@ the exit, gravity): from the rope start the pulling force falls for the whole ru
 the cable out of the bend's bending boundary layer, with the axial mode ringing on top; from the
 steady start, laid out past the bend, it stays where it started. The comparison is with the steady
 mode solved independently at the same extent (the dynamic run's ``reference_pulled_out_m``).
-Coarse and short (seconds); the full routes are ``benchmarks/industry_dynamic.py``.
+Coarse and short (seconds); the full routes are ``studies/industry_dynamic.py``.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """How far each Newton iterate of a step is from the step's converged state, check point by check
-point (issue 15): where Newton overshoots, by how much, and how fast it comes back.
+point: where Newton overshoots, by how much, and how fast it comes back.
 
 Runs a scenario from its start to ``--to``, records the state at every contact force call after
 ``--from`` and, for every step with at least ``--min-iterates`` iterates, prints per iterate: the
@@ -7,7 +7,11 @@ largest node position and velocity error against the step's last iterate (and wh
 points touching, the sum of normal forces, the range of penetration errors δ - δ_final, the normal
 force error (total, and the element with most) and the points whose damping clip is on.
 
-    nice .venv/bin/python benchmarks/newton_iterates.py scenarios/paper_ex4_spatial.toml --from 0.07 --to 0.108
+    nice .venv/bin/python studies/newton_iterates.py scenarios/paper_ex4_spatial.toml --from 0.07 --to 0.108
+    nice .venv/bin/python studies/newton_iterates.py --quick   # smoke run: the fast Example 2 over its first 3 ms
+
+``--no-hold`` sets :data:`exucable.solve.dynamic.HOLD_ONSET` (a module setting; ``simulate`` takes no
+settings object) for this run and restores it after.
 
 Linear convergence shows as a penetration error shrinking by a constant factor per iterate
 (1/2: Newton on a quadratic, e.g. a damping force ∝ δ·δ̇; 1/3: on δ^1.5 from above).
@@ -21,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import exucable.solve.dynamic as solve  # noqa: E402
@@ -29,14 +34,25 @@ from contact_flips import record_force_calls  # noqa: E402
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scenario")
+    ap.add_argument("scenario", nargs="?", help="scenario file (required unless --quick)")
     ap.add_argument("--from", dest="t_from", type=float, default=0.07, help="first time recorded [s]")
     ap.add_argument("--to", dest="t_to", type=float, default=0.108, help="end time of the run [s]")
     ap.add_argument("--min-iterates", type=int, default=5)
     ap.add_argument("--no-hold", action="store_true", help="damping onset g(δ) of every iterate (solve.HOLD_ONSET)")
+    ap.add_argument("--quick", action="store_true",
+                    help="smoke run: scenarios/fast/paper_ex2_bend90.toml from 0 to 3 ms, steps of >= 2 iterates")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.scenario = args.scenario or str(ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml")
+        args.t_from, args.t_to, args.min_iterates = 0.0, 0.003, 2
+    if not args.scenario:
+        ap.error("scenario: give a scenario file (or --quick)")
+    hold = solve.HOLD_ONSET
     solve.HOLD_ONSET = not args.no_hold
-    model, calls = record_force_calls(args.scenario, args.t_from, args.t_to)
+    try:
+        model, calls = record_force_calls(args.scenario, args.t_from, args.t_to)
+    finally:
+        solve.HOLD_ONSET = hold
     impl = model.coupling.kernel._impl
     n_k = impl.nh.shape[0]
     steps = {}
@@ -47,6 +63,8 @@ def main(argv=None) -> int:
         d = np.linalg.norm(state["residual_m"], axis=1) - impl.gap
         return np.nan_to_num(d, nan=-1.0)
 
+    print(f"# {Path(args.scenario).name}: {len(calls)} force calls in [{args.t_from}, {args.t_to}] s, "
+          f"{sum(len(v) >= args.min_iterates for v in steps.values())} steps of >= {args.min_iterates} iterates\n")
     for t, its in steps.items():
         if len(its) < args.min_iterates:
             continue

@@ -1,4 +1,4 @@
-"""Is the Newton Jacobian exact? A finite-difference check of the whole Exudyn residual (issue 15).
+"""Is the Newton Jacobian exact? A finite-difference check of the whole Exudyn residual.
 
 Runs a scenario with Exudyn's own solver and, at chosen Newton iterations, compares the system
 Jacobian that Exudyn assembled (mass term, ANCF elements, contact coupling, start-up damper,
@@ -14,8 +14,9 @@ contraction 0.2; ρ ≪ 0.1 says the Jacobian is exact and the slowness comes fr
 (non-smoothness: check points entering and leaving contact between iterations). Run it with a
 tiny ``--eps`` (1e-12: the derivative) and a larger one (1e-8: how far the residual stays linear).
 
-    nice .venv/bin/python benchmarks/jacobian_check.py scenarios/paper_ex4_spatial.toml \
+    nice .venv/bin/python studies/jacobian_check.py scenarios/paper_ex4_spatial.toml \
         --from-time 0.0022 --checks 2 --eps 1e-12
+    nice .venv/bin/python studies/jacobian_check.py --quick   # smoke run: the fast Example 2, one check
 """
 
 from __future__ import annotations
@@ -83,14 +84,21 @@ def fd_jacobian(solver, mbs, settings, eps: float) -> np.ndarray:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scenario")
+    ap.add_argument("scenario", nargs="?", help="scenario file (required unless --quick)")
     ap.add_argument("--from-time", type=float, default=0.0022, help="check iterations of steps after this time [s]")
     ap.add_argument("--checks", type=int, default=3, help="number of Newton iterations to check")
     ap.add_argument("--eps", type=float, default=1e-8, help="finite-difference step along Δ [m, -]")
     ap.add_argument("--exudyn", action="append", default=[], metavar="KEY=VALUE",
                     help="dotted attribute of SimulationSettings.timeIntegration")
     ap.add_argument("--save", default=None, help="save J, J_fd and r to SAVE_k.npz")
+    ap.add_argument("--quick", action="store_true",
+                    help="smoke run: scenarios/fast/paper_ex2_bend90.toml, one check after 1 ms")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.scenario = args.scenario or str(ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml")
+        args.from_time, args.checks = 0.001, 1
+    if not args.scenario:
+        ap.error("scenario: give a scenario file (or --quick)")
     sc = load_scenario(args.scenario)
     model = build_model(sc)
     mbs = model.mbs
@@ -144,6 +152,8 @@ def main(argv=None) -> int:
                      q=np.array(sd.GetODE2Coordinates(cur)), v=np.array(sd.GetODE2Coordinates_t(cur)))
 
     mbs.SetPreNewtonResidualUserFunction(check)
+    print(f"# {Path(args.scenario).name}: Exudyn's Jacobian against central differences (eps {args.eps:g}), "
+          f"{args.checks} Newton iterations after t = {args.from_time} s\n", flush=True)
 
     def stop_when_done(mbs_, t):
         return len(done) < args.checks

@@ -1,14 +1,15 @@
 """Three-point bending predicted: the beam-in-conduit model's change of the pulling force against its own
-EJ → 0 limit, for the industry routes and the bending-stiffness study's `tight` bend (issue 10, items 6–7).
+EJ → 0 limit, for the industry routes and the bending-stiffness study's `tight` bend.
 
 `exucable.quasistatic.beam.stiff_route_difference` — an independent steady beam in the conduit (a node chain
 with unilateral round walls, the weight, Coulomb friction; not Exudyn, not ANCF) — at two node spacings
 (λ/10 and λ/20), beside nothing of exucable's own: reference/README.md sets these predictions beside the
 measured exucable − rope with clearance (`exucable validate --suite industry`, `bending_stiffness_study.py`).
 
-    nice .venv/bin/python benchmarks/beam_conduit_study.py                 # minutes per route on a loaded machine
-    nice .venv/bin/python benchmarks/beam_conduit_study.py --ej-scale 0.1  # a cable 10x less stiff
-    nice .venv/bin/python benchmarks/beam_conduit_study.py --only gera --levels 1
+    nice .venv/bin/python studies/beam_conduit_study.py                 # minutes per route on a loaded machine
+    nice .venv/bin/python studies/beam_conduit_study.py --ej-scale 0.1  # a cable 10x less stiff
+    nice .venv/bin/python studies/beam_conduit_study.py --only gera --levels 1
+    nice .venv/bin/python studies/beam_conduit_study.py --quick   # smoke run: the tight bend, EJ 4, λ/10 only
 
 Prints a Markdown table (and writes ``--json``).
 """
@@ -61,7 +62,11 @@ def main(argv=None):
     ap.add_argument("--levels", type=int, default=2, help="node spacings λ/10, λ/20, ... (default 2)")
     ap.add_argument("--only", action="append", help="cases whose label contains this (repeatable)")
     ap.add_argument("--json", type=Path, help="write the rows here")
+    ap.add_argument("--quick", action="store_true",
+                    help="smoke run: the tight bend without gravity at EJ 4 N m², node spacing λ/10 only")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.only, args.levels = ["tight EJ 4"], 1
     cases = [industry_case(n, d, args.ej_scale) for n, d in INDUSTRY] + [tight_case(g, e, args.ej_scale) for g, e in TIGHT]
     if args.only:
         cases = [c for c in cases if any(o in c["label"] for o in args.only)]

@@ -1,4 +1,4 @@
-"""Bending stiffness at a bend, predicted and measured (issue 10, items 5–6).
+"""Bending stiffness at a bend, predicted and measured.
 
 exucable's pulling force against the rope with clearance (the EJ → 0 limit, `exucable.quasistatic.clearance`)
 on single bends, sweeping the bending length √(EJ/T_in)/R (T_in the rope's tension entering the
@@ -15,11 +15,12 @@ also gets the gravity term of the linearised duct model (`exucable.quasistatic.d
 crossing the floor's trough to a horizontal bend's inner wall, or held by its weight on a
 down-bend's floor, which the in-plane model lacks.
 
-    nice .venv/bin/python benchmarks/bending_stiffness_study.py --json reference/bending_stiffness_study.json \\
+    nice .venv/bin/python studies/bending_stiffness_study.py --json reference/bending_stiffness_study.json \\
         --figure reference/bending_stiffness.png                            # ~10 min on 2 loaded cores
-    nice .venv/bin/python benchmarks/bending_stiffness_study.py --case tight --ej 1.0 --refine
-    nice .venv/bin/python benchmarks/bending_stiffness_study.py --from-json reference/bending_stiffness_study.json
-    nice .venv/bin/python benchmarks/bending_stiffness_study.py --from-json reference/bending_stiffness_study.json \\
+    nice .venv/bin/python studies/bending_stiffness_study.py --case tight --ej 1.0 --refine
+    nice .venv/bin/python studies/bending_stiffness_study.py --quick    # smoke run: one row, tight, EJ 4
+    nice .venv/bin/python studies/bending_stiffness_study.py --from-json reference/bending_stiffness_study.json
+    nice .venv/bin/python studies/bending_stiffness_study.py --from-json reference/bending_stiffness_study.json \\
         --gravity-terms --figure reference/bending_stiffness.png        # add the duct model's gravity terms
 
 Prints a Markdown table.
@@ -197,7 +198,7 @@ def by_case(rows) -> list[list[dict]]:
 
 
 def mesh_table(rows) -> str:
-    """Issue 10's mesh check of every case: the study's mesh against the refined one (pulling force of
+    """The mesh check of every case: the study's mesh against the refined one (pulling force of
     each, their difference, bound 0.2 %) and the wall time of each solve."""
     out = ["| case | gravity | c [mm] | EJ [N m²] | meshes (elements × check points) | pulling force per mesh [N] | "
            "study mesh vs refined | wall per mesh [s] |", "|---|---|---|---|---|---|---|---|"]
@@ -300,7 +301,11 @@ def main(argv=None) -> int:
                         "rewrite the JSON (no exucable runs)")
     p.add_argument("--mesh-report", action="store_true",
                    help="with --from-json: the mesh check of every case (pulling force and wall time per mesh)")
+    p.add_argument("--quick", action="store_true",
+                   help="smoke run: one row of the sweep (tight, no gravity, EJ 4 N m², the coarsest mesh)")
     a = p.parse_args(argv)
+    if a.quick and not a.from_json:
+        a.case, a.gravity, a.ej = "tight", False, 4.0
     if a.mass is not None and a.case:
         CASES[a.case]["mass_kg_per_m"] = a.mass
     if a.from_json:

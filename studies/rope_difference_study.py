@@ -1,4 +1,4 @@
-"""What separates exucable from the rope: bending stiffness and the clearance (issue 10, item 6).
+"""What separates exucable from the rope: bending stiffness and the clearance.
 
 On single bends the pulling force of exucable is compared with two flexible references:
 the centreline rope (``exucable.quasistatic.rope``: no bending stiffness, glued to the conduit's centreline)
@@ -7,20 +7,21 @@ wall and hang in free spans across the clearance). The sweep varies the bending 
 √(EJ/T) against the bend radius R (``cable.bending_stiffness``, at a fixed EA; the references do
 not depend on it) and the clearance c against R, with and without gravity:
 
-- ``hbend``: a horizontal 90° bend, R 3 m, between 2 m straights; the issue's 18 mm fibre cable
+- ``hbend``: a horizontal 90° bend, R 3 m, between 2 m straights; an 18 mm fibre cable
   (0.21 kg/m, μ 0.5, 100 N back tension); without gravity and with it (then the cable rolls
   from the floor of the straights to the bend's inner side: a 3D path);
-- ``upbend`` / ``downbend``: a 60° vertical bend, R 5 m, between a 5 m and a 3 m straight, the
-  issue's 1 kg/m cable (μ 0.3, 200 N back tension), gravity on.
+- ``upbend`` / ``downbend``: a 60° vertical bend, R 5 m, between a 5 m and a 3 m straight,
+  a 1 kg/m cable (μ 0.3, 200 N back tension), gravity on.
 
 Both references are evaluated for the cable's extent at the mean time of the averaging window
 (``exucable.quasistatic.extent``: the cable leaves the conduit at the pull speed, so the length inside
 shrinks and the part beyond the exit pulls along the exit line with its weight). Each exucable
 run stops once steady (0.2 s window, 0.1 %); its scatter is the standard deviation there.
 
-    nice .venv/bin/python benchmarks/rope_difference_study.py            # the table (~15 min on 2 cores)
-    nice .venv/bin/python benchmarks/rope_difference_study.py --case upbend --clearance 0.01 --ej 7.9
-    nice .venv/bin/python benchmarks/rope_difference_study.py --figure reference/rope_difference.png
+    nice .venv/bin/python studies/rope_difference_study.py            # the table (~15 min on 2 cores)
+    nice .venv/bin/python studies/rope_difference_study.py --case upbend --clearance 0.01 --ej 7.9
+    nice .venv/bin/python studies/rope_difference_study.py --figure reference/rope_difference.png
+    nice .venv/bin/python studies/rope_difference_study.py --quick   # smoke run: the c → 0 table, one coarse row
 
 Prints a Markdown table; ``--json FILE`` keeps the rows, ``--figure`` plots them.
 """
@@ -41,7 +42,7 @@ sys.path.insert(0, str(ROOT))
 
 CABLE_RADIUS_M = 0.009
 SPEED_M_PER_S = 0.2
-# The issue's fibre cable: EA = 1.3e5 N whatever EJ is (EJ is given on its own, as for a stranded
+# The fibre cable: EA = 1.3e5 N whatever EJ is (EJ is given on its own, as for a stranded
 # cable; deriving it from E would make a low-EJ cable axially soft, and its axial mode, 4L/√(EA/ρA)
 # ≈ 0.8 s with EJ = 0.079 N m² from E, then rang in the pulling force by ±0.5 %).
 YOUNGS_MODULUS_PA = 5e8
@@ -240,7 +241,13 @@ def main(argv=None) -> int:
     p.add_argument("--clearance-limit", action="store_true",
                    help="only the rope with clearance against the centreline rope as c → 0 (seconds)")
     p.add_argument("--mesh-report", help="reprint the mesh check written by --mesh-check to this JSON file")
+    p.add_argument("--quick", action="store_true",
+                   help="smoke run: the c → 0 table and the sweep's first row (hbend, no gravity, c 8.4 mm, "
+                        "EJ 7.9 N m²) on a coarse mesh (0.25 m elements, check points 20 mm apart)")
     a = p.parse_args(argv)
+    if a.quick:
+        a.case, a.no_gravity, a.clearance, a.ej = "hbend", True, 0.0084, 7.9
+        a.element_length, a.check_spacing = 0.25, 0.02
     if a.mesh_report:
         print(MESH_HEADER)
         for row in json.loads(Path(a.mesh_report).read_text()):
