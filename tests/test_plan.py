@@ -321,8 +321,14 @@ def test_without_limits_the_plan_says_not_checked(tmp_path, capsys):
 @pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
 def test_an_infinite_tension_fails_with_or_without_limits():
     """A tension past what a float holds (a back tension of 1.79e308 N grown by friction) is infinite,
-    and that fails a check of its own instead of passing unchecked."""
-    plan = _plan(pull__back_tension=1.79e308)
+    and that fails a check of its own instead of passing unchecked. The scenario's ranges refuse such a
+    back tension in one line (pull.back_tension ≤ 1e8 N, μ × turning ≤ 50), so the guard is reached
+    here only with the value forced past them."""
+    with pytest.raises(ScenarioError, match=r"^pull\.back_tension: must be <= 1e\+08 \(N\)"):
+        _plan(pull__back_tension=1.79e308)
+    scenario, spec = parse_plan_scenario(_data(), ROOT)
+    object.__setattr__(scenario.pull, "back_tension_N", 1.79e308)   # past the parser, as a bug would
+    plan = plan_pull(scenario, spec)
     for name in ("forward", "reverse"):
         d = plan["directions"][name]
         assert not math.isfinite(d["max_tension_N"])
