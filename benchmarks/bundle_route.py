@@ -56,7 +56,10 @@ def main(argv=None) -> int:
     p.add_argument("--length", type=float, default=100.0, help="route length [m] (approximately)")
     p.add_argument("--repeat", type=int, default=1)
     p.add_argument("--out", default="out/bundle-benchmark")
+    p.add_argument("--quick", action="store_true", help="two cables on a 12 m route (a smoke run)")
     args = p.parse_args(argv)
+    if args.quick:      # the smoke run: two cables on a short route
+        args.count, args.length, args.repeat = 2, 12.0, 1
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     bends_m = 3 * 0.5 * 3.14159265 * 5.0 + 3.14159265 / 6 * 5.0

@@ -20,6 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # script -> a line fragment of the table header it prints (how a reader finds the table)
 SCRIPTS = {
+    "benchmarks/bundle_route.py": "ratio bundle / one cable",
     "benchmarks/contact_kernel.py": "ms/eval",
     "benchmarks/fixed_cost.py": "| command | wall, median [s]",
     "benchmarks/industry_suite.py": "pull force [N]",
@@ -39,12 +40,17 @@ SCRIPTS = {
     "studies/mesh_study.py": "| route | default mesh | default [N]",
     "studies/newton_iterates.py": "force calls in",
     "studies/rope_difference_study.py": "| case | gravity | c [mm] | c/R | EJ [N m²]",
+    "studies/slow_pull.py": "force [N]",
+    "studies/tension_profile.py": "| route | refine | elements | pull [N]",
+    "studies/fit_engines.py": "mu_rope",
 }
 
 # the slowest smoke runs, 10-35 s each on the shared 2-core machine (several processes each importing
 # Exudyn and numba, or an industry route of hundreds of elements): run with -m slow
 SLOW = {"benchmarks/naive_baseline.py", "benchmarks/run_examples.py", "benchmarks/sweep_scaling.py",
-        "benchmarks/industry_suite.py", "studies/industry_dynamic.py"}
+        "benchmarks/industry_suite.py", "studies/industry_dynamic.py",
+        # minutes even in their smoke runs: two cables through four bends; multibody steady runs both ways
+        "benchmarks/bundle_route.py", "studies/fit_engines.py"}
 
 
 def test_every_script_is_smoke_tested():

@@ -30,7 +30,7 @@ def test_steady_force_is_the_capstan_value_at_every_pull_speed(speed_m_per_s):
     """Five decades of pull speed (the regularised law gave -8.8 % at 1 mm/s, -24.7 % at 0.1 mm/s).
     Tolerance 0.2 %: the coarse mesh's own error against the capstan value is -0.06 % at 0.1 m/s;
     the contact damping on δ̇ = n·V r' moves it by a further 0.03 % over these speeds
-    (benchmarks/slow_pull.py)."""
+    (studies/slow_pull.py)."""
     sc = load_scenario(EX2_FAST).replace(**{"pull.speed": speed_m_per_s, "solver.mode": "steady"})
     res = run_scenario(sc)
     s = res.summary

@@ -218,7 +218,7 @@ FIELDS: tuple[Field, ...] = (
       None, gt=0.0, ge=1.0e-9, ours=True, derived=True, default_doc="1 % of `pull.speed`",
       rule="> 0: dynamic mode's friction direction v_τ/√(|v_τ|² + ε²); at 1 % of the pull speed the friction at "
            "that speed is 99.995 % developed whatever the speed (a fixed 1 mm/s gave −4.5 % on Example 2 at "
-           "1 mm/s, benchmarks/slow_pull.py); a run where it develops less than 1 − 1e-4 of μ is flagged "
+           "1 mm/s, studies/slow_pull.py); a run where it develops less than 1 − 1e-4 of μ is flagged "
            "`friction_underdeveloped`. Steady mode slides at the pull speed and uses fully developed friction",
       le=10.0, why="1/ε must stay finite"),
     F("contact.check_points_per_element", "check_points_per_element", "int", "", None, ge=1,

@@ -8,7 +8,7 @@ the latter with the scenario's friction regularisation velocity ε (default 1 % 
 the pulling force, its error against the capstan value, the status, the friction factor
 V/√(V² + ε²) and the wall time, all measured in this one run.
 
-    nice .venv/bin/python benchmarks/slow_pull.py [--speeds 1e-4 1e-3 1e-2 1e-1 1] [--relative 0.01]
+    nice .venv/bin/python studies/slow_pull.py [--speeds 1e-4 1e-3 1e-2 1e-1 1] [--relative 0.01]
 """
 
 from __future__ import annotations
@@ -33,7 +33,10 @@ def main() -> None:
     ap.add_argument("--fixed", type=float, default=None,
                     help="also dynamic runs with contact.friction_regularisation_velocity = this [m/s] at every speed")
     ap.add_argument("--modes", nargs="+", default=["steady", "dynamic"])
+    ap.add_argument("--quick", action="store_true", help="two speeds, steady mode only (a smoke run)")
     args = ap.parse_args()
+    if args.quick:      # the smoke run: two speeds in steady mode
+        args.speeds, args.modes = [1e-3, 1e-1], ["steady"]
     base = load_scenario(ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml")
     print(f"coarse Example 2, capstan {CAPSTAN_N:.4f} N")
     print(f"{'mode':8} {'eps':>9} {'V [m/s]':>9} {'force [N]':>10} {'error':>9} {'factor':>9} {'status':>10} "

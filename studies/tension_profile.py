@@ -13,7 +13,7 @@ inside; the target is ≤ 1 %), and the largest change of each profile when the 
 The change on halving is given as its largest value (dominated by a friction step that moves with the
 check points near a bend end) and its root mean square along the cable.
 
-Run: ``nice .venv/bin/python benchmarks/tension_profile.py [--only NAME] [--refine 1 2] [--mode steady|dynamic]``
+Run: ``nice .venv/bin/python studies/tension_profile.py [--only NAME] [--refine 1 2] [--mode steady|dynamic]``
 (dynamic: each route with ``solver.start_from = "steady"`` and ``solver.steady_stop``).
 """
 
@@ -74,7 +74,10 @@ def main() -> None:
     ap.add_argument("--only", action="append", help="routes whose name contains this (repeatable)")
     ap.add_argument("--refine", type=float, nargs="+", default=[1.0, 2.0], help="mesh refinements (default 1 2)")
     ap.add_argument("--mode", choices=("steady", "dynamic"), default="steady", help="solver mode (default steady)")
+    ap.add_argument("--quick", action="store_true", help="the first route on one mesh (a smoke run)")
     args = ap.parse_args()
+    if args.quick:      # the smoke run: one route, one mesh
+        args.refine = [1.0]
     cases = [(f"{n} {d}", dataclasses.replace(
         sc := load_scenario(ROOT / "scenarios" / "industry" / f"{n}.toml"),
         pull=dataclasses.replace(sc.pull, direction=d))) for n, d in INDUSTRY]
@@ -82,6 +85,8 @@ def main() -> None:
               for name, data in study_routes()]
     if args.only:
         cases = [c for c in cases if any(o in c[0] for o in args.only)]
+    if args.quick:
+        cases = cases[-1:]      # the last study route (the shortest to solve)
     if args.mode == "dynamic":
         cases = [(n, sc.replace(**{"solver.start_from": "steady", "solver.steady_stop": True})) for n, sc in cases]
     print("| route | refine | elements | pull [N] | band [N] | EA·ε range [N] | beyond band [% pull] "

@@ -8,7 +8,7 @@ near the head, so this is an estimate). T_mb at the scenario's μ is fitted by t
 (``exucable.fit``: the same grid, spline and least squares as ``exucable fit``), noise-free; the printed
 μ_rope − μ says how far a rope fit of a log that followed the multibody model would be off.
 
-Run: ``nice .venv/bin/python benchmarks/fit_engines.py [ROUTE ...]`` (default: the four one-cable routes).
+Run: ``nice .venv/bin/python studies/fit_engines.py [ROUTE ...]`` (default: the four one-cable routes).
 """
 
 from __future__ import annotations
@@ -33,7 +33,10 @@ HERE = Path(__file__).resolve().parent.parent / "scenarios" / "industry"
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("routes", nargs="*", default=ROUTES)
+    ap.add_argument("--quick", action="store_true", help="the first route only (a smoke run)")
     args = ap.parse_args()
+    if args.quick:      # the smoke run: the first route only
+        args.routes = args.routes[:1]
     print(f"{'route':34s} {'dir':8s} {'mu':>6s} {'mu_rope':>8s} {'diff %':>7s} {'pull mb/rope-1 %':>17s} {'rows':>5s} "
           f"{'wall s':>7s}")
     for name in args.routes:
