@@ -67,6 +67,12 @@ _COARSEN = 4
 # levels below 4000 segments cost more than they saved (100 m: 150 -> 210 ms, commscope: 190 -> 260 ms),
 # and Example 2's 559 segments, which open no long spans, 18 -> 26 ms.
 _COARSEN_REQUESTED_ABOVE = 800
+# Nodes of the default chain beyond which its spacing grows past 2 cm (1 km and longer): the solve's
+# cost is linear in the nodes, and the free spans of a long route's high tensions are tens of metres
+# long. Measured on a 10 km route (30 mm cable in a 60 mm duct, 15° bends of 10 m radius): 2 cm,
+# 500 000 nodes, 11.1 s CPU; 20 cm 1.9 s; the pulling force differs by 3e-6 relative
+# (benchmarks/long_routes.py --clearance-spacing).
+_MAX_NODES = 50_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,9 +146,11 @@ def default_node_spacing_m(centreline, clearance_m: float) -> float:
 
     A hundredth of the tightest bend radius (each node turns 0.01 rad; the discrete capstan's
     error is O((μ·0.01)³) per node) and at most 2 cm (free spans across 10 mm clearances are
-    metres long); at least 400 nodes over the route.
+    metres long), or on routes over 1 km at most a ``_MAX_NODES``-th of the route; at least 400
+    nodes over the route.
     """
-    h = min(0.01 * centreline.min_bend_radius_m, 0.02, centreline.length_m / 400.0)
+    L = centreline.length_m
+    h = min(0.01 * centreline.min_bend_radius_m, max(0.02, L / _MAX_NODES), L / 400.0)
     return float(h)
 
 
