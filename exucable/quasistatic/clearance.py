@@ -70,8 +70,8 @@ _COARSEN_REQUESTED_ABOVE = 800
 # Nodes of the default chain beyond which its spacing grows past 2 cm (1 km and longer): the solve's
 # cost is linear in the nodes, and the free spans of a long route's high tensions are tens of metres
 # long. Measured on a 10 km route (30 mm cable in a 60 mm duct, 15° bends of 10 m radius): 2 cm,
-# 500 000 nodes, 11.1 s CPU; 20 cm 1.9 s; the pulling force differs by 3e-6 relative
-# (benchmarks/long_routes.py --clearance-spacing).
+# 500 000 nodes, 11.8 s CPU; the default 10 cm there (the bends' rule) 3.4 s; the pulling force
+# differs by 1.5e-5 relative (benchmarks/long_routes.py --clearance-spacing).
 _MAX_NODES = 50_000
 
 
