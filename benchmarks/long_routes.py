@@ -3,27 +3,29 @@
 Realistic long routes: a 30 mm power cable (1.5 kg/m, EA = 14 MN) in a 60 mm duct, gravity,
 μ = 0.2, 500 N back tension, a 15° bend (radius 10 m) every ~350 m, alternating left/up/right/down so
 that the straights between the vertical bends slope; the mesh and the check points are the
-scenario's default rules (:func:`route_scenario`).
+scenario's default rules (:func:`route_data`).
 
 Each length runs in its own process (so that its peak memory is its own): the process imports
 exucable, parses the scenario, builds the model (the start layout and both rope references
 included), solves steady, post-processes (tension profile, check-point loads, pressure, bends,
 trust), writes the result files and draws the three figures, each stage timed on its own. The
 parent times the whole child process (interpreter start to exit). Printed per length: elements,
-check points, Newton iterations, the wall time of each stage and its share of the whole, the
+check points, Newton iterations, the wall time of each stage and its share of the whole, the CPU
+time of the whole process and of each stage (on a shared, loaded machine the CPU times are the ones
+to compare), the
 contact kernel's share of the solve, the solve's time per Newton iteration, peak memory (ru_maxrss)
 and the pulling force against the rope with clearance; then the exponent p of a least-squares fit
-whole-process wall ∝ L^p, measured in this one run.
+whole-process wall (and CPU time) ∝ L^p, measured in this one run.
 
 ``--profile`` runs the longest route once more under cProfile (in this process, after a short
-warm-up) and prints the functions with the most own time and the steady Newton loop's split:
-contact kernel (forces and exact Jacobian), Exudyn's static solver (assembling the system
-Jacobian and residual, factorising and solving the sparse system) and our Python callbacks.
+warm-up) and prints Exudyn's own timers of its static solver per Newton iteration (system
+Jacobian, factorisation, residual) and the functions with the most own and cumulative time (the
+contact kernel, our coupling's and the pseudo-time spring's user functions, the build's parts).
 
 Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--clearance-spacing]``;
 ``--clearance-spacing`` solves the longest route's rope with clearance at a 2 cm node spacing and at
 the default rule's, with the pulling force's change and the CPU time of each.
-``--quick`` is a smoke run (a 200 m and a 400 m route, no figures' worth of data).
+``--quick`` is a smoke run (a 200 m and a 400 m route).
 """
 
 from __future__ import annotations
