@@ -67,6 +67,14 @@ _COARSEN = 4
 # levels below 4000 segments cost more than they saved (100 m: 150 -> 210 ms, commscope: 190 -> 260 ms),
 # and Example 2's 559 segments, which open no long spans, 18 -> 26 ms.
 _COARSEN_REQUESTED_ABOVE = 800
+# Nodes of the default chain beyond which its spacing grows past 2 cm (routes over 2 km): the solve's
+# cost is linear in the nodes, and the free spans of a long route's high tensions are tens of metres
+# long. Measured on a 10 km route (30 mm cable in a 60 mm duct, 15° bends of 10 m radius): 2 cm,
+# 500 000 nodes, 11.8 s CPU; 10 cm 3.4 s; the pulling force differs by 1.5e-5 relative
+# (benchmarks/long_routes.py --clearance-spacing). A light cable at low tension needs the finer
+# chain: an 18 mm cable, 8 mm clearance, μ 0.5, 100 N back tension, 10 km of 20 m bends moved by
+# 2.5e-4 at 10 cm and 1.4e-3 at 20 cm, hence no coarser than 10 cm at 10 km.
+_MAX_NODES = 100_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,9 +148,11 @@ def default_node_spacing_m(centreline, clearance_m: float) -> float:
 
     A hundredth of the tightest bend radius (each node turns 0.01 rad; the discrete capstan's
     error is O((μ·0.01)³) per node) and at most 2 cm (free spans across 10 mm clearances are
-    metres long); at least 400 nodes over the route.
+    metres long), or on routes over 2 km at most a ``_MAX_NODES``-th of the route; at least 400
+    nodes over the route.
     """
-    h = min(0.01 * centreline.min_bend_radius_m, 0.02, centreline.length_m / 400.0)
+    L = centreline.length_m
+    h = min(0.01 * centreline.min_bend_radius_m, max(0.02, L / _MAX_NODES), L / 400.0)
     return float(h)
 
 

@@ -1,0 +1,299 @@
+"""Cost of a steady run against route length, stage by stage: 1, 2, 5, 10 km.
+
+Realistic long routes: a 30 mm power cable (1.5 kg/m, EA = 14 MN) in a 60 mm duct, gravity,
+μ = 0.2, 500 N back tension, a 15° bend (radius 10 m) every ~350 m, alternating left/up/right/down so
+that the straights between the vertical bends slope; the mesh and the check points are the
+scenario's default rules (:func:`route_data`).
+
+Each length runs in its own process (so that its peak memory is its own): the process imports
+exucable, parses the scenario, builds the model (the start layout and both rope references
+included), solves steady, post-processes (tension profile, check-point loads, pressure, bends,
+trust), writes the result files and draws the three figures, each stage timed on its own. The
+parent times the whole child process (interpreter start to exit). Printed per length: elements,
+check points, Newton iterations, the wall time of each stage and its share of the whole, the CPU
+time of the whole process and of each stage (on a shared, loaded machine the CPU times are the ones
+to compare), the
+contact kernel's share of the solve, the solve's time per Newton iteration, peak memory (ru_maxrss)
+and the pulling force against the rope with clearance; then the exponent p of a least-squares fit
+whole-process wall (and CPU time) ∝ L^p, measured in this one run.
+
+``--profile`` runs the longest route once more under cProfile (in this process, after a short
+warm-up) and prints Exudyn's own timers of its static solver per Newton iteration (system
+Jacobian, factorisation, residual) and the functions with the most own and cumulative time (the
+contact kernel, our coupling's and the pseudo-time spring's user functions, the build's parts).
+
+Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--clearance-spacing]``;
+``--clearance-spacing`` solves the longest route's rope with clearance at a 2 cm node spacing and at
+the default rule's, with the pulling force's change and the CPU time of each.
+``--quick`` is a smoke run (a 200 m and a 400 m route).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+CABLE_RADIUS_M = 0.015
+MASS_PER_LENGTH_KG_PER_M = 1.5
+AXIAL_STIFFNESS_N = 14.0e6
+DUCT_INNER_RADIUS_M = 0.030
+BEND_SPACING_M = 350.0
+BEND_ANGLE_DEG = 15.0
+BEND_RADIUS_M = 10.0
+
+
+def route_path(length_m: float) -> list[dict]:
+    """Straights and 15° bends adding up to ``length_m`` [m], one bend per ~350 m (at least one),
+    turning left, up, right, down in turn (the straights after an up or down bend slope)."""
+    import math
+
+    turns = ["left", "up", "right", "down"]
+    n_bends = max(1, int(round(length_m / BEND_SPACING_M)))
+    arc = math.radians(BEND_ANGLE_DEG) * BEND_RADIUS_M
+    straight = (length_m - n_bends * arc) / (n_bends + 1)
+    path = [{"straight": straight}]
+    for i in range(n_bends):
+        path.append({"bend": BEND_ANGLE_DEG, "radius": BEND_RADIUS_M, "turn": turns[i % 4]})
+        path.append({"straight": straight})
+    return path
+
+
+def route_data(length_m: float) -> dict:
+    """The scenario (as a TOML-like dict) of a route of ``length_m`` [m], steady mode."""
+    import math
+
+    area = math.pi * CABLE_RADIUS_M ** 2
+    return {
+        "name": f"long-route-{length_m:g}m",
+        "cable": {"radius": CABLE_RADIUS_M, "mass_per_length": MASS_PER_LENGTH_KG_PER_M,
+                  "youngs_modulus": AXIAL_STIFFNESS_N / area},
+        "conduit": {"inner_radius": DUCT_INNER_RADIUS_M, "path": route_path(length_m)},
+        "contact": {"friction": 0.2},
+        "pull": {"speed": 0.1, "back_tension": 500.0},
+        "gravity": {"g": 9.81},
+        "solver": {"mode": "steady", "end_time": 1.0},   # end_time: required, unused by a steady solve
+    }
+
+
+class _Clock:
+    """Wall [s] and this process's CPU time [s] of each stage (CPU time: robust on a loaded machine)."""
+
+    def __init__(self):
+        self.wall, self.cpu = {}, {}
+        self._t = (time.perf_counter(), time.process_time())
+
+    def lap(self, name: str) -> None:
+        now = (time.perf_counter(), time.process_time())
+        self.wall[name], self.cpu[name] = now[0] - self._t[0], now[1] - self._t[1]
+        self._t = now
+
+
+def one_case(length_m: float, figures: bool = True) -> dict:
+    """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints)."""
+    clock = _Clock()
+    from exucable.output.results import write_results
+    from exucable.plots.results import plot_pressure, plot_pull_force, plot_tension_profile
+    from exucable.run import run_scenario
+    from exucable.scenario.specs import parse_scenario
+    clock.lap("import_s")
+    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    clock.lap("parse_s")
+    res = run_scenario(sc, None, plots=False)
+    clock.lap("run_s")
+    s = res.summary
+    # run_scenario times its build and its solve; the rest of it is post-processing
+    t = {k: clock.wall[k] for k in ("import_s", "parse_s")}
+    t["build_s"] = s["build_time_s"]
+    t["solve_s"] = s["wall_time_s"]
+    t["post_s"] = clock.wall["run_s"] - s["build_time_s"] - s["wall_time_s"]
+
+    out = Path(tempfile.mkdtemp(prefix="exucable-long-routes-"))
+    try:
+        clock.lap("rest")
+        write_results(out, res, plots=False)
+        clock.lap("write_s")
+        if figures:
+            plot_pull_force(out / "pull_force.png", res)
+            plot_tension_profile(out / "tension_profile.png", res)
+            if res.pressure_profile is not None:
+                plot_pressure(out / "pressure.png", res)
+        clock.lap("figures_s")
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+    return {"length_m": length_m, "status": s["status"], "message": s["message"],
+            "elements": s["scenario"]["cable"]["elements"],
+            "check_points": s["scenario"]["cable"]["elements"] * s["mesh"]["check_points_per_element"],
+            "newton_iterations": s["newton_iterations"], "steps": s["steps"],
+            "kernel_s": s["kernel_time_s"], "pull_force_N": s["pull_force_N"],
+            "rope_clearance_pull_force_N": s["rope_clearance_pull_force_N"],
+            "rope_pull_force_N": s["rope_pull_force_N"],
+            "write_s": clock.wall["write_s"], "figures_s": clock.wall["figures_s"],
+            "cpu_s": {k: v for k, v in clock.cpu.items() if k != "rest"},
+            "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **t}
+
+
+def in_child(length_m: float, figures: bool) -> dict:
+    """:func:`one_case` in a fresh process; adds the whole process's wall time ``process_s``."""
+    cmd = [sys.executable, __file__, "--case", f"{length_m:g}"] + ([] if figures else ["--no-figures"])
+    t0 = time.perf_counter()
+    cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - t0
+    cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (cpu1.ru_utime - cpu0.ru_utime) + (cpu1.ru_stime - cpu0.ru_stime)
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr[-2000:]}")
+    return dict(json.loads(done.stdout.strip().splitlines()[-1]), process_s=wall, process_cpu_s=cpu)
+
+
+STAGES = ("import_s", "parse_s", "build_s", "solve_s", "post_s", "write_s", "figures_s")
+
+
+def report(r: dict) -> str:
+    whole = r["process_s"]
+    stages = "  ".join(f"{k[:-2]} {r[k]:6.2f} ({100 * r[k] / whole:3.0f} %)" for k in STAGES)
+    n = max(r["newton_iterations"], 1)
+    F, Fc = r["pull_force_N"], r["rope_clearance_pull_force_N"]
+    vs = f"{100 * (F / Fc - 1):+.2f} %" if F is not None and Fc else "-"
+    return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process {whole:6.2f} s  "
+            f"elements {r['elements']:5d}  check points {r['check_points']:7d}  Newton {r['newton_iterations']:4d} "
+            f"({r['steps']} pseudo-time steps)  peak RSS {r['peak_rss_MB']:5.0f} MB\n"
+            f"{'':9s}{stages}  (outside them: interpreter start and exit "
+            f"{whole - sum(r[k] for k in STAGES):5.2f})\n"
+            f"{'':9s}CPU time: whole process {r['process_cpu_s']:6.2f} s; "
+            + "  ".join(f"{k[:-2]} {v:6.2f}" for k, v in r["cpu_s"].items()) + "\n"
+            f"{'':9s}solve per Newton iteration {1e3 * r['solve_s'] / n:6.1f} ms, of which contact kernel "
+            f"{1e3 * r['kernel_s'] / n:6.1f} ms ({100 * r['kernel_s'] / max(r['solve_s'], 1e-12):3.0f} %);  "
+            f"F {'-' if F is None else f'{F:.1f}'} N, vs rope with clearance {vs}"
+            + (f"\n{'':9s}{r['message']}" if r["message"] else ""))
+
+
+def profile(length_m: float, top: int = 25) -> None:
+    """cProfile of one steady run of ``length_m`` [m] (after a short warm-up in this process)."""
+    import contextlib
+    import cProfile
+    import io
+    import pstats
+
+    from exucable.run import run_scenario
+    from exucable.scenario.specs import parse_scenario
+
+    import exudyn as exu
+
+    import exucable.solve.steady as steady
+
+    run_scenario(parse_scenario(route_data(200.0), ROOT, default_name="route"), None, plots=False)
+    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    # Exudyn's own timers of its static solver, summed over the solves (they run only when asked
+    # for by show.computationTime, which also prints them: the output is captured and dropped)
+    parts = ("jacobianODE2", "factorization", "ODE2RHS", "newtonIncrement", "total")
+    timers = dict.fromkeys(parts, 0.0)
+    base_solver, base_settings = exu.MainSolverStatic, steady.quiet_sparse
+
+    class TimedSolver(base_solver):
+        def SolveSystem(self, mbs, settings):
+            ok = super().SolveSystem(mbs, settings)
+            for k in parts:
+                timers[k] += getattr(self.timer, k)
+            return ok
+
+    def timed_settings(settings):
+        settings = base_settings(settings)
+        settings.show.computationTime = True
+        return settings
+
+    exu.MainSolverStatic, steady.quiet_sparse = TimedSolver, timed_settings
+    pr = cProfile.Profile()
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            pr.enable()
+            res = run_scenario(sc, None, plots=False)
+            pr.disable()
+    finally:
+        exu.MainSolverStatic, steady.quiet_sparse = base_solver, base_settings
+    s = res.summary
+    n = max(s["newton_iterations"], 1)
+    print(f"Exudyn's static solver per Newton iteration (its timers, wall): total {1e3 * timers['total'] / n:.1f} ms = "
+          + ", ".join(f"{k} {1e3 * timers[k] / n:.1f} ms ({100 * timers[k] / max(timers['total'], 1e-12):.0f} %)"
+                      for k in parts[:-1])
+          + f"; of the system Jacobian, our contact coupling's and pseudo-time spring's user functions and the "
+            f"contact kernel are in the cProfile below")
+    buf = io.StringIO()
+    st = pstats.Stats(pr, stream=buf)
+    st.sort_stats("tottime").print_stats(top)
+    print(f"cProfile of {length_m / 1000:g} km: build {s['build_time_s']:.2f} s, solve {s['wall_time_s']:.2f} s, "
+          f"Newton {s['newton_iterations']}, kernel {s['kernel_time_s']:.2f} s")
+    print(buf.getvalue())
+    buf = io.StringIO()
+    pstats.Stats(pr, stream=buf).sort_stats("cumulative").print_stats(top)
+    print(buf.getvalue())
+
+
+def clearance_spacing(length_m: float, spacings_m=(0.02, None)) -> None:
+    """The rope with clearance of the route of ``length_m`` [m] at node spacings ``spacings_m``
+    (None: the default rule), with its pulling force and the CPU time of each solve."""
+    import math
+
+    from exucable.quasistatic.clearance import default_node_spacing_m, solve_rope_with_clearance
+    from exucable.scenario.specs import parse_scenario
+
+    centre = parse_scenario(route_data(length_m), ROOT, default_name="route").build_conduit().centreline
+    clearance = DUCT_INNER_RADIUS_M - CABLE_RADIUS_M
+    first = None
+    for h in spacings_m:
+        h = default_node_spacing_m(centre, clearance) if h is None else h
+        t0 = time.process_time()
+        r = solve_rope_with_clearance(centre, clearance, 0.2, MASS_PER_LENGTH_KG_PER_M * 9.81, 500.0,
+                                      node_spacing_m=h)
+        cpu = time.process_time() - t0
+        first = first if first is not None else r.pull_force_N
+        print(f"rope with clearance, {length_m / 1000:g} km, node spacing {100 * h:5.1f} cm "
+              f"({math.ceil(length_m / h)} nodes): pulling force {r.pull_force_N:.4f} N "
+              f"({r.pull_force_N / first - 1:+.1e} relative), CPU {cpu:.2f} s", flush=True)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--lengths", type=float, nargs="+", default=[1000.0, 2000.0, 5000.0, 10000.0])
+    ap.add_argument("--quick", action="store_true", help="smoke run: 200 m and 400 m")
+    ap.add_argument("--profile", action="store_true", help="also cProfile the longest route")
+    ap.add_argument("--clearance-spacing", action="store_true",
+                    help="also the longest route's rope with clearance at 2 cm and at the default node spacing")
+    ap.add_argument("--no-figures", action="store_true", help="skip the figures stage")
+    ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.case:
+        print(json.dumps(one_case(float(args.case), figures=not args.no_figures)))
+        return
+    lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
+    walls = []
+    for L in lengths:
+        r = in_child(L, figures=not args.no_figures)
+        print(report(r), flush=True)
+        if r["status"] != "failed":
+            walls.append((L, r["process_s"], r["solve_s"], r["process_s"] - r["solve_s"], r["process_cpu_s"]))
+    if len(walls) >= 2:
+        import numpy as np
+
+        L, w, solve, rest, cpu = np.array(walls).T
+        fit = lambda y: np.polyfit(np.log(L), np.log(y), 1)[0]
+        print(f"whole process ∝ L^{fit(w):.2f}, solve ∝ L^{fit(solve):.2f}, everything but the solve ∝ "
+              f"L^{fit(rest):.2f}, whole process's CPU time ∝ L^{fit(cpu):.2f} over {', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
+        print(f"share of everything but the solve at {L[-1]:g} m: {100 * rest[-1] / w[-1]:.0f} %")
+    if args.clearance_spacing:
+        clearance_spacing(lengths[-1])
+    if args.profile:
+        profile(lengths[-1])
+
+
+if __name__ == "__main__":
+    main()
