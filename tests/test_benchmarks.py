@@ -24,6 +24,7 @@ SCRIPTS = {
     "benchmarks/contact_kernel.py": "ms/eval",
     "benchmarks/fixed_cost.py": "| command | wall, median [s]",
     "benchmarks/industry_suite.py": "pull force [N]",
+    "benchmarks/long_routes.py": "everything but the solve",
     "benchmarks/naive_baseline.py": "| | whole process [s] | simulation [s]",
     "benchmarks/newton_cost.py": "| case | check points | steps | Newton its",
     "benchmarks/newton_trace.py": "| accepted steps | rejected attempts",
