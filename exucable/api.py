@@ -20,7 +20,6 @@ dotted key. Nothing here imports Exudyn until :func:`run` is called.
 from __future__ import annotations
 
 import itertools
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Sequence
@@ -240,9 +239,10 @@ class Result:
     pull_force_N : float
         Mean pulling force in the steady window [N] (NaN if nothing was recorded).
     pull_force_uncertainty_N : float
-        Its uncertainty [N]: ``summary["pull_force_uncertainty_N"]`` when the run wrote one, else
-        √(σ² + d²) of the steady window (σ the scatter, d the drift of the least-squares line
-        across it): how steady the number is, not how mesh-converged.
+        Its uncertainty [N], ``summary["pull_force_uncertainty_N"]`` (NaN where the summary has
+        none): in steady mode the discretisation's and the solve's (a second solve on a coarser
+        mesh, :mod:`exucable.solve.error_bar`), in dynamic mode the steady window's scatter and
+        drift; ``summary["pull_force_uncertainty_method"]`` says which.
     status : str
         ``"ok"``, ``"steady"`` (stopped once steady) or ``"failed"``.
     message : str
@@ -285,13 +285,8 @@ def _number(value) -> float:
 
 
 def _uncertainty(summary: dict) -> float:
-    if summary.get("pull_force_uncertainty_N") is not None:
-        return float(summary["pull_force_uncertainty_N"])
-    std = _number(summary.get("pull_force_std_N"))
-    drift = _number(summary.get("steady_drift_N"))
-    if math.isnan(drift):
-        return std
-    return math.hypot(std, drift)
+    # the summary's own value, NaN where it states none: a made-up substitute would read as a bound
+    return _number(summary.get("pull_force_uncertainty_N"))
 
 
 def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False) -> Result:

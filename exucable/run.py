@@ -19,7 +19,7 @@ from .output.results import RunResult, write_results
 from .scenario.specs import Scenario, load_scenario
 from .post.pressure import bend_table, default_window_m, pressure_profile
 from .post.tension import SteadyState, detect_steady_state, tension_at, tension_profile
-from .post.trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
+from .post.trust import AxisGauge, DYNAMIC_LIMIT, PENETRATION_LIMIT, assess, not_steady_fix, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile"]
 
@@ -131,12 +131,16 @@ def _assess(model, out, st, h, pull_force_N):
         pull_force_N=(model.rope.pull_force_N if model.rope is not None
                       else pull_force_N if pull_force_N is not None else float("nan")),
         steady_window_s=sc.solver.steady_window_s, steady_tolerance=sc.solver.steady_tolerance,
-        end_time_s=out.end_time_s, base_status=out.status)
+        end_time_s=out.end_time_s, base_status=out.status,
+        not_steady_fix=not_steady_fix(force_controlled=sc.pull.force_N is not None, start_from=sc.solver.start_from,
+                                      exit_span_damping_1_per_s=sc.solver.exit_span_damping_1_per_s,
+                                      pretension=sc.solver.pretension))
 
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
                  steady_stop: bool | None = None, refine: float = 1.0,
-                 check_points_per_element: int | None = None, mode: str | None = None) -> RunResult:
+                 check_points_per_element: int | None = None, mode: str | None = None,
+                 error_bar: bool = True) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
@@ -144,7 +148,9 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     written. Invalid input raises :class:`~exucable.errors.ExucableError` before anything runs.
     ``refine`` divides the mesh's element length and ``check_points_per_element`` overrides the
     scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
-    ``solver.mode``.
+    ``solver.mode``. ``error_bar``: a steady solve states its uncertainty from a second solve on a
+    coarser mesh (:mod:`exucable.solve.error_bar`); False skips that solve (its uncertainty is then
+    None), as ``exucable converge`` does, whose levels are the error bar.
     """
     from .model.build import build_model
     from .solve.dynamic import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
@@ -161,11 +167,20 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     first = None
     if sc.solver.start_from == "steady" and sc.solver.mode == "dynamic" and sc.pull.force_N is None and sc.solver.pretension:
         first = steady_start(sc, refine=refine, check_points_per_element=check_points_per_element)
-    model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element,
+    coarse = None
+    solve_refine, points = refine, check_points_per_element
+    if _steady_on_the_rule(sc):
+        # steady mode solves on the rule's mesh refined STEADY_REFINE times, elements and check-point
+        # spacing alike; the rule's own mesh is the error bar's coarse solve (exucable.solve.error_bar)
+        from .scenario.mesh import STEADY_REFINE
+        coarse = build_model(sc, refine=refine, check_points_per_element=points)
+        solve_refine, points = refine * STEADY_REFINE, coarse.mesh.check_points_per_element
+    model = build_model(sc, refine=solve_refine, check_points_per_element=points,
                         start=first.layout if first is not None else None)
     build_s = time.perf_counter() - t_start
     sp = sc.solver
     recorder = None
+    bar = None
     if sp.mode == "steady":
         from .solve.steady import solve_steady
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
@@ -178,6 +193,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         i0 = max(len(h["time_s"]) - 1, 0)
         refs = extent_references(sc, model, model.start.lead_out_m)
         pf = None
+        if error_bar and out.status != "failed" and len(h["time_s"]):
+            from .solve.error_bar import steady_error_bar
+            quantity = steady_quantity(model)
+            bar = steady_error_bar(sc, model, float(h[quantity][-1]), quantity, coarse=coarse, refine=solve_refine)
     else:
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
         snapshot_times = sc.output.times_s(sp.end_time_s)
@@ -195,6 +214,11 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         # extent, evaluated at the window's mean time): remove that drift first
         pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"],
                                     st.from_s if np.isfinite(st.from_s) else 0.0) if len(h["time_s"]) else None
+    if sp.mode == "steady":
+        uncertainty = _steady_uncertainty(sc, bar, out)
+    else:
+        uncertainty = {"pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
+                       "pull_force_uncertainty_method": (pf.method if pf else "no history: none")}
     q, _ = model.coordinates()
     x, N = tension_profile(q, model.layout.element_length_m, model.axial_stiffness_N)
     points = check_point_loads(model)
@@ -204,6 +228,7 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     summary = {
         "name": sc.name,
         "mode": sp.mode,
+        "mode_rule": sp.mode_rule,
         "status": out.status,
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
@@ -211,14 +236,15 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
         if len(h["time_s"]) else None,
         "reference_drift_N_per_s": drift,
-        "pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
+        **uncertainty,
         "pull_force_drift_N_per_s": pf.drift_N_per_s + drift if pf else None,
         "pull_force_unexplained_drift_N_per_s": pf.drift_N_per_s if pf else None,
         "pull_force_uncertainty": ({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
                                     "periods": pf.periods, "period_s": pf.period_s,
                                     "window_s": list(pf.window_s),
                                     "method": pf.method + (f"; after removing the references' expected drift "
-                                                           f"{drift:.4g} N/s" if drift else "")} if pf else None),
+                                                           f"{drift:.4g} N/s" if drift else "")} if pf
+                                   else bar.to_dict() if bar is not None else None),
         "steady_quantity": steady_quantity(model),
         "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
@@ -242,7 +268,8 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         "reference_pulled_out_m": refs.get("pulled_out_m"),
         **pressure_info,
         "bends": bends,
-        "mesh": model.mesh.to_dict() if model.mesh is not None else None,
+        "mesh": (dict(model.mesh.to_dict(), steady_refine=solve_refine / refine)
+                 if model.mesh is not None else None),
         "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
         "scenario": sc.to_dict(),
         "versions": versions(),
@@ -283,6 +310,25 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     if out_dir is not None:
         write_results(out_dir, result, plots=plots)
     return result
+
+
+def _steady_on_the_rule(sc) -> bool:
+    """A steady solve on the mesh rule's mesh (no ``cable.elements`` or ``cable.element_length`` given)."""
+    return (sc.solver.mode == "steady" and "elements" in sc.cable.derived_keys
+            and sc.cable.element_length_m is None)
+
+
+def _steady_uncertainty(sc, bar, out) -> dict:
+    """The summary's uncertainty keys of a steady solve from its error bar (None: none made)."""
+    if bar is None:
+        why = "the steady solve failed" if out.status == "failed" else "not asked for (error_bar=False)"
+        return {"pull_force_uncertainty_N": None, "pull_force_uncertainty_method": f"none: {why}"}
+    if sc.pull.force_N is not None:
+        # the pulling force is given; what the solve finds is the trailing tension
+        return {"pull_force_uncertainty_N": 0.0, "pull_force_uncertainty_method": "prescribed (pull.force)",
+                "trailing_tension_uncertainty_N": bar.uncertainty_N,
+                "trailing_tension_uncertainty_method": bar.method}
+    return {"pull_force_uncertainty_N": bar.uncertainty_N, "pull_force_uncertainty_method": bar.method}
 
 
 def _refuse_pulling_the_cable_out(sc) -> None:

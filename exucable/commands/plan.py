@@ -32,10 +32,11 @@ CHECK_COLUMNS = ("direction", "name", "passed", "value", "limit", "margin", "whe
 def add_arguments(p) -> None:
     p.add_argument("scenario", help="scenario file (TOML), with optional [limits], cable.count, cable.arrangement")
     p.add_argument("--out", default=None, help="output directory (default: plan_<scenario name>)")
-    p.add_argument("--engine", choices=ENGINES, default="rope",
-                   help="rope (default, instant, any cable.count); steady (one static solve per direction) or "
-                        "dynamic (a dynamic run per direction, with progress): the multibody model of one cable, "
-                        "the rope's values beside")
+    p.add_argument("--engine", choices=ENGINES, default="auto",
+                   help="auto (default): steady for one cable, rope for cable.count > 1; steady (one static solve "
+                        "per direction, seconds) or dynamic (a dynamic run per direction, with progress; needs "
+                        "solver.end_time): the multibody model of one cable, the rope's values beside; rope "
+                        "(instant, any cable.count)")
     p.add_argument("--units", choices=SYSTEMS, default=None,
                    help="units of the printed tables and the report (default: the scenario's display.units); "
                         "the file's bare numbers are always read in its own display.units")
@@ -102,6 +103,7 @@ def main(args) -> int:
     plan = plan_pull(scenario, spec, engine=args.engine, progress=True)
     units = spec.units
     f = display_unit("force", units)
+    print(f"{scenario.name}: engine {plan['engine']} ({plan['engine_rule']})")
     print(f"{scenario.name}: {plan['count']} cable(s), {plan['arrangement']}, weight correction "
           f"{plan['weight_correction_factor']:.4g}, jam ratio {plan['jam_ratio']:.3g} ({plan['jam_risk']}), "
           f"clearance {from_si(plan['clearance_m'], 'length', units, small=True):.3g} {display_unit('length', units, small=True)}")
@@ -110,6 +112,9 @@ def main(args) -> int:
         print(f"\n{name} pull: pull force {from_si(d['pull_force_N'], 'force', units):.4g} {f}, "
               f"max tension {from_si(d['max_tension_N'], 'force', units):.4g} {f}")
         if "rope_pull_force_N" in d:
+            u = d.get("pull_force_uncertainty_N")
+            if u is not None:
+                print(f"  pull force uncertainty ± {from_si(u, 'force', units):.2g} {f}")
             print(f"  {plan['engine']} engine, {d['elements']} elements: status {d['status']}"
                   f"{'; ' + d['message'] if d['message'] else ''}; rope: pull force "
                   f"{from_si(d['rope_pull_force_N'], 'force', units):.4g} {f}, max tension "

@@ -50,9 +50,13 @@ def main(args) -> int:
                        mode=args.mode)
     s = res.summary
     rope = s.get("rope_pull_force_N")
+    if s.get("mode") == "steady":
+        # no scatter, no drift: the error bar is the mesh's and the solve's (summary: pull_force_uncertainty)
+        spread = "mesh and solve tolerance"
+    else:
+        spread = f"sd {_f(s['pull_force_std_N'], '.2g')} N, drift {_f(s['pull_force_drift_N_per_s'], '.2g')} N/s"
     print(f"{sc.name}: status {s['status']}, pulling force {_f(s['pull_force_N'])} N "
-          f"(± {_f(s['pull_force_uncertainty_N'], '.2g')} N, sd {_f(s['pull_force_std_N'], '.2g')} N, "
-          f"drift {_f(s['pull_force_drift_N_per_s'], '.2g')} N/s), trailing tension {_f(s['trailing_tension_N'])} N, "
+          f"(± {_f(s['pull_force_uncertainty_N'], '.2g')} N: {spread}), trailing tension {_f(s['trailing_tension_N'])} N, "
           f"max tension {_f(s['max_tension_N'])} N")
     if s["steady_quantity"] == "trailing_tension_N":     # force-controlled: T2 is the result
         ref, got, what = s.get("rope_trailing_tension_N"), s["trailing_tension_N"], "trailing tension"
@@ -64,7 +68,7 @@ def main(args) -> int:
     if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
         print(f"  rope with clearance: pulling force {ref_c:.6g} N ({100 * (got / ref_c - 1):+.3f} %)")
     if s.get("mode") == "steady":
-        print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
+        print(f"  steady mode ({s['mode_rule']}): {s['message']}: {s['steps']} solves, "
               f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     else:
         print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
@@ -75,8 +79,9 @@ def main(args) -> int:
               "`exucable compile` builds ahead-of-time kernels that later runs load instead")
     m = s.get("mesh") or {}
     if m:
+        refined = f", refined {m['steady_refine']:g}x for steady mode" if m.get("steady_refine", 1.0) != 1.0 else ""
         print(f"  mesh: {m['elements']} elements of {m['element_length_m']:.4g} m ({m['source']}; rule "
-              f"{m['rule_element_length_m']:.4g} m), {m['check_points_per_element']} check points per element")
+              f"{m['rule_element_length_m']:.4g} m{refined}), {m['check_points_per_element']} check points per element")
     for w in s.get("warnings", []):
         print(f"  warning: {w}", file=sys.stderr)
     if s["status"] == "failed":
