@@ -9,7 +9,8 @@ default's mesh: levels of elements and check-point spacing both refined by 2), w
 estimate. A row passes when |F − F∞| ≤ u and u ≤ 0.3 % of F.
 
 The whole process (``python -m exucable run FILE --out DIR``: import, scenario, both solves,
-post-processing, result files and figures) is timed in a subprocess, the median of ``--repeat``.
+post-processing, result files and figures) is timed in a subprocess, the median of ``--repeat``:
+wall time, and the child's CPU time (user + system), which a loaded machine does not stretch.
 
     nice .venv/bin/python benchmarks/steady_error_bar.py                      # every case (minutes)
     nice .venv/bin/python benchmarks/steady_error_bar.py --only downbend --levels 4
@@ -23,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -58,16 +60,21 @@ def user_scenario(path: Path, tmp: Path) -> Path:
     return out
 
 
-def whole_process_s(path: Path, out: Path, repeat: int) -> tuple[float, list[float]]:
-    times = []
+def whole_process_s(path: Path, out: Path, repeat: int) -> tuple[float, list[float], float]:
+    """Median wall time [s] of ``exucable run`` in a subprocess, each run's, and the median CPU time
+    (user + system of the child) [s], which the machine's other jobs do not stretch."""
+    times, cpus = [], []
     for _ in range(repeat):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         proc = subprocess.run([sys.executable, "-m", "exucable", "run", str(path), "--out", str(out), "--quiet"],
                               capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)))
         times.append(time.perf_counter() - t0)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
         if proc.returncode not in (0, 1):
             raise RuntimeError(f"{path.name}: exucable run exited {proc.returncode}: {proc.stderr.strip()}")
-    return statistics.median(times), times
+    return statistics.median(times), times, statistics.median(cpus)
 
 
 def main(argv=None) -> int:
@@ -84,20 +91,20 @@ def main(argv=None) -> int:
     cases = [c for c in CASES if not args.only or any(o in c for o in args.only)]
     print(f"load average at start: {os.getloadavg()[0]:.1f}")
     print("| case | elements (coarse) | F [N] | u [N] (u/F) | F∞ [N] ± err (order) | F − F∞ | within u | "
-          "whole process [s] | status |")
+          "whole process wall / CPU [s] | status |")
     print("|---|---|---|---|---|---|---|---|---|")
     rows = []
     with tempfile.TemporaryDirectory() as tmpdir:
         tmp = Path(tmpdir)
         for case in cases:
             path = user_scenario(ROOT / "scenarios" / case, tmp)
-            wall, walls = whole_process_s(path, tmp / "run", args.repeat)
+            wall, walls, cpu = whole_process_s(path, tmp / "run", args.repeat)
             s = json.loads((tmp / "run" / "summary.json").read_text())
             F, u = s["pull_force_N"], s["pull_force_uncertainty_N"]
             row = {"case": case, "mode": s["mode"], "status": s["status"], "pull_force_N": F,
                    "uncertainty_N": u, "elements": s["mesh"]["elements"],
                    "coarse_elements": (s.get("pull_force_uncertainty") or {}).get("coarse_elements"),
-                   "whole_process_s": wall, "whole_process_runs_s": walls}
+                   "whole_process_s": wall, "whole_process_runs_s": walls, "whole_process_cpu_s": cpu}
             conv = ""
             if not args.no_converge:
                 sc = load_scenario(path)
@@ -116,7 +123,7 @@ def main(argv=None) -> int:
                 conv = "– | – | –"
             rows.append(row)
             print(f"| {Path(case).stem} | {row['elements']} ({row['coarse_elements']}) | {F:.6g} | "
-                  f"{u:.3g} ({100 * u / F:.3f} %) | {conv} | {wall:.2f} | {s['status']} ({s['mode']}) |", flush=True)
+                  f"{u:.3g} ({100 * u / F:.3f} %) | {conv} | {wall:.2f} / {cpu:.2f} | {s['status']} ({s['mode']}) |", flush=True)
     print(f"load average at end: {os.getloadavg()[0]:.1f}")
     if args.json:
         from exucable.io import atomic_write_text

@@ -173,8 +173,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         # steady mode solves on the rule's mesh refined STEADY_REFINE times, elements and check-point
         # spacing alike; the rule's own mesh is the error bar's coarse solve (exucable.solve.error_bar)
         from .scenario.mesh import STEADY_REFINE
-        coarse = build_model(sc, refine=refine, check_points_per_element=points)
-        solve_refine, points = refine * STEADY_REFINE, coarse.mesh.check_points_per_element
+        if error_bar or points is None:     # without the bar, only for the rule's check points per element
+            coarse = build_model(sc, refine=refine, check_points_per_element=points)
+            points = coarse.mesh.check_points_per_element
+        solve_refine = refine * STEADY_REFINE
     model = build_model(sc, refine=solve_refine, check_points_per_element=points,
                         start=first.layout if first is not None else None)
     build_s = time.perf_counter() - t_start
