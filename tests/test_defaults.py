@@ -159,3 +159,35 @@ def test_down_bend_with_gravity_both_modes_agree_within_their_uncertainties():
     combined = dyn["pull_force_uncertainty_N"] + st["pull_force_uncertainty_N"]
     assert abs(dyn["pull_force_N"] - st["pull_force_N"]) <= combined
     assert combined <= 0.003 * st["pull_force_N"]
+
+
+def test_plan_without_engine_runs_the_multibody_steady_solve_for_one_cable(tmp_path, capsys):
+    from exucable.cli import main as cli_main
+
+    toml = tmp_path / "one.toml"
+    toml.write_text(f"""
+name = "one"
+[cable]
+radius = 0.0025
+density = 1000.0
+youngs_modulus = 1.0e9
+elements = 24
+[conduit]
+inner_radius = 0.0035
+path = [{{ straight = 1.0 }}, {{ bend = 90.0, radius = 0.5, turn = "left" }}, {{ straight = 1.0 }}]
+[contact]
+friction = 0.2
+[pull]
+speed = 0.1
+back_tension = 150.0
+""")
+    assert cli_main(["plan", str(toml), "--out", str(tmp_path / "plan")]) == 0
+    plan = json.loads((tmp_path / "plan" / "plan.json").read_text())
+    assert plan["engine"] == "steady" and plan["engine_rule"].startswith("auto")
+    for name in ("forward", "reverse"):
+        d = plan["directions"][name]
+        assert d["status"] == "ok" and d["pull_force_uncertainty_N"] > 0.0
+        # the rope beside: the capstan, which the steady answer meets within 0.2 %
+        assert d["rope_pull_force_N"] == pytest.approx(CAPSTAN_N, rel=1e-9)
+        assert abs(d["pull_force_N"] / CAPSTAN_N - 1) < 2e-3
+    assert "engine steady (auto" in capsys.readouterr().out

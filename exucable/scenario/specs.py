@@ -821,9 +821,9 @@ class Scenario:
             object.__setattr__(self, "solver", solver)
         if self.solver.mode == "dynamic" and self.solver.end_time_s is None:
             why = "" if "mode" not in self.solver.derived_keys else f" (solver.mode {self.solver.mode_rule})"
+            steady = ", or set solver.mode = \"steady\" (no end_time)" if self.solver.pretension else ""
             raise ScenarioError("solver.end_time", f"required in dynamic mode{why}: give the simulated time [s], "
-                                                   "e.g. end_time = 3.0 with steady_stop = true, or set "
-                                                   "solver.mode = \"steady\" (no end_time)")
+                                                   f"e.g. end_time = 3.0 with steady_stop = true{steady}")
         late = [t for t in self.output.snapshots_s
                 if self.solver.end_time_s is not None and t > self.solver.end_time_s]
         if late:
