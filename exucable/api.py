@@ -259,10 +259,10 @@ class Result:
         Mean pulling force in the steady window [N] (NaN if nothing was recorded); in steady mode the
         pulling force of the steady sliding state.
     pull_force_uncertainty_N : float
-        Its uncertainty [N], as ``summary["pull_force_uncertainty_N"]``: from whole oscillation periods
-        and the drift over the steady window; how steady the number is, not how mesh-converged. NaN
-        where the summary has none (null): a steady-mode result (one static state has no scatter) or a
-        run without a steady window.
+        Its uncertainty [N], ``summary["pull_force_uncertainty_N"]`` (NaN where the summary has
+        none): in steady mode the discretisation's and the solve's (a second solve on a coarser
+        mesh, :mod:`exucable.solve.error_bar`), in dynamic mode the steady window's scatter and
+        drift; ``summary["pull_force_uncertainty_method"]`` says which.
     status : str
         ``"ok"``, ``"steady"`` (stopped once steady), ``"failed"``, or for a result that must not be
         trusted the first of ``"dynamic"``, ``"outside_conduit"``, ``"penetration"``, ``"not_steady"``
@@ -328,13 +328,8 @@ def _number(value) -> float:
 
 
 def _uncertainty(summary: dict) -> float:
-    if "pull_force_uncertainty_N" in summary:      # null (steady mode, no window): NaN, as the summary says
-        return _number(summary["pull_force_uncertainty_N"])
-    std = _number(summary.get("pull_force_std_N"))
-    drift = _number(summary.get("steady_drift_N"))
-    if math.isnan(drift):
-        return std
-    return math.hypot(std, drift)
+    # the summary's own value, NaN where it states none: a made-up substitute would read as a bound
+    return _number(summary.get("pull_force_uncertainty_N"))
 
 
 def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False, mode: str | None = None) -> Result:

@@ -20,7 +20,7 @@ from .output.results import RunResult, write_results
 from .scenario.specs import Scenario, load_scenario
 from .post.pressure import bend_table, default_window_m, pressure_profile
 from .post.tension import SteadyState, detect_steady_state, profile_stations_m
-from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, pull_force_uncertainty
+from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, not_steady_fix, pull_force_uncertainty
 
 __all__ = ["run_scenario", "contact_profile"]
 
@@ -139,7 +139,10 @@ def _assess(model, out, st, h, pull_force_N):
         steady_window_s=sc.solver.steady_window_s, steady_tolerance=sc.solver.steady_tolerance,
         end_time_s=out.end_time_s, base_status=out.status, loaded=is_loaded(sc), friction=sc.contact.friction,
         regularisation_velocity_m_per_s=(sc.contact.friction_regularisation_velocity_m_per_s
-                                         if sc.solver.mode == "dynamic" else None))
+                                         if sc.solver.mode == "dynamic" else None),
+        not_steady_fix=not_steady_fix(force_controlled=sc.pull.force_N is not None, start_from=sc.solver.start_from,
+                                      exit_span_damping_1_per_s=sc.solver.exit_span_damping_1_per_s,
+                                      pretension=sc.solver.pretension))
 
 
 def is_loaded(sc) -> bool:
@@ -151,7 +154,8 @@ def is_loaded(sc) -> bool:
 
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
                  steady_stop: bool | None = None, refine: float = 1.0,
-                 check_points_per_element: int | None = None, mode: str | None = None) -> RunResult:
+                 check_points_per_element: int | None = None, mode: str | None = None,
+                 error_bar: bool = True) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
@@ -162,7 +166,9 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     directory is this run's from before the solve until its files are written.
     ``refine`` divides the mesh's element length and ``check_points_per_element`` overrides the
     scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
-    ``solver.mode``.
+    ``solver.mode``. ``error_bar``: a steady solve states its uncertainty from a second solve on a
+    coarser mesh (:mod:`exucable.solve.error_bar`); False skips that solve (its uncertainty is then
+    None), as ``exucable converge`` does, whose levels are the error bar.
     """
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
@@ -174,14 +180,15 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         solve = _solve
     _refuse_snapshot_times_in_steady_mode(sc)
     if out_dir is None:
-        return solve(sc, quiet, steady_stop, refine, check_points_per_element)
+        return solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
     with owned_out_dir(out_dir) as out:
-        result = solve(sc, quiet, steady_stop, refine, check_points_per_element)
+        result = solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
         write_results(out, result, plots=plots)
     return result
 
 
-def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_per_element) -> RunResult:
+def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_per_element,
+           error_bar: bool = True) -> RunResult:
     """Build and solve a validated scenario and post-process it (no files)."""
     from .model.build import build_model
     from .solve.dynamic import Progress, earliest_steady_s, expected_drift_N_per_s, simulate, steady_quantity  # Exudyn: only when a run is asked for
@@ -191,11 +198,22 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     first = None
     if sc.solver.start_from == "steady" and sc.solver.mode == "dynamic" and sc.pull.force_N is None and sc.solver.pretension:
         first = steady_start(sc, refine=refine, check_points_per_element=check_points_per_element)
-    model = build_model(sc, refine=refine, check_points_per_element=check_points_per_element,
+    coarse = None
+    solve_refine, points = refine, check_points_per_element
+    if _steady_on_the_rule(sc):
+        # steady mode solves on the rule's mesh refined STEADY_REFINE times, elements and check-point
+        # spacing alike; the rule's own mesh is the error bar's coarse solve (exucable.solve.error_bar)
+        from .scenario.mesh import STEADY_REFINE
+        if error_bar or points is None:     # without the bar, only for the rule's check points per element
+            coarse = build_model(sc, refine=refine, check_points_per_element=points)
+            points = coarse.mesh.check_points_per_element
+        solve_refine = refine * STEADY_REFINE
+    model = build_model(sc, refine=solve_refine, check_points_per_element=points,
                         start=first.layout if first is not None else None)
     build_s = time.perf_counter() - t_start
     sp = sc.solver
     recorder = None
+    bar = None
     if sp.mode == "steady":
         from .output.snapshots import SnapshotRecorder
         from .solve.steady import solve_steady
@@ -214,6 +232,10 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         i0 = max(len(h["time_s"]) - 1, 0)
         refs = extent_references(sc, model, model.start.lead_out_m)
         pf = None
+        if error_bar and out.status != "failed" and len(h["time_s"]):
+            from .solve.error_bar import steady_error_bar
+            quantity = steady_quantity(model)
+            bar = steady_error_bar(sc, model, float(h[quantity][-1]), quantity, coarse=coarse, refine=solve_refine)
     else:
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
         snapshot_times = sc.output.times_s(sp.end_time_s)
@@ -231,6 +253,11 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         # extent, evaluated at the window's mean time): remove that drift first
         pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"],
                                     st.from_s if np.isfinite(st.from_s) else 0.0) if len(h["time_s"]) else None
+    if sp.mode == "steady":
+        uncertainty = _steady_uncertainty(sc, bar, out)
+    else:
+        uncertainty = {"pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
+                       "pull_force_uncertainty_method": (pf.method if pf else "no history: none")}
     # the cable's tension from the equilibrium of its loads (exucable.post.tension.equilibrium_tension):
     # EA·ε of the elements oscillates next to the concentrated loads at bend ends
     x = profile_stations_m(model.layout.element_length_m)
@@ -246,6 +273,7 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     summary = {
         "name": sc.name,
         "mode": sp.mode,
+        "mode_rule": sp.mode_rule,
         "status": out.status,
         "message": out.message,
         "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
@@ -253,14 +281,15 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
         if len(h["time_s"]) else None,
         "reference_drift_N_per_s": drift,
-        "pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
+        **uncertainty,
         "pull_force_drift_N_per_s": pf.drift_N_per_s + drift if pf else None,
         "pull_force_unexplained_drift_N_per_s": pf.drift_N_per_s if pf else None,
         "pull_force_uncertainty": ({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
                                     "periods": pf.periods, "period_s": pf.period_s,
                                     "window_s": list(pf.window_s),
                                     "method": pf.method + (f"; after removing the references' expected drift "
-                                                           f"{drift:.4g} N/s" if drift else "")} if pf else None),
+                                                           f"{drift:.4g} N/s" if drift else "")} if pf
+                                   else bar.to_dict() if bar is not None else None),
         "steady_quantity": steady_quantity(model),
         "steady_drift_N": st.drift_N,
         "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
@@ -287,7 +316,8 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         "max_sidewall_pressure_N_per_m": None,     # without contact or rope; else pressure_info's
         **pressure_info,
         "bends": bends,
-        "mesh": model.mesh.to_dict() if model.mesh is not None else None,
+        "mesh": (dict(model.mesh.to_dict(), steady_refine=solve_refine / refine)
+                 if model.mesh is not None else None),
         "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
         "scenario": sc.to_dict(),
         "versions": versions(),
@@ -344,7 +374,8 @@ def _refuse_snapshot_times_in_steady_mode(sc) -> None:
                           "snapshot (snapshot_*.csv, time_s = 0); remove the key or use the dynamic mode")
 
 
-def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_element) -> RunResult:
+def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_element,
+                  error_bar: bool = True) -> RunResult:
     """Several cables in one conduit (``cable.count`` > 1): one steady solve of the bundle
     (:mod:`exucable.model.bundle`), its report in ``summary.json`` and each cable's tension in
     ``cable_tensions.csv``; ``tension_profile.csv`` holds the bundle's, the sum over the cables
@@ -392,6 +423,25 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     result = RunResult(summary=summary, history=h, tension_profile={"x_m": cables["x_m"], "tension_N": total},
                        cable_tensions=cables, model=model)
     return result
+
+
+def _steady_on_the_rule(sc) -> bool:
+    """A steady solve on the mesh rule's mesh (no ``cable.elements`` or ``cable.element_length`` given)."""
+    return (sc.solver.mode == "steady" and "elements" in sc.cable.derived_keys
+            and sc.cable.element_length_m is None)
+
+
+def _steady_uncertainty(sc, bar, out) -> dict:
+    """The summary's uncertainty keys of a steady solve from its error bar (None: none made)."""
+    if bar is None:
+        why = "the steady solve failed" if out.status == "failed" else "not asked for (error_bar=False)"
+        return {"pull_force_uncertainty_N": None, "pull_force_uncertainty_method": f"none: {why}"}
+    if sc.pull.force_N is not None:
+        # the pulling force is given; what the solve finds is the trailing tension
+        return {"pull_force_uncertainty_N": 0.0, "pull_force_uncertainty_method": "prescribed (pull.force)",
+                "trailing_tension_uncertainty_N": bar.uncertainty_N,
+                "trailing_tension_uncertainty_method": bar.method}
+    return {"pull_force_uncertainty_N": bar.uncertainty_N, "pull_force_uncertainty_method": bar.method}
 
 
 def _refuse_pulling_the_cable_out(sc) -> None:

@@ -40,7 +40,7 @@ def make_scenario(**tables):
         "cable": dict(PAPER_CABLE, elements=10),
         "conduit": {"inner_radius": 0.0035, "path": [{"straight": 1.0}]},
         "pull": {"speed": 0.1},
-        "solver": {"end_time": 0.2, "step": 0.01},
+        "solver": {"mode": "dynamic", "end_time": 0.2, "step": 0.01},
     }
     for k, v in tables.items():
         if isinstance(v, dict) and isinstance(data.get(k), dict):

@@ -26,7 +26,7 @@ def test_issue_code_block_gives_the_capstan():
     sc = xc.Scenario(route=route,
                      cable=xc.Cable(radius=2.5e-3, density=1000.0, youngs_modulus=1e9),
                      contact=xc.Contact(friction=0.2), pull=xc.Pull(speed=0.1, back_tension=150.0),
-                     gravity=None, solver=xc.Solver(end_time=0.3))
+                     gravity=None, solver=xc.Solver(mode="dynamic", end_time=0.3))
     res = xc.run(sc)
     reference = capstan_out_N(150.0, 0.2, math.pi / 2)
     assert res.status == "ok", res.message

@@ -29,6 +29,7 @@ SCRIPTS = {
     "benchmarks/newton_cost.py": "| case | check points | steps | Newton its",
     "benchmarks/newton_trace.py": "| accepted steps | rejected attempts",
     "benchmarks/run_examples.py": "| example | status | wall [s]",
+    "benchmarks/steady_error_bar.py": "| case | elements (coarse) | F [N] | u [N] (u/F)",
     "benchmarks/steady_iterations.py": "exact steps",
     "benchmarks/steady_scale.py": "ms/element",
     "benchmarks/sweep_scaling.py": "cases/min",

@@ -42,7 +42,7 @@ def _data(**over):
 
 def _plan(**over):
     scenario, spec = parse_plan_scenario(_data(**over), ROOT)
-    return plan_pull(scenario, spec)
+    return plan_pull(scenario, spec, engine="rope")
 
 
 def test_single_cable_matches_the_closed_form_section_by_section():
@@ -109,7 +109,7 @@ def test_imperial_numbers_equal_si_quantities():
     imp_data["pull"]["back_tension"] = 100.0 / 4.4482216152605
     imp_data["pull"]["speed"] = 0.1 / 0.3048
     scenario, spec = parse_plan_scenario(imp_data, ROOT)
-    imp = plan_pull(scenario, spec)
+    imp = plan_pull(scenario, spec, engine="rope")
     assert imp["directions"]["forward"]["pull_force_N"] == pytest.approx(si["directions"]["forward"]["pull_force_N"],
                                                                          rel=1e-9)
     assert imp["checks"][0]["limit"] == pytest.approx(20e3)
@@ -260,7 +260,7 @@ def test_imperial_file_reads_the_manuals_numbers():
     from exucable.plan.pull import load_plan_scenario
 
     scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml")
-    plan = plan_pull(scenario, spec)
+    plan = plan_pull(scenario, spec, engine="rope")
     lbf, ft = 4.4482216152605, 0.3048
     assert spec.units == "imperial"
     assert plan["inputs"]["weight_per_length_one_cable_N_per_m"] / (lbf / ft) == pytest.approx(0.144, rel=1e-12)
@@ -280,7 +280,7 @@ def test_3d_bends_and_helices_are_named_and_get_a_pressure():
 def test_a_prescribed_pull_force_is_refused_and_slack_is_reported():
     scenario, spec = parse_plan_scenario(_data(pull={"speed": 0.1, "force": 500.0}), ROOT)
     with pytest.raises(ScenarioError) as exc:
-        plan_pull(scenario, spec)
+        plan_pull(scenario, spec, engine="rope")
     assert exc.value.key == "pull.force"
     # 30 deg down a straight with mu 0.3 < tan 30 deg: the reverse pull runs slack (tension 0, not negative).
     plan = _plan(conduit__heading=[math.cos(math.radians(30)), 0.0, math.sin(math.radians(30))],
@@ -331,7 +331,7 @@ def test_an_infinite_tension_fails_with_or_without_limits():
     with pytest.raises(ScenarioError, match=r"^pull\.back_tension"):
         _plan(pull__back_tension=1.79e308)
     scenario, spec = parse_plan_scenario(_data(), ROOT)
-    plan = plan_pull(scenario, spec)
+    plan = plan_pull(scenario, spec, engine="rope")
     for name in ("forward", "reverse"):
         d = dict(plan["directions"][name], max_tension_N=math.inf)
         check = next(c for c in pull._checks(d, spec, scenario, plan["clearance_m"], SimpleNamespace(risk="not applicable"))

@@ -23,7 +23,7 @@ LB_PER_FT = LBF / FT
                          ids=[f"{x['scenario']}-{x['direction']}" for x in REFERENCE["example"]])
 def test_published_section_tensions_and_swbp(example):
     scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / example["scenario"])
-    plan = plan_pull(scenario, spec)
+    plan = plan_pull(scenario, spec, engine="rope")
     rows = plan["directions"][example["direction"]]["sections"]
     mu = scenario.contact.friction
     mu_bend = mu * plan["weight_correction_factor"] if spec.weight_correction_in_bends else mu
@@ -59,7 +59,7 @@ def test_errata_follow_from_their_printed_operands():
 def test_tes_weight_correction_is_the_published_occupancy_factor():
     """TES-P-104.05 p. 10: OF = 1/sqrt(1 - (4.13/(15.4 - 4.13))^2) = 1.07 for the three cables."""
     scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "sec_tes_p_104_05_three_cables.toml")
-    plan = plan_pull(scenario, spec)
+    plan = plan_pull(scenario, spec, engine="rope")
     assert round(plan["weight_correction_factor"], 2) == 1.07 and plan["arrangement"] == "triangular"
     assert plan["weight_correction_in_bends"] is False
 
@@ -67,7 +67,7 @@ def test_tes_weight_correction_is_the_published_occupancy_factor():
 def test_commscope_recommends_the_direction_the_manual_finds_easier():
     # Manual p. 44: pulling from A to H = 64 lb, from H to A = 54 lb.
     scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "commscope_conquest_run_a_h.toml")
-    plan = plan_pull(scenario, spec)
+    plan = plan_pull(scenario, spec, engine="rope")
     assert plan["recommended_direction"] == "reverse"
     assert plan["directions"]["reverse"]["pull_force_N"] < plan["directions"]["forward"]["pull_force_N"]
 
@@ -75,5 +75,5 @@ def test_commscope_recommends_the_direction_the_manual_finds_easier():
 def test_tes_recommends_the_direction_the_standard_finds_easier():
     # Sect. 4.5.2: "Pulling from at point (F) to at point (A) results in considerably less tension".
     scenario, spec = load_plan_scenario(ROOT / "scenarios" / "industry" / "sec_tes_p_104_05_three_cables.toml")
-    plan = plan_pull(scenario, spec)
+    plan = plan_pull(scenario, spec, engine="rope")
     assert plan["recommended_direction"] == "reverse" and plan["passed"]

@@ -14,7 +14,7 @@ def ex2(end_time=0.2):
     route = xc.Route(inner_radius=3.5e-3).straight(1.0).bend(90, radius=0.5, turn="left").straight(1.0)
     return xc.Scenario(route=route, cable=xc.Cable(radius=2.5e-3, density=1000.0, youngs_modulus=1e9),
                        contact=xc.Contact(friction=0.2), pull=xc.Pull(speed=0.1, back_tension=150.0),
-                       solver=xc.Solver(end_time=end_time))
+                       solver=xc.Solver(mode="dynamic", end_time=end_time))
 
 
 def test_initial_layout_needs_no_exudyn_and_is_pretensioned():

@@ -75,7 +75,7 @@ def test_a_pull_starts_on_the_rope_with_clearance():
         "contact": {"friction": 0.3},
         "pull": {"speed": 0.2, "back_tension": 200.0},
         "gravity": {"g": 9.81},
-        "solver": {"end_time": 0.5, "step": 1e-2},
+        "solver": {"mode": "dynamic", "end_time": 0.5, "step": 1e-2},
     }
     sc = parse_scenario(data, ".")
     model = build_model(sc)

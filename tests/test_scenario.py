@@ -77,7 +77,10 @@ BAD = [
      "cable.element_length", "> 0"),
     ("elements-float-zero", with_(base(), ("cable", "elements"), 0.0), "cable.elements", "integer"),
     ("no-speed", with_(base(), ("pull", "speed"), _DELETE), "pull.speed", "required"),
-    ("no-end-time", with_(base(), ("solver", "end_time"), _DELETE), "solver.end_time", "required"),
+    ("no-end-time", with_(with_(base(), ("solver", "mode"), "dynamic"), ("solver", "end_time"), _DELETE),
+     "solver.end_time", "required in dynamic mode"),
+    ("no-end-time-snapshots", with_(with_(base(), ("solver", "end_time"), _DELETE), ("output",), {"snapshots": [0.1]}),
+     "solver.end_time", "snapshots need the time integration"),
     ("no-inner-radius", with_(base(), ("conduit", "inner_radius"), _DELETE), "conduit.inner_radius", "required"),
     # wrong types
     ("radius-bool", with_(base(), ("cable", "radius"), True), "cable.radius", "must be a number"),

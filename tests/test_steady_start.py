@@ -21,7 +21,7 @@ def _scenario(start):
                        cable=xc.Cable(radius=0.01905, mass_per_length=2.2322, youngs_modulus=1e9),
                        contact=xc.Contact(friction=0.3), pull=xc.Pull(speed=0.3048, back_tension=500.0),
                        gravity=xc.Gravity(g=9.80665),
-                       solver=xc.Solver(end_time=0.4, step=1e-2, start_from=start))
+                       solver=xc.Solver(mode="dynamic", end_time=0.4, step=1e-2, start_from=start))
 
 
 def test_steady_start_is_steady_and_agrees_with_steady_mode():

@@ -20,7 +20,7 @@ TINY = dict(
     cable={"radius": 0.0025, "density": 1000.0, "youngs_modulus": 1e9, "elements": 8},
     contact={"friction": 0.2, "check_points_per_element": 8},
     pull={"speed": 0.1, "back_tension": 20.0},
-    solver={"end_time": 0.6, "step": 0.01, "steady_stop": True, "steady_window": 0.1, "steady_tolerance": 5e-3},
+    solver={"mode": "dynamic", "end_time": 0.6, "step": 0.01, "steady_stop": True, "steady_window": 0.1, "steady_tolerance": 5e-3},
 )
 
 

@@ -52,7 +52,7 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
     for level in range(levels):
         refine = ratio**level
         res = run_scenario(sc, out / f"level_{level}", quiet=quiet, plots=False, refine=refine,
-                           check_points_per_element=k0, mode=mode)
+                           check_points_per_element=k0, mode=mode, error_bar=False)
         s = res.summary
         mesh = s["mesh"]
         k0 = mesh["check_points_per_element"] if k0 is None else k0

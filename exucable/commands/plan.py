@@ -36,10 +36,11 @@ def add_arguments(p) -> None:
     p.add_argument("scenario", help="scenario file (TOML) or a shipped scenario's name, with optional [limits], "
                                     "cable.count, cable.arrangement")
     p.add_argument("--out", default=None, help="output directory (default: plan_<scenario name>)")
-    p.add_argument("--engine", choices=ENGINES, default="rope",
-                   help="rope (default, instant, any cable.count); steady (one static solve per direction) or "
-                        "dynamic (a dynamic run per direction, with progress): the multibody model of one cable, "
-                        "the rope's values beside")
+    p.add_argument("--engine", choices=ENGINES, default="auto",
+                   help="auto (default): steady for one cable, rope for cable.count > 1; steady (one static solve "
+                        "per direction, seconds) or dynamic (a dynamic run per direction, with progress; needs "
+                        "solver.end_time): the multibody model of one cable, the rope's values beside; rope "
+                        "(instant, any cable.count)")
     p.add_argument("--units", choices=SYSTEMS, default=None,
                    help="units of the printed tables and the report (default: the scenario's display.units); "
                         "the file's bare numbers are always read in its own display.units")
@@ -140,6 +141,7 @@ def main(args) -> int:
     def force(v):
         return f"{fmt_number(from_si(v, 'force', units))} {f}"
 
+    print(f"{scenario.name}: engine {plan['engine']} ({plan['engine_rule']})")
     print(f"{scenario.name}: {plan['count']} cable(s), {plan['arrangement']}, weight correction "
           f"{fmt_number(plan['weight_correction_factor'])}, jam ratio {fmt_number(plan['jam_ratio'])} ({plan['jam_risk']}), "
           f"clearance {fmt_number(from_si(plan['clearance_m'], 'length', units, small=True))} "
@@ -149,6 +151,9 @@ def main(args) -> int:
         print(f"\n{direction_label(plan, name)} pull: pull force {force(d['pull_force_N'])}, "
               f"max tension {force(d['max_tension_N'])}")
         if "rope_pull_force_N" in d:
+            u = d.get("pull_force_uncertainty_N")
+            if u is not None:
+                print(f"  pull force uncertainty ± {from_si(u, 'force', units):.2g} {f}")
             print(f"  {plan['engine']} engine, {d['elements']} elements: status {d['status']}"
                   f"{'; ' + d['message'] if d['message'] else ''}; rope: pull force "
                   f"{force(d['rope_pull_force_N'])}, max tension {force(d['rope_max_tension_N'])}")

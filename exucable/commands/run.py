@@ -65,8 +65,9 @@ def main(args) -> int:
         return None if v is None else from_si(v, "force", system)
 
     rope = force("rope_pull_force_N")
-    if s.get("mode") == "steady":       # one static state: no scatter, no drift, no time
-        spread = "one steady state"
+    if s.get("mode") == "steady":
+        # no scatter, no drift: the error bar is the mesh's and the solve's (summary: pull_force_uncertainty)
+        spread = f"± {_f(force('pull_force_uncertainty_N'), '.2g')} {N}: mesh and solve tolerance"
     else:
         spread = (f"± {_f(force('pull_force_uncertainty_N'), '.2g')} {N}, sd {_f(force('pull_force_std_N'), '.2g')} "
                   f"{N}, drift {_f(force('pull_force_drift_N_per_s'), '.2g')} {per_s}")
@@ -82,7 +83,7 @@ def main(args) -> int:
     if what == "pulling force" and ref_c is not None and got is not None and np.isfinite(got):
         print(f"  rope with clearance: pulling force {ref_c:.6g} {N} ({_versus(got, ref_c)})")
     if s.get("mode") == "steady":
-        print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
+        print(f"  steady mode ({s['mode_rule']}): {s['message']}: {s['steps']} solves, "
               f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     else:
         print(f"  steady from {_f(s['steady_from_s'], '.4g')} s: {s['steady']}; {s['steps']} steps, "
@@ -91,8 +92,9 @@ def main(args) -> int:
     m = s.get("mesh") or {}
     if m:
         ln = display_unit("length", system)
+        refined = f", refined {m['steady_refine']:g}x for steady mode" if m.get("steady_refine", 1.0) != 1.0 else ""
         print(f"  mesh: {m['elements']} elements of {from_si(m['element_length_m'], 'length', system):.4g} {ln} "
-              f"({m['source']}; rule {from_si(m['rule_element_length_m'], 'length', system):.4g} {ln}), "
+              f"({m['source']}; rule {from_si(m['rule_element_length_m'], 'length', system):.4g} {ln}{refined}), "
               f"{m['check_points_per_element']} check points per element")
     for w in s.get("warnings", []):
         print(f"  warning: {w}", file=sys.stderr)

@@ -5,7 +5,7 @@ and Southwire manuals' hand calculations) give for a route and a cable set, from
 reference (:mod:`exucable.quasistatic.rope`): for each direction the tension entering and leaving every section,
 the sidewall bearing pressure (SWBP) in every bend, the limit checks with margins, and the recommended
 direction (the lower maximum tension among the directions that violate no limit). With ``engine =
-"steady"`` or ``"dynamic"`` each direction is also run on the multibody model of one cable
+"steady"`` (the default for one cable) or ``"dynamic"`` each direction is also run on the multibody model of one cable
 (:func:`exucable.run.run_scenario`), whose section tensions and windowed SWBP replace the rope's, the rope's
 kept beside them.
 
@@ -43,7 +43,18 @@ from exucable.output.versions import versions
 __all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "pull_in_rope",
            "ENGINES", "CHECKS", "point_names"]
 
-ENGINES = ("rope", "steady", "dynamic")
+ENGINES = ("auto", "rope", "steady", "dynamic")
+
+
+def resolve_engine(engine: str, count: int) -> tuple[str, str]:
+    """The engine ``"auto"`` stands for, and why: the multibody steady solve for one cable (the
+    most accurate single-cable answer, seconds per direction, the rope's values beside), the rope
+    for several cables per duct (not simulated: the calculators' weight correction)."""
+    if engine != "auto":
+        return engine, "given (--engine)"
+    if count == 1:
+        return "steady", "auto: one cable, the multibody model's steady solve (--engine rope for an instant answer)"
+    return "rope", f"auto: {count} cables per duct are not simulated; the rope with the weight correction factor"
 
 
 @dataclass(frozen=True)
@@ -445,13 +456,15 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
         "message": summary["message"],
         "flags": summary.get("flags", []),
         "pull_force_std_N": summary.get("pull_force_std_N"),
+        "pull_force_uncertainty_N": summary.get("pull_force_uncertainty_N"),
+        "pull_force_uncertainty_method": summary.get("pull_force_uncertainty_method"),
         "pressure_window_m": summary.get("pressure_window_m"),
         "elements": int(result.model.layout.element_length_m.size),
         "wall_time_s": summary["wall_time_s"],
     }
 
 
-def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress: bool = False) -> dict:
+def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress: bool = False) -> dict:
     """Plan a pull in both directions.
 
     Parameters
@@ -459,7 +472,8 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     scenario : Scenario
         Route, cable (one of the ``spec.count`` identical cables), friction, back tension, gravity.
     spec : PlanSpec
-    engine : {"rope", "steady", "dynamic"}
+    engine : {"auto", "rope", "steady", "dynamic"}
+        ``"auto"`` (default): ``"steady"`` for one cable, ``"rope"`` for several (:func:`resolve_engine`).
         ``"rope"``: the quasi-static rope (instant). ``"steady"`` / ``"dynamic"``: the multibody model of
         one cable (:func:`exucable.run.run_scenario` in that solver mode, one run per direction, the
         reverse run on the reversed route); the rope's values stay beside each section's
@@ -470,7 +484,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     Returns
     -------
     dict
-        The content of ``plan.json`` (SI): ``engine``, ``directions.forward`` / ``.reverse`` (each with
+        The content of ``plan.json`` (SI): ``engine`` (the one used), ``engine_rule``, ``directions.forward`` / ``.reverse`` (each with
         ``pull_force_N``, ``max_tension_N``, ``max_sidewall_pressure_N_per_m``, ``sections``, ``checks``,
         ``passed`` and, if asked, ``pull_in``), ``recommended_direction``, ``weight_correction_factor``,
         ``jam_ratio``, ``jam_risk``, ``clearance_m``, ``arrangement``, ``count``, ``checks`` and
@@ -485,6 +499,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     """
     if engine not in ENGINES:
         raise ExucableError(f"--engine: must be one of {', '.join(ENGINES)}, got {engine!r}")
+    engine, engine_rule = resolve_engine(engine, spec.count)
     if engine != "rope" and spec.count != 1:
         raise ScenarioError("cable.count", f"--engine {engine} simulates one cable, got {spec.count}; plan "
                                            "several cables per duct with --engine rope (weight correction "
@@ -543,6 +558,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "rope", progress
     recommended = min(pool, key=lambda n: directions[n]["max_tension_N"])
     return {
         "engine": engine,
+        "engine_rule": engine_rule,
         "directions": directions,
         "recommended_direction": recommended,
         "weight_correction_factor": wc,

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["AxisGauge", "cable_sample_points", "PullForceEstimate", "pull_force_uncertainty", "assess",
+__all__ = ["AxisGauge", "cable_sample_points", "PullForceEstimate", "pull_force_uncertainty", "assess", "not_steady_fix",
            "PENETRATION_LIMIT", "DYNAMIC_LIMIT", "FRICTION_DEFICIT_LIMIT", "TRUSTED_STATUSES", "friction_factor"]
 
 PENETRATION_LIMIT = 0.25
@@ -174,13 +174,35 @@ def pull_force_uncertainty(time_s, force_N, from_s: float) -> PullForceEstimate:
     return PullForceEstimate(mean, u, float(slope), int(n), period, (float(t[0]), float(t[-1])), how)
 
 
+def not_steady_fix(*, force_controlled: bool, start_from: str, exit_span_damping_1_per_s: float,
+                   pretension: bool) -> str:
+    """What to try when a dynamic run ends ``not_steady``, most effective first.
+
+    A velocity-controlled pull from the rope start rings in the cable's all but undamped axial
+    mode and, on a stiff cable, pulls its rig out of the last bend's boundary layer; the span past
+    the exit swings undamped (reference/README.md, "Why the force wandered"). Steady mode gives
+    the steady force without any of that; a longer run only waits.
+    """
+    tries = []
+    if pretension:
+        tries.append('solver.mode = "steady" for the steady force in one solve')
+    if not force_controlled:
+        if start_from != "steady" and pretension:
+            tries.append('solver.start_from = "steady" to start the dynamic run in the steady state')
+        if exit_span_damping_1_per_s == 0.0:
+            tries.append("solver.exit_span_damping = 10 to damp the span past the exit")
+    tries.append("raise solver.end_time")
+    return "try " + "; or ".join(tries)
+
+
 def assess(*, failed: bool, steady: bool, max_penetration_m: float, max_penetration_time_s: float,
            max_penetration_s_conduit_m: float, max_axis_offset_m: float, max_axis_offset_time_s: float,
            max_axis_offset_s_conduit_m: float, clearance_m: float, cable_radius_m: float, inner_radius_m: float,
            mass_per_length_kg_per_m: float, speed_m_per_s: float, pull_force_N: float,
            steady_window_s: float, steady_tolerance: float, end_time_s: float,
            base_status: str, loaded: bool = True, friction: float = 0.0,
-           regularisation_velocity_m_per_s: float | None = None) -> tuple[str, list[dict]]:
+           regularisation_velocity_m_per_s: float | None = None,
+           not_steady_fix: str = "raise solver.end_time") -> tuple[str, list[dict]]:
     """The run's status and its flags (see the module docstring).
 
     ``loaded`` False (no gravity, back tension or prescribed force) skips the inertia check: the
@@ -237,7 +259,7 @@ def assess(*, failed: bool, steady: bool, max_penetration_m: float, max_penetrat
         flags.append({"flag": "not_steady", "time_s": end_time_s,
                       "message": f"no final window of {steady_window_s:g} s (solver.steady_window) in which drift and "
                                  f"scatter stay within {steady_tolerance:g} (solver.steady_tolerance) by "
-                                 f"t = {end_time_s:.4g} s (raise solver.end_time)"})
+                                 f"t = {end_time_s:.4g} s ({not_steady_fix})"})
     if failed:
         return "failed", flags
     names = [f["flag"] for f in flags]

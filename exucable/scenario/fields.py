@@ -259,7 +259,9 @@ FIELDS: tuple[Field, ...] = (
       rule="≥ 0, acting along −z (the paper's examples give 9.8, the industry files standard gravity 9.80665)",
       le=1000.0, why="up to 100 g"),
     # ---- solver
-    F("solver.end_time", "end_time_s", "float", "s", gt=0.0, rule="> 0", le=1.0e6, why="keeps the run's size finite"),
+    F("solver.end_time", "end_time_s", "float", "s", None, gt=0.0, default_doc="required in dynamic mode",
+      rule="> 0: simulated time of a dynamic run (an upper bound with `steady_stop`); steady mode does not use it",
+      le=1.0e6, why="keeps the run's size finite"),
     F("solver.step", "step_s", "float", "s", 1.0e-2, gt=0.0,
       rule="> 0 (initial and maximum step; the adaptive controller cuts it where needed)", le=1.0e3, why="keeps the run's size finite"),
     F("solver.min_step", "min_step_s", "float", "s", None, gt=0.0, ge=1.0e-15, ours=True, derived=True,
@@ -289,7 +291,7 @@ FIELDS: tuple[Field, ...] = (
            "exerts no force on a steadily sliding cable); 0 switches it off. The industry scenarios use 10 "
            "(reference/README.md, \"Why the force wandered\")", le=1.0e6, why="a rate far beyond the cable's own (stiff damping stalls the steps)"),
     F("solver.output_interval", "output_interval_s", "float", "s", None, gt=0.0, ours=True, derived=True,
-      default_doc="max(step, end_time/1000)", rule="> 0", why="keeps the run's size finite; at most 1e6 outputs per run"),
+      default_doc="max(step, end_time/1000)", rule="> 0 (dynamic mode)", why="keeps the run's size finite; at most 1e6 outputs per run"),
     F("solver.steady_stop", "steady_stop", "bool", "", False, ours=True,
       rule="stop once the pulling force is steady"),
     F("solver.steady_window", "steady_window_s", "float", "s", 0.2, gt=0.0, ours=True, rule="> 0", le=1.0e6, why="keeps the run's size finite"),
@@ -297,12 +299,16 @@ FIELDS: tuple[Field, ...] = (
       rule="> 0, relative drift/scatter bound"),
     F("solver.pretension", "pretension", "bool", "", True, ours=True,
       rule="start from the rope solution's tension profile near contact equilibrium"),
-    F("solver.mode", "mode", "choice", "", "dynamic", choices=("dynamic", "steady"), ours=True,
-      rule="`\"dynamic\"`: integrate the dynamics in time (paper Sect. 2.6); `\"steady\"`: one static solve "
+    F("solver.mode", "mode", "choice", "", None, choices=("auto", "dynamic", "steady"), ours=True, derived=True,
+      default_doc="`\"auto\"`",
+      rule="`\"auto\"`: `\"steady\"`, unless the scenario asks for what only the time integration gives "
+           "(`[output]` snapshots) or what steady mode cannot start without (`solver.pretension = false`): then "
+           "`\"dynamic\"`; the summary's `mode` and `mode_rule` say which and why (README, \"Two solver modes\"). "
+           "`\"dynamic\"`: integrate the dynamics in time (paper Sect. 2.6); `\"steady\"`: one static solve "
            "of the steady sliding state (friction along the cable's tangent, no start-up, no time history; "
            "needs `solver.pretension = true`; on a route ending in a bend the start is laid out past the exit so that "
            "the rig sits 10 bending lengths √(EJ/T) beyond the bend, and `reference_pulled_out_m` says how far); "
-           "the `solver` time keys are then unused"),
+           "the `solver` time keys are then unused, `solver.end_time` included"),
     F("solver.start_from", "start_from", "choice", "", "rope", choices=("rope", "steady"), ours=True,
       rule="dynamic mode, velocity-controlled pull: `\"rope\"` starts from the rope's tension on the rope-with-"
            "clearance path (`solver.pretension`); `\"steady\"` first solves the steady state (as `solver.mode = "

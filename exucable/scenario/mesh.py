@@ -33,13 +33,17 @@ from ..errors import ModelError
 
 __all__ = ["MeshPlan", "plan_mesh", "rule_element_length_m", "bending_length_m",
            "MAX_SAGITTA_CLEARANCES", "REFUSE_SAGITTA_CLEARANCES", "MAX_TURN_RAD", "REFUSE_TURN_RAD",
-           "MAX_MODEL_CHECK_POINTS"]
+           "MAX_MODEL_CHECK_POINTS", "STEADY_REFINE"]
 
 MAX_SAGITTA_CLEARANCES = 2.0       # rule: chord sagitta ≤ 2 clearances
 MAX_TURN_RAD = 0.2                 # rule: turning per element
 REFUSE_SAGITTA_CLEARANCES = 16.0   # refused beyond (issue #10: 17 c gave +16 %)
 REFUSE_TURN_RAD = 0.5              # refused beyond (cubic misfit Rφ⁴/384 ≈ 0.16 mm per metre of radius)
 MIN_ELEMENTS = 10
+#: Steady mode solves on the rule's mesh refined this many times (a given mesh as given) and the
+#: rule's own mesh gives its error bar (exucable.solve.error_bar): the rule's mesh was up to 0.13 %
+#: off on a down-bend with gravity, its halving within 0.01 % (benchmarks/steady_error_bar.py).
+STEADY_REFINE = 2.0
 CHECK_POINTS_PER_BENDING_LENGTH = 4
 MIN_CHECK_POINTS = 8
 MAX_CHECK_POINTS = 200

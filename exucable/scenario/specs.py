@@ -42,6 +42,7 @@ __all__ = [
     "PullSpec",
     "GravitySpec",
     "OutputSpec",
+    "resolve_mode",
     "SolverSpec",
     "LimitsSpec",
     "DisplaySpec",
@@ -588,8 +589,8 @@ class SolverSpec(_Spec):
 
     Attributes
     ----------
-    end_time_s : float
-        Simulated end time [s].
+    end_time_s : float or None
+        Simulated end time [s]; required in dynamic mode, unused in steady mode.
     step_s : float
         Initial and maximum time step [s].
     min_step_s : float
@@ -617,9 +618,11 @@ class SolverSpec(_Spec):
         Relative drift/scatter bound of the pulling force in that window [-].
     pretension : bool
         Start from the rope solution's tension profile near contact equilibrium.
-    mode : {"dynamic", "steady"}
+    mode : {"auto", "dynamic", "steady"}
         ``"dynamic"``: integrate the paper's dynamics in time; ``"steady"``: solve the steady
-        sliding state in one static solve (:mod:`exucable.solve.steady`).
+        sliding state in one static solve (:mod:`exucable.solve.steady`); ``"auto"`` (the default)
+        is resolved by the :class:`Scenario` (:func:`resolve_mode`), which holds the spec with
+        the mode it chose.
     start_from : {"rope", "steady"}
         Dynamic mode: start from the rope's tension (``"rope"``) or from the steady solve's state
         (``"steady"``, :func:`exucable.solve.start.steady_start`).
@@ -652,7 +655,16 @@ class SolverSpec(_Spec):
     steady_residual: float = _default("solver.steady_residual")
     start_from: str = _default("solver.start_from")
 
+    @property
+    def mode_rule(self) -> str:
+        """Why :attr:`mode` is what it is: given, or what ``"auto"`` chose (:func:`resolve_mode`)."""
+        return self.__dict__.get("_mode_rule", "given (solver.mode)" if self.mode != "auto" else "auto: not yet resolved")
+
     def _check(self) -> None:
+        if self.mode in (None, "auto"):
+            # resolved by the Scenario, which knows the pull and the outputs asked for
+            object.__setattr__(self, "mode", "auto")
+            object.__setattr__(self, "_derived", self._derived | {"mode"})
         if self.mode == "steady" and not self.pretension:
             raise ScenarioError("solver.pretension", 'solver.mode = "steady" starts from the rope solution '
                                 "near the steady state; set it to true (or use the dynamic mode)")
@@ -661,7 +673,8 @@ class SolverSpec(_Spec):
         elif self.min_step_s > self.step_s:
             raise ScenarioError("solver.min_step", f"must be <= solver.step ({self.step_s!r} s), got {self.min_step_s!r}")
         if self.output_interval_s is None:
-            object.__setattr__(self, "output_interval_s", max(self.step_s, self.end_time_s / 1000.0))
+            object.__setattr__(self, "output_interval_s",
+                               self.step_s if self.end_time_s is None else max(self.step_s, self.end_time_s / 1000.0))
 
 
 @dataclass(frozen=True)
@@ -781,6 +794,8 @@ def _check_sizes(sc: "Scenario") -> None:
                                 f"{c.elements} elements × {sc.contact.check_points_per_element} check points = {n_cp}, "
                                 f"more than {MAX_MODEL_CHECK_POINTS} ({_SIZE_WHY}); give fewer of either")
     sp = sc.solver
+    if sp.end_time_s is None:       # steady mode needs no end time: no outputs or snapshots to count
+        return
     if sp.end_time_s / sp.output_interval_s > MAX_OUTPUTS:
         raise ScenarioError("solver.output_interval", f"gives {sp.end_time_s / sp.output_interval_s:.3g} outputs over "
                                                       f"solver.end_time {sp.end_time_s:g} s, more than {MAX_OUTPUTS} "
@@ -802,6 +817,30 @@ def _check_friction_turning(sc: "Scenario", conduit) -> None:
         raise ScenarioError(key, f"μ {mu:g} × the route's total turning {theta:.4g} rad = {mu * theta:.4g}: the capstan "
                                  f"ratio e^(μθ) would exceed e^{MAX_FRICTION_TURNING:g} (no real pull; the tension "
                                  "overflows); check the friction and the route")
+
+
+def resolve_mode(solver: SolverSpec, output: OutputSpec) -> tuple[str, str]:
+    """The solver mode ``solver.mode = "auto"`` stands for, and why.
+
+    Steady mode gives the steady sliding state's pulling force in one static solve, with its
+    discretisation uncertainty, in a fraction of a dynamic run's time; it is the answer a route
+    plan needs. The dynamic mode is chosen only when the scenario asks for what only the time
+    integration gives (snapshots of the state at given times) or for a start steady mode cannot
+    solve from (``solver.pretension = false``).
+
+    Returns
+    -------
+    mode : {"steady", "dynamic"}
+    rule : str
+        One line for the summary's ``mode_rule``.
+    """
+    if solver.mode not in (None, "auto"):
+        return solver.mode, "given (solver.mode)"
+    if output.snapshots_s or output.snapshot_interval_s is not None:
+        return "dynamic", "auto: [output] snapshots need the time integration"
+    if not solver.pretension:
+        return "dynamic", "auto: solver.pretension = false (steady mode starts from the rope solution)"
+    return "steady", "auto: the steady sliding state in one static solve (set solver.mode = \"dynamic\" for the transient)"
 
 
 def default_elements(centreline, clearance_m: float, cable_length_m: float,
@@ -866,7 +905,7 @@ class Scenario:
     contact: ContactSpec = field(default_factory=ContactSpec)
     pull: PullSpec | None = None
     gravity: GravitySpec | None = None
-    solver: SolverSpec | None = None
+    solver: SolverSpec = field(default_factory=SolverSpec)
     output: OutputSpec = field(default_factory=OutputSpec)
     limits: LimitsSpec = field(default_factory=LimitsSpec)
     display: DisplaySpec = field(default_factory=DisplaySpec)
@@ -893,16 +932,30 @@ class Scenario:
             ("conduit", ConduitSpec, "route=exucable.Route(...)"),
             ("contact", ContactSpec, "exucable.Contact(...)"),
             ("pull", PullSpec, "exucable.Pull(...)"),
-            ("solver", SolverSpec, "exucable.Solver(...)"),
         ):
             value = getattr(self, part)
             if value is None:
                 raise ScenarioError(part, f"required: give the [{part}] table, or {part}={how} in Python")
             if not isinstance(value, cls):
                 raise ScenarioError(part, f"must be a {cls.__name__} ({how}), got {_describe(value)}")
+        if not isinstance(self.solver, SolverSpec):
+            raise ScenarioError("solver", f"must be a SolverSpec (exucable.Solver(...)), got {_describe(self.solver)}")
         if not isinstance(self.output, OutputSpec):
             raise ScenarioError("output", f"must be an OutputSpec, got {_describe(self.output)}")
-        late = [t for t in self.output.snapshots_s if t > self.solver.end_time_s]
+        if self.solver.mode == "auto":
+            # a copy, not dataclasses.replace: that would re-check and read the mode as given
+            solver = copy.copy(self.solver)
+            mode, rule = resolve_mode(self.solver, self.output)
+            object.__setattr__(solver, "mode", mode)
+            object.__setattr__(solver, "_mode_rule", rule)
+            object.__setattr__(self, "solver", solver)
+        if self.solver.mode == "dynamic" and self.solver.end_time_s is None:
+            why = "" if "mode" not in self.solver.derived_keys else f" (solver.mode {self.solver.mode_rule})"
+            steady = ", or set solver.mode = \"steady\" (no end_time)" if self.solver.pretension else ""
+            raise ScenarioError("solver.end_time", f"required in dynamic mode{why}: give the simulated time [s], "
+                                                   f"e.g. end_time = 3.0 with steady_stop = true{steady}")
+        late = [t for t in self.output.snapshots_s
+                if self.solver.end_time_s is not None and t > self.solver.end_time_s]
         if late:
             i = self.output.snapshots_s.index(late[0])
             raise ScenarioError(f"output.snapshots[{i}]", f"must be <= solver.end_time = "
@@ -1155,7 +1208,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     pull = _parse_pull(top.table("pull"))
     gravity_data = top.table("gravity", default=None)
     gravity = None if gravity_data is None else _parse_gravity(gravity_data)
-    solver = _parse_solver(top.table("solver"))
+    solver = _parse_solver(top.table("solver", default={}))
     output = _parse_output(top.table("output", default={}))
     limits = _parse_table("limits", top.table("limits", default={}), LimitsSpec)
     # Cross-section rules (inner radius > cable radius, cable length <= conduit length),

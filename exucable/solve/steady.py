@@ -316,7 +316,7 @@ def _outside_points(model) -> int:
 
 #: What to change when the steady solve stalls (scenario keys), appended to its message.
 STALL_FIX = ('fix: a coarser mesh (larger `cable.element_length`, or fewer `contact.check_points_per_element`) '
-             'or the dynamic run (`solver.mode = "dynamic"`)')
+             'or the dynamic run (`solver.mode = "dynamic"` with a `solver.end_time`)')
 
 
 class _FailedSteps:

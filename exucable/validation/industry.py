@@ -406,7 +406,7 @@ def validate_industry(fast: bool = False, out_dir="validation/industry", quiet: 
             if ex["direction"] != sc.pull.direction:
                 sc = sc.replace(**{"pull.direction": ex["direction"]})
             spec = plan_spec(sc)
-            plan = plan_pull(sc, spec)
+            plan = plan_pull(sc, spec, engine="rope")   # the calculators' method, checked against the published value
             sections = plan["directions"][ex["direction"]]["sections"]
             mu_bend = sc.contact.friction * (plan["weight_correction_factor"] if spec.weight_correction_in_bends
                                              else 1.0)

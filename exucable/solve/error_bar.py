@@ -1,0 +1,142 @@
+"""The error bar of a steady solve: a second, cheaper solve on a coarser mesh.
+
+A steady solve has no time scatter; what bounds its error is the discretisation (element length
+and check-point spacing) and the solve's stop tolerance. The mesh part is measured, not assumed
+from the mesh rule: the same scenario is solved again on a mesh ``COARSE_RATIO`` times coarser
+(fewer elements, the same check points per element, so both spacings grow alike, as in
+``exucable converge``), and with the solved mesh h and the coarse one H = r·h
+
+    u_mesh = |F_h − F_H| / (r^p − 1) + ``RESOLUTION_FLOOR`` · |F_h|,   p = ``ASSUMED_ORDER``,
+
+Richardson's error estimate of F_h for an assumed order p, plus a floor for the wiggle that the
+check points' places along the bends leave once the sequence has converged (two meshes can agree
+by chance closer than either is to the limit). The solve's part is its stop residual:
+``STATIC_TOLERANCE`` × the rope's largest tension bounds the unbalanced force left, which moves the
+pulling force by at most that much. The parts are added (not in quadrature: they may push the
+same way).
+
+Measured (``benchmarks/steady_error_bar.py``, against the value on meshes 4 and 8 times finer): the
+rule's mesh is not yet in the asymptotic range on every route (a 60° down-bend with gravity: +0.13 %
+at the rule's 11 elements, −0.009 % at 22, < 0.001 % beyond; coarser than the rule the sequence
+jumps by 2 %), so a coarse solve below the rule's mesh says little. Steady mode therefore solves on
+the rule's mesh refined ``exucable.scenario.mesh.STEADY_REFINE`` times and takes the rule's own mesh
+as the coarse one: there |F_h − F_H| bounded the error of F_h on every case measured, by factors of
+2 to 20, except where the two agreed by chance to 5e-6 (a 90° bend: error 6e-5 of the force, within
+the floor).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+__all__ = ["SteadyErrorBar", "steady_error_bar", "combine", "COARSE_RATIO", "ASSUMED_ORDER", "RESOLUTION_FLOOR"]
+
+#: The coarse mesh has this many times fewer elements than the solved one.
+COARSE_RATIO = 2.0
+
+#: Order of convergence assumed for the error estimate: the lowest plausible one, so the estimate
+#: is |F_h − F_H| itself (benchmarks/steady_error_bar.py: the error of F_h was below it on every case
+#: measured but one within the floor).
+ASSUMED_ORDER = 1.0
+
+#: Relative floor of the mesh part [-]: the largest change seen on meshes finer than the solved one
+#: once the sequence had converged, 6e-5 of the force (a 90° bend, benchmarks/steady_error_bar.py),
+#: rounded up.
+RESOLUTION_FLOOR = 1e-4
+
+
+@dataclass(frozen=True)
+class SteadyErrorBar:
+    """The uncertainty of a steady solve's result.
+
+    Attributes
+    ----------
+    uncertainty_N : float or None
+        u_mesh + u_solve [N]; None when the coarse solve could not be made.
+    mesh_N : float or None
+        u_mesh [N].
+    solve_N : float
+        u_solve [N].
+    coarse_value_N : float or None
+        The coarse mesh's value [N].
+    coarse_elements : int or None
+        Its element count.
+    method : str
+        How it was made, in words (the summary's ``pull_force_uncertainty_method``).
+    wall_time_s : float
+        The coarse solve's wall time, model build included [s].
+    """
+
+    uncertainty_N: float | None
+    mesh_N: float | None
+    solve_N: float
+    coarse_value_N: float | None
+    coarse_elements: int | None
+    method: str
+    wall_time_s: float
+
+    def to_dict(self) -> dict:
+        return {"uncertainty_N": self.uncertainty_N, "mesh_N": self.mesh_N, "solve_N": self.solve_N,
+                "coarse_value_N": self.coarse_value_N, "coarse_elements": self.coarse_elements,
+                "method": self.method, "wall_time_s": self.wall_time_s}
+
+
+def combine(value_N: float, coarse_N: float, elements: int, coarse_elements: int, solve_N: float,
+            order: float = ASSUMED_ORDER) -> tuple[float, float]:
+    """u_mesh = |F_h − F_H| / (r^p − 1) + floor·|F_h| with r = elements / coarse_elements, and
+    u_mesh + u_solve [N]."""
+    r = elements / coarse_elements
+    mesh = abs(value_N - coarse_N) / (r**order - 1.0) + RESOLUTION_FLOOR * abs(value_N)
+    return mesh, mesh + solve_N
+
+
+def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None,
+                     refine: float = 1.0) -> SteadyErrorBar:
+    """Solve ``scenario`` again on a mesh ``COARSE_RATIO`` times coarser than ``model``'s and state
+    the uncertainty of ``value_N`` (the solved model's ``quantity``: ``"pull_force_N"`` or
+    ``"trailing_tension_N"``) [N].
+
+    ``coarse``: that coarser model, already built (steady mode on the mesh rule builds the rule's
+    mesh first); otherwise it is built here at ``refine`` / ``COARSE_RATIO`` (``refine``: the solved
+    model's) with the solved model's check points per element.
+
+    Never raises for a coarse mesh the rule refuses or a coarse solve that fails: the result then
+    has ``uncertainty_N = None`` and the method says why.
+    """
+    from ..errors import ModelError
+    from ..model.build import build_model
+    from .steady import STATIC_TOLERANCE, solve_steady, steady_forces
+
+    t0 = time.perf_counter()
+    T_max = model.rope.max_tension_N if getattr(model, "rope", None) is not None else abs(value_N)
+    solve_N = STATIC_TOLERANCE * T_max
+    n = model.mesh.elements
+    k = model.mesh.check_points_per_element
+    head = f"second steady solve on a mesh {COARSE_RATIO:g}x coarser"
+    if coarse is None:
+        try:
+            coarse = build_model(scenario, refine=refine / COARSE_RATIO, check_points_per_element=k)
+        except ModelError as exc:
+            return SteadyErrorBar(None, None, solve_N, None, None, f"{head} not possible: {exc}",
+                                  time.perf_counter() - t0)
+    m = coarse.mesh.elements
+    if m >= n:
+        return SteadyErrorBar(None, None, solve_N, None, m, f"{head} not possible: {n} elements cannot be coarsened",
+                              time.perf_counter() - t0)
+    out = solve_steady(coarse)
+    if out.status == "failed":
+        return SteadyErrorBar(None, None, solve_N, None, m, f"{head} failed ({out.message})", time.perf_counter() - t0)
+    pull, trail, _ = steady_forces(coarse)
+    coarse_N = trail if quantity == "trailing_tension_N" else pull
+    mesh_N, total = combine(value_N, coarse_N, n, m, solve_N)
+    r = n / m
+    method = (f"{head} ({m} elements x {coarse.mesh.check_points_per_element} check points against {n} x {k}): "
+              f"mesh = |F - F_coarse| / "
+              f"(r^p - 1) with r = {r:.4g} and an assumed order p = {ASSUMED_ORDER:g} "
+              f"(Richardson's error estimate) + {RESOLUTION_FLOOR:g} x |F|; plus the steady solve's stop residual "
+              f"{STATIC_TOLERANCE:g} x the rope's largest tension; added")
+    if not math.isfinite(total):
+        return SteadyErrorBar(None, None, solve_N, coarse_N, m, f"{head}: not finite", time.perf_counter() - t0)
+    return SteadyErrorBar(total, mesh_N, solve_N, coarse_N, m, method, time.perf_counter() - t0)
