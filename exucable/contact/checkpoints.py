@@ -68,7 +68,7 @@ def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     k/√(4k² − 1) (O(n²); numpy's ``leggauss`` takes a dense eigensolve, O(n³), 0.2-0.7 s at the
     paper's 800 points per element), polished by one Newton step on P_n; the weights are
     2 / ((1 − x²) P_n'(x)²) (Abramowitz & Stegun 25.4.29). Here rather than ``scipy.special``,
-    whose import is a tenth of a second of ``exucable run``'s fixed cost (issue 15); scipy.linalg is
+    whose import is a tenth of a second of ``exucable run``'s fixed cost (docs/performance.md); scipy.linalg is
     loaded anyway (numba's BLAS).
     """
     from scipy.linalg import eigvalsh_tridiagonal

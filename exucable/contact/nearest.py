@@ -3,7 +3,7 @@
 Used by :class:`exucable.post.trust.AxisGauge` (the cable axis's distance from the conduit's axis, at
 every record) in place of ``scipy.spatial.cKDTree``, whose import alone (scipy.spatial with the
 scipy.sparse and scipy.special it loads) was a tenth of a second of every ``exucable run``
-(issue 15, fixed cost); numba is loaded by the contact kernel anyway.
+(the fixed cost, docs/performance.md); numba is loaded by the contact kernel anyway.
 
 The samples are cut into blocks of √n consecutive samples. A block's samples lie within its radius
 ρ_b (the largest distance of a member from the block's centre sample) of that centre, so none of

@@ -268,7 +268,7 @@ def lay_cable(
     want = np.linalg.norm(target - C - np.sum((target - C) * t_c, axis=1)[:, None] * t_c, axis=1)
     inside = (ss > 0.0) & (ss < L)
     # scipy.linalg (loaded anyway: numba's BLAS) rather than scipy.sparse, whose import is part of
-    # `exucable run`'s fixed cost (issue 15)
+    # `exucable run`'s fixed cost (docs/performance.md)
     from scipy.linalg import cho_solve_banded, cholesky_banded
 
     n_unknowns = 2 * (n_elements + 1)
@@ -401,7 +401,7 @@ class InitialLayout:
 
 #: Length of straight cable between the last bend's end and the rig in a steady solve, in bending
 #: lengths √(EJ/T) of the cable at the exit [-] (see :func:`steady_lead_out_m`). Measured on
-#: Fig. 12's one coil (80 elements, 1.5 m lead-in; 2026-11-29), steady minus capstan at 1 / 2.5 /
+#: Fig. 12's one coil (80 elements, 1.5 m lead-in), steady minus capstan at 1 / 2.5 /
 #: 5 / 10 / 20 bending lengths: +0.09 / +0.00 / -0.034 / -0.050 / -0.052 %: settled from 10 on.
 LEAD_OUT_BENDING_LENGTHS = 10.0
 
@@ -415,7 +415,7 @@ def steady_lead_out_m(centreline, bending_stiffness_N_m2: float, exit_tension_N:
     top, Example 4's last bend), that end sits a few millimetres past the bend, inside the
     bending boundary layer λ (4 cm on Fig. 12's coil): the cable must unbend from 1/R to zero
     curvature within it, presses on the wall at the bend's end, and its extra friction raised the
-    pulling force by +0.7 % once the mesh resolved λ (the error grew under refinement, 2026-11-29).
+    pulling force by +0.7 % once the mesh resolved λ (the error grew under refinement).
     A real rig sits far out on the exit line, where the moment has decayed as e^(-x/λ); the
     dynamic run reaches that state as it pulls the end out. Routes ending on a straight at least
     that long need no lead-out (0).
@@ -554,7 +554,7 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         if free is not None:
             # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
             # free spans across the clearance, and a start pressed onto the wall the centreline rope's
-            # load points to rang for a second as those spans formed (issue 10, item 3).
+            # load points to rang for a second as those spans formed.
             T_grid = np.interp(s_grid, free.s_conduit_m, free.tension_N)
             path = {"path_offset_m": np.stack([np.interp(s_grid, free.s_conduit_m, free.offset_m[:, j])
                                                for j in range(3)], axis=1),

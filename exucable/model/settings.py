@@ -23,11 +23,9 @@ def solver_settings(solver_spec) -> exu.SimulationSettings:
     ti.automaticStepSize = True
     ti.adaptiveStep = True
     # After a failed step Exudyn halves the step and doubles it again after `RecoverySteps` steps
-    # that took at most `RecoveryIterations` Newton iterations. At 2 steps and any count (7), the
-    # doubling failed again and again (a rejected attempt burns all its iterations: 45-59 % of
-    # Examples 2 and 3's iterations, 31 % of Example 4's). 4 and 4, measured with
-    # benchmarks/newton_trace.py: Newton iterations Ex. 2 398 -> 356, Ex. 3 821 -> 479,
-    # Ex. 4 1947 -> 1818, Ex. 1 37 -> 37, results within 7e-5 relative.
+    # that took at most `RecoveryIterations` Newton iterations. With fewer, the doubling failed again
+    # and again and the rejected attempts burnt a third to a half of all iterations; 4 and 4 cut them
+    # at the same results (benchmarks/newton_trace.py; decision record 0002).
     ti.adaptiveStepRecoverySteps = 4
     ti.adaptiveStepRecoveryIterations = 4
     ti.newton.useModifiedNewton = False          # full Newton on the exact Jacobian

@@ -1,6 +1,6 @@
 """Mesh convergence of a scalar result: observed order, Richardson extrapolation, error estimate.
 
-Pure numpy (issue #10 item 2). Given values f_1, f_2, f_3 … on meshes refined by a constant
+Pure numpy. Given values f_1, f_2, f_3 … on meshes refined by a constant
 ratio r (element length h_k = h_1 / r^(k−1)), the last three give the observed order
 
     p = ln((f_{n−2} − f_{n−1}) / (f_{n−1} − f_n)) / ln r,

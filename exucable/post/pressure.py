@@ -1,5 +1,5 @@
 """Sidewall bearing pressure an engineer can use: windowed along the route, point loads at bend
-ends, and a per-bend table beside the rope's (issue #10 item 5).
+ends, and a per-bend table beside the rope's.
 
 The contact check points carry forces [N] at their places s along the conduit. Their force per
 element share (``contact_profile.csv``) is a row of spikes when elements touch a bend near their

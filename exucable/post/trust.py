@@ -5,7 +5,7 @@ Pure numpy/scipy on what a run recorded (no Exudyn):
 * :func:`cable_axis_offset` — how far the cable's axis is from the conduit's axis, and where;
 * :func:`pull_force_uncertainty` — the steady pulling force's mean over whole oscillation periods,
   its uncertainty (scatter of per-period means, plus the drift across the window) and drift rate;
-* :func:`assess` — the flags that make a result untrustworthy (issue #10 item 4), each naming the
+* :func:`assess` — the flags that make a result untrustworthy, each naming the
   cause, where [m along the conduit] and when [s].
 
 Thresholds (stated in the summary and in scenarios/README.md, "Trust"):

@@ -1,4 +1,4 @@
-"""A stiff cable in its conduit, touching either wall: three-point bending (issue #10 items 6–7).
+"""A stiff cable in its conduit, touching either wall: three-point bending.
 numpy and scipy only; no Exudyn.
 
 :mod:`exucable.quasistatic.stiff_bend` lands the free span of a stiff cable on the bend's inner wall and

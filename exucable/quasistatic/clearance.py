@@ -63,7 +63,7 @@ _COARSEN_ABOVE = 4000
 _COARSEN = 4
 # ... and so does the chain a caller asks for (not the coarser chains solved for it) above this many:
 # Example 4's 970-segment chain spent 31 of its 47 Newton steps opening its free spans a node or two a
-# step, which the 4× coarser chain does 4× faster and 4× cheaper (39 -> 24 ms, 2026-11-29); more
+# step, which the 4× coarser chain does 4× faster and cheaper; more
 # levels below 4000 segments cost more than they saved (100 m: 150 -> 210 ms, commscope: 190 -> 260 ms),
 # and Example 2's 559 segments, which open no long spans, 18 -> 26 ms.
 _COARSEN_REQUESTED_ABOVE = 800

@@ -1,5 +1,5 @@
 """A stiff cable in a circular duct, linearised about the centreline: the gravity terms of the
-bending-stiffness estimate (issue #10 item 6). Pure numpy/scipy; no Exudyn, no contact kernel.
+bending-stiffness estimate. Pure numpy/scipy; no Exudyn, no contact kernel.
 
 Why a model of its own. The in-plane stiff-bend model (:mod:`exucable.quasistatic.stiff_bend`) predicts what
 bending stiffness EJ changes at a bend without gravity. With gravity the cable lies on the floor of

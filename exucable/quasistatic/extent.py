@@ -1,4 +1,4 @@
-"""Flexible-cable references for the cable's current extent (issue 10, items 3 and 6).
+"""Flexible-cable references for the cable's current extent.
 
 A velocity-controlled pull moves the cable out of its conduit at the pull speed v: after a time t
 the length inside is ``L_cable − v t`` (the tail has moved in by v t) and a straight length v t

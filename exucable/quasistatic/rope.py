@@ -34,7 +34,7 @@ from exucable.errors import ModelError
 # scipy.integrate and scipy.optimize are imported where needed: a route of straights and
 # gravity-free or horizontal bends is integrated in closed form (_closed_form), and importing them
 # (with the scipy.spatial, scipy.sparse and scipy.special they pull in) is a third of a second of an
-# `exucable run` of such a route (issue 15, fixed cost).
+# `exucable run` of such a route (the fixed cost, docs/performance.md).
 
 __all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "rope_pull_force_N", "sidewall_pressure_N_per_m"]
 

@@ -1,5 +1,5 @@
 """A stiff cable pulled round a bend: what its bending stiffness changes against the rope
-(issue #10 items 5–6). Pure Python; no Exudyn.
+Pure Python; no Exudyn.
 
 A rope turns by the curvature of the wall it lies on, so its curvature jumps from 0 to 1/ρ where a
 straight meets a bend, and it presses the bend with T/ρ [N/m]. A cable of bending stiffness EJ

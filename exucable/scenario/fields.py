@@ -270,9 +270,9 @@ FIELDS: tuple[Field, ...] = (
       rule="generalized-α ρ∞ in [0, 1]"),
     # 12 iterations and 1e-7: measured on Example 2, 735 -> 155 steps at the same pulling
     # force (within 0.02 %) as 8 and 1e-8 (exudyn-findings had 8 with a different start);
-    # 1e-7 -> 1e-5 (issue 15): Exudyn resets the Lagrange multipliers to 0 at each step, so the
+    # 1e-7 -> 1e-5: Exudyn resets the Lagrange multipliers to 0 at each step, so the
     # first residual is about the rig force and 1e-5 of it is a force balance to 1e-5 of the pull.
-    # 12 -> 8 (issue 15, with the damping onset held per step): a step still unconverged after 8
+    # 12 -> 8 (with the damping onset held per step): a step still unconverged after 8
     # contracts linearly (0.3-0.5) or cycles; halving it costs fewer iterations (Ex. 4 288 its in
     # 71 steps -> 290 in 73, 4.06 -> 3.97 per step; 100 m route 685 -> 669; Ex. 1-3 unchanged)
     F("solver.newton_max_iterations", "newton_max_iterations", "int", "", 8, ge=1, ours=True,

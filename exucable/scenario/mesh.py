@@ -6,7 +6,7 @@ anything runs. The rule (also in scenarios/README.md, "Mesh rule"):
 * **Bends.** On a bend of radius R with clearance c = R_in − r, an element of length L_e spans a
   chord whose sagitta is L_e²/(8R). When the sagitta exceeds a few clearances, the element bridges
   the bend instead of lying along its wall and touches it only near its nodes (a row of spikes in
-  the contact profile); on the 100 m route of issue #10 (R 3 m, c 2 mm) the pulling force was
+  the contact profile); on a 100 m route (R 3 m, c 2 mm) the pulling force was
   16 % high at 110 elements (sagitta 17 c) and 0.5 % at 440 (sagitta 1.1 c), while at c = 8.4 mm
   110, 220 and 440 elements agreed (sagitta ≤ 4 c). The rule keeps the sagitta ≤ 2 c,
   L_e ≤ √(16 R c), and the turning per element ≤ 0.2 rad (a cubic element departs from an arc
@@ -37,7 +37,7 @@ __all__ = ["MeshPlan", "plan_mesh", "rule_element_length_m", "bending_length_m",
 
 MAX_SAGITTA_CLEARANCES = 2.0       # rule: chord sagitta ≤ 2 clearances
 MAX_TURN_RAD = 0.2                 # rule: turning per element
-REFUSE_SAGITTA_CLEARANCES = 16.0   # refused beyond (issue #10: 17 c gave +16 %)
+REFUSE_SAGITTA_CLEARANCES = 16.0   # refused beyond (17 c gave +16 % on a 100 m route)
 REFUSE_TURN_RAD = 0.5              # refused beyond (cubic misfit Rφ⁴/384 ≈ 0.16 mm per metre of radius)
 MIN_ELEMENTS = 10
 #: Steady mode solves on the rule's mesh refined this many times (a given mesh as given) and the

@@ -1,4 +1,4 @@
-"""The dynamic run's start from a steady solve (``solver.start_from = "steady"``, issue 10 item 3).
+"""The dynamic run's start from a steady solve (``solver.start_from = "steady"``).
 
 Its own module: it builds and solves a steady-mode model (:mod:`exucable.solve.steady`) for the
 dynamic run (:mod:`exucable.solve.dynamic`), which neither of those should import.
@@ -40,7 +40,7 @@ def steady_start(scenario, refine: float = 1.0, check_points_per_element: int | 
 
     The rope start (:func:`exucable.model.layout.initial_layout`) carries the rope's tension
     (EJ = 0) on the rope-with-clearance path. Where bending stiffness or gravity's free spans make
-    the cable's steady tension differ from it (issue 10 item 3: Gera's 2 ft bend +9 %), the misfit
+    the cable's steady tension differ from it (Gera's 2 ft bend: +9 %), the misfit
     rings in the cable's fundamental axial mode, which sliding Coulomb friction does not damp,
     and the cable's lateral shape in the clearance relaxes only as the material slides on, over a
     sliding distance of the order of the bend's boundary layer √(EJ/T) (Coulomb friction

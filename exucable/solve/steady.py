@@ -75,7 +75,7 @@ EXACT_WITHIN = 1000.0
 #: Newton's absolute tolerance in an exact pseudo-time step, as a share of the stop tolerance [-];
 #: the Newton residual left over counts toward the stop test (spring force + leftover ≤ tolerance).
 #: Why not tighter: the residual has a round-off floor that grows with the mesh. Measured on Gera's
-#: route (2026-11-29): 2e-5 N at 2032 elements, while the former absolute tolerance 1e-3 × the stop
+#: route: 2e-5 N at 2032 elements, while the former absolute tolerance 1e-3 × the stop
 #: tolerance was 6e-7 N and the relative one 1e-8 × the initial residual 6.5e-6 N; every exact step
 #: then failed (12 iterations stuck at 2e-5 N), the spring rate rose a million-fold without helping,
 #: and the solve was reported as "continuation stalled at load scale 0". At 0.1 the floor is 30×
@@ -246,7 +246,7 @@ class _StateStore:
     A rejected or failed pseudo-time step restarts from the saved state, whose contact forces and
     Jacobian the kernel computed when the step that reached it ended; handing that evaluation back
     to the coupling spares the restart a kernel pass (the coupling reuses it only at the same
-    coordinates bit for bit). Measured (2026-11-29, one-iteration steps): Ex. 3 37 -> 27 kernel
+    coordinates bit for bit). Measured (one-iteration steps): Ex. 3 37 -> 27 kernel
     passes, Fig. 12 4 coils 47 -> 33, the 1 km benchmark route 94 -> 66; the iterates are unchanged.
     """
 

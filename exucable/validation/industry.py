@@ -55,7 +55,7 @@ __all__ = ["LBF_N", "REFINE", "MESH_TOLERANCE", "SCATTER_TOLERANCE", "MODE_TOLER
 LBF_N = 4.4482216152605
 #: Refinement of the second mesh: element length and check-point spacing divided by this.
 REFINE = 2.0
-#: Issue #10's targets: default mesh within 0.2 % of the refined answer, scatter ≤ 0.2 %, modes within 0.2 %.
+#: The targets: default mesh within 0.2 % of the refined answer, scatter ≤ 0.2 %, modes within 0.2 %.
 MESH_TOLERANCE = 2e-3
 SCATTER_TOLERANCE = 2e-3
 MODE_TOLERANCE = 2e-3

@@ -85,7 +85,7 @@ class ModeDifference:
 
 # Tolerances: (paper fidelity, fast). Paper-fidelity targets are the issue's; fast ones are what
 # the coarse meshes hold, measured by the mesh-convergence study in reference/README.md.
-# Fast ones, measured (exucable validate --fast, 2026-11-22): Ex. 1 0.014 %; Ex. 2 0.06 %;
+# Fast ones, measured (exucable validate --fast): Ex. 1 0.014 %; Ex. 2 0.06 %;
 # Ex. 3 0.62 % with 40 elements (0.11 % with the paper's 80: the error falls ~h^2.5, mesh; the fast
 # variant has 64 since its 40 ended not_steady);
 # Fig. 12 0.26-0.37 % with 20 elements per coil; Ex. 4 0.8 % with 40 elements (from the steady start).
