@@ -80,8 +80,28 @@ def friction_sweep_sentence() -> tuple[str, str]:
     return r"`friction_sweep\.py` μ = [0-9.]+ … [0-9.]+ within [+−-][0-9.]+ … [+−-][0-9.]+ % of the capstan", text
 
 
+def winch_drum_sentence() -> tuple[str, str]:
+    """(pattern, text): examples/README.md's sentence on ``winch_drum.py``, from running it at full length
+    (the numbers it prints: the drum's torque over its radius, the reel's tension, exucable's own rig)."""
+    module = _load_example("winch_drum")
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        module.main()
+    lines = {line.split("  ")[0].strip(): line for line in printed.getvalue().splitlines()}
+    drum = float(lines["drum torque / radius"].split()[-2])
+    reel = float(lines["cable tension at reel"].split()[-2])
+    rig_line = lines["exucable's rig"].split()
+    rig, u = float(rig_line[-4]), float(rig_line[-1])
+    text = (f"`winch_drum.py` (1 s, steady mean over the second half) drum torque / radius {drum:.3f} N, the "
+            f"cable's tension at the reel {reel:.3f} N, exucable's rig on the same scenario {rig:.3f} ± {u:.2g} N "
+            f"({_signed(100 * (drum / rig - 1))} %)")
+    return (r"`winch_drum\.py` \(1 s, steady mean over the second half\) drum torque / radius [0-9.]+ N, the "
+            r"cable's tension at the reel [0-9.]+ N, exucable's rig on the same scenario [0-9.]+ ± [0-9.e+-]+ N "
+            r"\([+−-][0-9.]+ %\)"), text
+
+
 GENERATED = ((README, readme_snippet_comment), (EXAMPLES_README, example2_sentence),
-             (EXAMPLES_README, friction_sweep_sentence))
+             (EXAMPLES_README, friction_sweep_sentence), (EXAMPLES_README, winch_drum_sentence))
 
 
 _NUMBER = re.compile(r"[+−-]?[0-9]+\.([0-9]+)")
