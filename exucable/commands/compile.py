@@ -14,8 +14,8 @@ import time
 
 __all__ = ["add_arguments", "main", "announce_compiling"]
 
-# what the first compile costs on a 2-core machine (docs/performance.md, "Fixed cost")
-COMPILE_ESTIMATE = "about 1 to 2 minutes"
+# what the first compile costs on a 2-core machine: 45 s quiet, 190 s with eight other jobs
+COMPILE_ESTIMATE = "about a minute, a few on a busy machine"
 
 
 def add_arguments(p) -> None:
