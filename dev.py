@@ -7,7 +7,7 @@
 Each command creates ./.venv and installs exucable with its test extras into it when needed
 (again only when pyproject.toml changes), so both are idempotent. Extra arguments are passed on
 (``python3 dev.py test -m slow``). Both also compile the contact kernels into numba's cache when the
-sources changed (``exucable compile``: 1-2 minutes on a fresh machine), so that no test or run pays it. The main job validates the paper's examples at the paper's
+sources changed (``exucable compile``: about a minute on a fresh machine, a few on a busy one), so that no test or run pays it. The main job validates the paper's examples at the paper's
 fidelity (about 90 s); ``python3 dev.py main --fast`` runs the coarse variants (about 15 s).
 """
 
