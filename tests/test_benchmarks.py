@@ -22,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = {
     "benchmarks/bundle_route.py": "ratio bundle / one cable",
     "benchmarks/contact_kernel.py": "ms/eval",
+    "benchmarks/figure_cost.py": "| mode | figures | wall, median [s]",
     "benchmarks/fixed_cost.py": "| command | wall, median [s]",
     "benchmarks/industry_suite.py": "pull force [N]",
     "benchmarks/long_routes.py": "everything but the solve",
