@@ -452,10 +452,10 @@ class SteadySolver:
 
     def advice(self, lam: float) -> str:
         """Where the solve got to and what to change (:func:`failure_advice`): the residual is the
-        smallest at the last load scale tried; it was still converging if it halved over the last
-        five accepted steps there."""
+        smallest at the last load scale tried; it counts as still converging unless five accepted
+        steps there failed to halve it (fewer steps tell nothing yet)."""
         r = self._trace
-        falling = len(r) >= 2 and r[-1] <= 0.5 * r[max(0, len(r) - 6)]
+        falling = len(r) < 6 or r[-1] <= 0.5 * r[-6]
         return failure_advice(self.model, load_scale=lam, residual_N=min(r) if r else float("nan"),
                               tolerance_N=self.tolerance_N, timed_out=self.timed_out, still_converging=falling,
                               time_limit_s=self.settings.time_limit_s)
