@@ -380,7 +380,9 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     (:mod:`exucable.model.bundle`), its report in ``summary.json`` and each cable's tension in
     ``cable_tensions.csv``; ``tension_profile.csv`` holds the bundle's, the sum over the cables
     (no files here: :func:`run_scenario` writes them)."""
-    from .model.bundle import build_bundle_model, bundle_report, bundle_tension_profile, check_bundle_supported
+    from .model.bundle import (build_bundle_model, bundle_cross_sections, bundle_report, bundle_sections,
+                               bundle_tension_profile, check_bundle_supported)
+    from .post.bundle import classify_cross_section
     from .solve.dynamic import Progress
     from .solve.steady import solve_steady
 
@@ -397,6 +399,21 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     cables = bundle_tension_profile(model)
     total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
     flags = []
+    panels = None
+    # a failed solve has no state to classify: the keys say so (jam unknown), not a silent false
+    report.update(sections=[], bends=[], jam=None, jam_s_conduit_m=None, cross_sections=[])
+    if out.status != "failed":
+        places = _bundle_places(sc, report, bundle_sections(model))
+        offsets = bundle_cross_sections(model, [p["s_conduit_m"] for p in places])
+        panels = []
+        for p, offs in zip(places, offsets):
+            if np.isnan(offs).any():
+                continue        # outside some cable's extent
+            c = classify_cross_section(offs, sc.conduit.inner_radius_m, sc.cable.radius_m)
+            panels.append(dict(p, offsets_m=offs.tolist(), label=f"{p['label']}: {c['arrangement']}", **c))
+        report["cross_sections"] = [{k: v for k, v in p.items() if k != "label"} for p in panels]
+        if report["jam"]:
+            flags.append(_jam_flag(sc, report))
     if report["contacts_at_window_edge"]:
         flags.append({"flag": "window_edge", "s_conduit_m": None, "time_s": None,
                       "message": f"{report['contacts_at_window_edge']} cable-cable contacts at the broad phase's window "
@@ -421,8 +438,43 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         "versions": versions(),
     }
     result = RunResult(summary=summary, history=h, tension_profile={"x_m": cables["x_m"], "tension_N": total},
-                       cable_tensions=cables, model=model)
+                       cable_tensions=cables, model=model,
+                       cross_sections={"panels": panels, "inner_radius_m": sc.conduit.inner_radius_m,
+                                       "cable_radius_m": sc.cable.radius_m} if panels else None)
     return result
+
+
+def _bundle_places(sc, report: dict, found: dict) -> list[dict]:
+    """Adds the arrangement keys of :func:`exucable.model.bundle.bundle_sections` to ``report`` and
+    returns the places to draw across the duct (``output.cross_sections``, or the middle of each
+    section inside the cables' extent, at most eight evenly chosen), each ``s_conduit_m`` and ``label``."""
+    report.update(found)
+    rows = found["sections"]
+    if sc.output.cross_sections_m:
+        def label(x):
+            row = next((r for r in rows if r["s_conduit_start_m"] <= x <= r["s_conduit_end_m"]), None)
+            return f"{row['kind']} {row['section']}" if row else "outside the cables"
+        return [{"s_conduit_m": x, "label": label(x)} for x in sc.output.cross_sections_m]
+    from .scenario.specs import MAX_CROSS_SECTIONS
+
+    pick = rows if len(rows) <= MAX_CROSS_SECTIONS else [rows[i] for i in np.linspace(0, len(rows) - 1, MAX_CROSS_SECTIONS).round().astype(int)]
+    return [{"s_conduit_m": 0.5 * (r["s_conduit_start_m"] + r["s_conduit_end_m"]), "label": f"{r['kind']} {r['section']}"}
+            for r in pick]
+
+
+def _jam_flag(sc, report: dict) -> dict:
+    """The summary's flag for three cables wedged across the duct: where, and what to change."""
+    from .quasistatic.engineering import JAM_RANGE_D_OVER_d
+
+    lo, hi = JAM_RANGE_D_OVER_d
+    ratio = report["duct_over_cable_diameter"]
+    where = next(r for r in report["sections"] if r["jam"])
+    inside = "inside" if report["in_jam_range"] else "outside"
+    return {"flag": "jam", "s_conduit_m": report["jam_s_conduit_m"], "time_s": None,
+            "message": f"jam: three cables wedged side by side across the duct at s = {report['jam_s_conduit_m']:.4g} m "
+                       f"({where['kind']} {where['section']}), D/d = {ratio:.3g} ({inside} the calculators' jam range "
+                       f"{lo:g}-{hi:g}); fix: a duct with D/d outside {lo:g}-{hi:g} (conduit.inner_radius), or the "
+                       "cables pulled as a bound trefoil"}
 
 
 def _steady_on_the_rule(sc) -> bool:
