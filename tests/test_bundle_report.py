@@ -151,3 +151,31 @@ def test_a_solved_straight_reports_its_arrangement_and_no_jam(tmp_path, arrangem
     assert b["bends"] == []
     assert (tmp_path / "cross_sections.png").stat().st_size > 0
 
+
+def test_plan_simulates_a_bundle_with_the_calculators_values_beside():
+    """`plan --engine steady` with three cables: each direction's tensions are the simulated bundle's
+    (the straight's tension out is the bundle's pull force), the calculators' (the rope with w_c)
+    beside; `auto` stays the rope for bundles and says why; the dynamic engine is refused naming
+    cable.count."""
+    from exucable.errors import ScenarioError
+    from exucable.plan.pull import plan_pull, plan_spec, resolve_engine
+
+    sc = straight_duct("cradled", 3.3)
+    plan = plan_pull(sc, plan_spec(sc), engine="steady")
+    assert plan["engine"] == "steady" and plan["count"] == 3
+    for name in ("forward", "reverse"):
+        d = plan["directions"][name]
+        assert d["status"] == "ok"
+        (row,) = d["sections"]
+        # EA·ε at the exit node against the eye's reactions: the coarse mesh's strain at an end node
+        # (measured 0.77 %)
+        assert row["tension_out_N"] == pytest.approx(d["pull_force_N"], rel=0.01)
+        assert row["rope_tension_out_N"] == pytest.approx(d["rope_pull_force_N"], rel=1e-12)
+        b = d["bundle"]
+        assert b["formula_weight_correction_factor"] == plan["weight_correction_factor"]
+        assert b["sections"][0]["arrangement"] == "cradled" and b["jam"] is False
+    engine, rule = resolve_engine("auto", 3)
+    assert engine == "rope" and "bends" in rule
+    with pytest.raises(ScenarioError) as err:
+        plan_pull(sc, plan_spec(sc), engine="dynamic")
+    assert err.value.key == "cable.count"
