@@ -155,7 +155,7 @@ def is_loaded(sc) -> bool:
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
                  steady_stop: bool | None = None, refine: float = 1.0,
                  check_points_per_element: int | None = None, mode: str | None = None,
-                 error_bar: bool = True) -> RunResult:
+                 error_bar: bool = True, cpu_budget_s: float | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
@@ -168,13 +168,16 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
     ``solver.mode``. ``error_bar``: a steady solve states its uncertainty from a second solve on a
     coarser mesh (:mod:`exucable.solve.error_bar`); False skips that solve (its uncertainty is then
-    None), as ``exucable converge`` does, whose levels are the error bar.
+    None), as ``exucable converge`` does, whose levels are the error bar. ``cpu_budget_s`` (several
+    cables only): the steady solve gives up once it has used this much CPU time [s], checked after
+    each accepted pseudo-time step (status ``failed``, saying so).
     """
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
     if sc.cable.count != 1:
-        solve = _solve_bundle
+        def solve(*args):
+            return _solve_bundle(*args, cpu_budget_s=cpu_budget_s)
     else:
         _refuse_pulling_the_cable_out(sc)
         solve = _solve
@@ -374,8 +377,29 @@ def _refuse_snapshot_times_in_steady_mode(sc) -> None:
                           "snapshot (snapshot_*.csv, time_s = 0); remove the key or use the dynamic mode")
 
 
+class _OverBudget(Exception):
+    """The steady solve of a bundle used up its CPU budget."""
+
+
+def _budgeted(progress, budget_s: float | None):
+    """``progress`` whose update (after each accepted pseudo-time step, between Exudyn's solves)
+    raises :class:`_OverBudget` once the process has used ``budget_s`` of CPU time since now."""
+    if budget_s is None:
+        return progress
+    t0, update = time.process_time(), progress.update
+
+    def checked(t, extra=""):
+        update(t, extra)
+        progress.last_step = extra
+        if time.process_time() - t0 > budget_s:
+            raise _OverBudget
+    progress.update = checked
+    progress.last_step = ""
+    return progress
+
+
 def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_element,
-                  error_bar: bool = True) -> RunResult:
+                  error_bar: bool = True, cpu_budget_s: float | None = None) -> RunResult:
     """Several cables in one conduit (``cable.count`` > 1): one steady solve of the bundle
     (:mod:`exucable.model.bundle`), its report in ``summary.json`` and each cable's tension in
     ``cable_tensions.csv``; ``tension_profile.csv`` holds the bundle's, the sum over the cables
@@ -393,7 +417,22 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     t_start = time.perf_counter()
     model = build_bundle_model(sc, refine=refine)
     build_s = time.perf_counter() - t_start
-    out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
+    t_cpu = time.process_time()
+    progress = _budgeted(Progress(1.0, label=sc.name, enabled=not quiet), cpu_budget_s)
+    try:
+        out = solve_steady(model, progress=progress)
+    except _OverBudget:
+        from .model.recorder import History
+        from .solve.dynamic import SolveOutcome
+
+        bends = sum(1 for p in model.conduit.centreline.pieces if p.is_curved)
+        why = (f"{bends} bend(s): several cables through bends do not yet solve reliably in steady mode" if bends
+               else "a route without bends")
+        out = SolveOutcome(history=History(), status="failed", end_time_s=0.0, steps=0, newton_iterations=0,
+                           jacobian_updates=0, wall_time_s=float("nan"),
+                           message=f"no steady state within the CPU budget of {cpu_budget_s:g} s (used "
+                                   f"{time.process_time() - t_cpu:.3g} s, last step: {progress.last_step}; {why}); "
+                                   "fix: --engine rope (the calculators' weight correction), or a shorter route")
     h = out.history.arrays()
     report = bundle_report(model)
     cables = bundle_tension_profile(model)

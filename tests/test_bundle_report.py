@@ -179,3 +179,47 @@ def test_plan_simulates_a_bundle_with_the_calculators_values_beside():
     with pytest.raises(ScenarioError) as err:
         plan_pull(sc, plan_spec(sc), engine="dynamic")
     assert err.value.key == "cable.count"
+
+
+def test_a_bend_reports_its_arrangement_and_the_pressure_beside_the_formula():
+    """Three cables (cradled at the start) through a 30° bend of 1 m radius without gravity: the
+    steady state is found; the bend's row names its most loaded cable and the calculators' SWBP
+    f_rad·T_out/R on the simulated exit tension; along every cable the pull minus the back tension
+    is the wall's friction μ ΣN (frictionless between the cables; what bending stiffness adds through
+    the shear at the bend's ends is measured -0.27 %, tolerance 1 %)."""
+    route = xc.Route(inner_radius=2.9 * R_CABLE).straight(1.0).bend(30, radius=1.0, turn="left").straight(1.0)
+    sc = xc.Scenario(route=route, cable=xc.Cable(radius=R_CABLE, density=2000.0, youngs_modulus=2e8, count=3,
+                                                 arrangement="cradled", elements=12),
+                     contact=xc.Contact(friction=0.3, check_points_per_element=8), pull=xc.Pull(speed=0.1, back_tension=100.0),
+                     solver=xc.Solver(mode="steady", steady_lead_out=0.0))
+    res = xc.run(sc)
+    assert res.status == "ok", res.summary["message"]
+    b = res.summary["bundle"]
+    (bend,) = b["bends"]
+    x = 1.0 / (2.9 - 1.0)
+    factor = eng.sidewall_pressure_factor(3, "cradled", 1 + 4 / 3 * x * x)
+    assert b["formula_sidewall_pressure_factor"] == pytest.approx(factor, rel=1e-12)
+    assert bend["formula_pressure_N_per_m"] == pytest.approx(factor * bend["tension_out_N"] / 1.0, rel=1e-12)
+    assert bend["most_loaded_cable"] in (1, 2, 3) and bend["peak_pressure_N_per_m"] > 0
+    assert [r["kind"] for r in b["sections"]] == ["straight", "bend", "straight"]
+    assert b["jam"] is False
+    F, wall = res.pull_force_N, sum(c["wall_normal_force_N"] for c in b["cables"])
+    assert F - 100.0 == pytest.approx(0.3 * wall, rel=1e-2)
+
+
+def test_a_plan_whose_bundle_does_not_solve_in_its_budget_fails_cleanly(monkeypatch):
+    """A bundle's steady solve given no CPU time at all: each direction's status is failed with the
+    budget named in its message, the calculators' sections are kept beside, and the plan's
+    multibody_run check fails (no number passes on an unsolved bundle)."""
+    import exucable.plan.pull as pull
+
+    monkeypatch.setattr(pull, "BUNDLE_CPU_BUDGET_S", 0.0)
+    sc = straight_duct("cradled", 3.3)
+    plan = pull.plan_pull(sc, pull.plan_spec(sc), engine="steady")
+    for d in plan["directions"].values():
+        assert d["status"] == "failed" and "CPU budget" in d["message"] and "--engine rope" in d["message"]
+        assert d["sections"][0]["tension_out_N"] == d["rope_pull_force_N"]
+        assert d["bundle"]["weight_correction_factor"] is None      # no simulated number from an unsolved state
+        (check,) = [c for c in d["checks"] if c["name"] == "multibody_run"]
+        assert not check["passed"]
+    assert not plan["passed"]

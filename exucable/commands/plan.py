@@ -125,6 +125,8 @@ def _print_bundle(b: dict, units: str) -> None:
     from exucable.scenario.units import display_unit, from_si
 
     p = display_unit("force_per_length", units)
+    if b["weight_correction_factor"] is None:
+        return      # the solve failed: the status above says so, the sections are the calculators'
     print(f"  simulated {b['count']} cables: weight correction factor {fmt_number(b['weight_correction_factor'])} "
           f"(the calculators' {fmt_number(b['formula_weight_correction_factor'])})"
           + (f"; JAM at s = {b['jam_s_conduit_m']:.4g} m" if b.get("jam") else ""))

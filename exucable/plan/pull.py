@@ -44,6 +44,10 @@ __all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_p
            "ENGINES", "CHECKS", "point_names"]
 
 ENGINES = ("auto", "rope", "steady", "dynamic")
+#: CPU time a simulated bundle's steady solve may take per direction [s] before the plan gives it up
+#: (status failed, saying so): bundles through bends do not yet solve reliably, and a plan must
+#: answer in minutes rather than stall.
+BUNDLE_CPU_BUDGET_S = 60.0
 
 
 def resolve_engine(engine: str, count: int) -> tuple[str, str]:
@@ -402,7 +406,8 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     from exucable.run import cable_tension_along_conduit, run_scenario  # builds an Exudyn model
 
     sc = dataclasses.replace(scenario, pull=dataclasses.replace(scenario.pull, direction=name))
-    result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine)
+    budget = {"cpu_budget_s": BUNDLE_CPU_BUDGET_S} if sc.cable.count > 1 else {}
+    result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine, **budget)
     summary = result.summary
     bundle = summary.get("bundle")
     if bundle is not None:
@@ -493,7 +498,9 @@ def _bundle_direction(result, name: str, rope_entry: dict) -> dict:
                                               "jam", "jam_s_conduit_m", "cables")},
     }
     if summary["status"] == "failed":
-        # no simulated state to report: the calculators' sections, marked as such by the status
+        # no simulated state to report: the calculators' sections and values, marked so by the status
+        common["bundle"] = {k: (v if k in ("count", "arrangement", "formula_weight_correction_factor") else None)
+                            for k, v in common["bundle"].items()}
         return dict(rope_entry, pull_force_N=float("nan"), **common)
     s_c, T_c = bundle_tension_along_conduit(result.model)
     order = np.argsort(s_c)
@@ -574,8 +581,8 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
     engine, engine_rule = resolve_engine(engine, spec.count)
     if engine == "dynamic" and spec.count != 1:
         raise ScenarioError("cable.count", f"--engine dynamic simulates one cable, got {spec.count}; plan "
-                                           "several cables per duct with --engine steady (simulated) or rope "
-                                           "(weight correction factor), or set cable.count = 1")
+                                           "several cables per duct with --engine rope (weight correction "
+                                           "factor) or --engine steady (simulated), or set cable.count = 1")
     if scenario.pull.force_N is not None:
         raise ScenarioError("pull.force", "exucable plan computes the pulling force from the back tension; give "
                                           "pull.back_tension (the reel's) instead of a prescribed pull.force")
