@@ -156,7 +156,7 @@ def is_loaded(sc) -> bool:
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
                  steady_stop: bool | None = None, refine: float = 1.0,
                  check_points_per_element: int | None = None, mode: str | None = None,
-                 error_bar: bool = True) -> RunResult:
+                 error_bar: bool = True, cpu_budget_s: float | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
@@ -169,13 +169,16 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
     ``solver.mode``. ``error_bar``: a steady solve states its uncertainty from a second solve on a
     coarser mesh (:mod:`exucable.solve.error_bar`); False skips that solve (its uncertainty is then
-    None), as ``exucable converge`` does, whose levels are the error bar.
+    None), as ``exucable converge`` does, whose levels are the error bar. ``cpu_budget_s`` (several
+    cables only): the steady solve gives up once it has used this much CPU time [s], checked after
+    each accepted pseudo-time step (status ``failed``, saying so).
     """
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
     if sc.cable.count != 1:
-        solve = _solve_bundle
+        def solve(*args):
+            return _solve_bundle(*args, cpu_budget_s=cpu_budget_s)
     else:
         _refuse_pulling_the_cable_out(sc)
         solve = _solve
@@ -377,13 +380,36 @@ def _refuse_snapshot_times_in_steady_mode(sc) -> None:
                           "snapshot (snapshot_*.csv, time_s = 0); remove the key or use the dynamic mode")
 
 
+class _OverBudget(Exception):
+    """The steady solve of a bundle used up its CPU budget."""
+
+
+def _budgeted(progress, budget_s: float | None):
+    """``progress`` whose update (after each accepted pseudo-time step, between Exudyn's solves)
+    raises :class:`_OverBudget` once the process has used ``budget_s`` of CPU time since now."""
+    if budget_s is None:
+        return progress
+    t0, update = time.process_time(), progress.update
+
+    def checked(t, extra=""):
+        update(t, extra)
+        progress.last_step = extra
+        if time.process_time() - t0 > budget_s:
+            raise _OverBudget
+    progress.update = checked
+    progress.last_step = ""
+    return progress
+
+
 def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_element,
-                  error_bar: bool = True) -> RunResult:
+                  error_bar: bool = True, cpu_budget_s: float | None = None) -> RunResult:
     """Several cables in one conduit (``cable.count`` > 1): one steady solve of the bundle
     (:mod:`exucable.model.bundle`), its report in ``summary.json`` and each cable's tension in
     ``cable_tensions.csv``; ``tension_profile.csv`` holds the bundle's, the sum over the cables
     (no files here: :func:`run_scenario` writes them)."""
-    from .model.bundle import build_bundle_model, bundle_report, bundle_tension_profile, check_bundle_supported
+    from .model.bundle import (build_bundle_model, bundle_cross_sections, bundle_report, bundle_sections,
+                               bundle_tension_profile, check_bundle_supported)
+    from .post.bundle import classify_cross_section
     from .solve.dynamic import Progress
     from .solve.steady import solve_steady
 
@@ -394,12 +420,42 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     t_start = time.perf_counter()
     model = build_bundle_model(sc, refine=refine)
     build_s = time.perf_counter() - t_start
-    out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
+    t_cpu = time.process_time()
+    progress = _budgeted(Progress(1.0, label=sc.name, enabled=not quiet), cpu_budget_s)
+    try:
+        out = solve_steady(model, progress=progress)
+    except _OverBudget:
+        from .model.recorder import History
+        from .solve.dynamic import SolveOutcome
+
+        bends = sum(1 for p in model.conduit.centreline.pieces if p.is_curved)
+        why = (f"{bends} bend(s): several cables through bends do not yet solve reliably in steady mode" if bends
+               else "a route without bends")
+        out = SolveOutcome(history=History(), status="failed", end_time_s=0.0, steps=0, newton_iterations=0,
+                           jacobian_updates=0, wall_time_s=float("nan"),
+                           message=f"no steady state within the CPU budget of {cpu_budget_s:g} s (used "
+                                   f"{time.process_time() - t_cpu:.3g} s, last step: {progress.last_step}; {why}); "
+                                   "fix: --engine rope (the calculators' weight correction), or a shorter route")
     h = out.history.arrays()
     report = bundle_report(model)
     cables = bundle_tension_profile(model)
     total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
     flags = []
+    panels = None
+    # a failed solve has no state to classify: the keys say so (jam unknown), not a silent false
+    report.update(sections=[], bends=[], jam=None, jam_s_conduit_m=None, cross_sections=[])
+    if out.status != "failed":
+        places = _bundle_places(sc, report, bundle_sections(model))
+        offsets = bundle_cross_sections(model, [p["s_conduit_m"] for p in places])
+        panels = []
+        for p, offs in zip(places, offsets):
+            if np.isnan(offs).any():
+                continue        # outside some cable's extent
+            c = classify_cross_section(offs, sc.conduit.inner_radius_m, sc.cable.radius_m)
+            panels.append(dict(p, offsets_m=offs.tolist(), label=f"{p['label']}: {c['arrangement']}", **c))
+        report["cross_sections"] = [{k: v for k, v in p.items() if k != "label"} for p in panels]
+        if report["jam"]:
+            flags.append(_jam_flag(sc, report))
     if report["contacts_at_window_edge"]:
         flags.append({"flag": "window_edge", "s_conduit_m": None, "time_s": None,
                       "message": f"{report['contacts_at_window_edge']} cable-cable contacts at the broad phase's window "
@@ -426,8 +482,43 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         versions=versions(),
     )
     result = RunResult(summary=summary, history=h, tension_profile={"x_m": cables["x_m"], "tension_N": total},
-                       cable_tensions=cables, model=model)
+                       cable_tensions=cables, model=model,
+                       cross_sections={"panels": panels, "inner_radius_m": sc.conduit.inner_radius_m,
+                                       "cable_radius_m": sc.cable.radius_m} if panels else None)
     return result
+
+
+def _bundle_places(sc, report: dict, found: dict) -> list[dict]:
+    """Adds the arrangement keys of :func:`exucable.model.bundle.bundle_sections` to ``report`` and
+    returns the places to draw across the duct (``output.cross_sections``, or the middle of each
+    section inside the cables' extent, at most eight evenly chosen), each ``s_conduit_m`` and ``label``."""
+    report.update(found)
+    rows = found["sections"]
+    if sc.output.cross_sections_m:
+        def label(x):
+            row = next((r for r in rows if r["s_conduit_start_m"] <= x <= r["s_conduit_end_m"]), None)
+            return f"{row['kind']} {row['section']}" if row else "outside the cables"
+        return [{"s_conduit_m": x, "label": label(x)} for x in sc.output.cross_sections_m]
+    from .scenario.specs import MAX_CROSS_SECTIONS
+
+    pick = rows if len(rows) <= MAX_CROSS_SECTIONS else [rows[i] for i in np.linspace(0, len(rows) - 1, MAX_CROSS_SECTIONS).round().astype(int)]
+    return [{"s_conduit_m": 0.5 * (r["s_conduit_start_m"] + r["s_conduit_end_m"]), "label": f"{r['kind']} {r['section']}"}
+            for r in pick]
+
+
+def _jam_flag(sc, report: dict) -> dict:
+    """The summary's flag for three cables wedged across the duct: where, and what to change."""
+    from .quasistatic.engineering import JAM_RANGE_D_OVER_d
+
+    lo, hi = JAM_RANGE_D_OVER_d
+    ratio = report["duct_over_cable_diameter"]
+    where = next(r for r in report["sections"] if r["jam"])
+    inside = "inside" if report["in_jam_range"] else "outside"
+    return {"flag": "jam", "s_conduit_m": report["jam_s_conduit_m"], "time_s": None,
+            "message": f"jam: three cables wedged side by side across the duct at s = {report['jam_s_conduit_m']:.4g} m "
+                       f"({where['kind']} {where['section']}), D/d = {ratio:.3g} ({inside} the calculators' jam range "
+                       f"{lo:g}-{hi:g}); fix: a duct with D/d outside {lo:g}-{hi:g} (conduit.inner_radius), or the "
+                       "cables pulled as a bound trefoil"}
 
 
 def _steady_on_the_rule(sc) -> bool:

@@ -18,6 +18,7 @@ Files
 ``bends.csv``             one row per bend: tensions in/out, windowed pressure mean/peak, point loads
                           (columns ``exucable.post.pressure.BEND_COLUMNS``)
 ``pressure_profile.csv``  ``s_conduit_m,windowed_pressure_N_per_m,rope_windowed_pressure_N_per_m``
+``cross_sections.png``    several cables: the cables across the duct at places along the route
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from pathlib import Path
 # The writers live in io.py (one atomic writer); re-exported here, where callers have found them.
 from ..errors import OutputError
 from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, csv_text, read_csv, write_csv, write_json
+from ..plots.bundle import plot_cross_sections
 from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
 from ..post.pressure import BEND_COLUMNS, PRESSURE_COLUMNS
 from .summary import RunSummary
@@ -61,6 +63,7 @@ class RunResult:
     pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
     snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.output.snapshots)
     cable_tensions: dict | None = None  # several cables: x_m and cable_<k>_tension_N -> arrays
+    cross_sections: dict | None = None  # several cables: plot_cross_sections' panels, inner_radius_m, cable_radius_m
     model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
 
 
@@ -68,8 +71,8 @@ class RunResult:
 #: :data:`exucable.output.formats.SNAPSHOT_FILES`). A new run removes those of an earlier run that it
 #: does not write again, so no file of another run is left beside its ``summary.json``.
 DATA_FILES = ("history.csv", "tension_profile.csv", "contact_profile.csv", "rope_profile.csv", "bends.csv",
-              "pressure_profile.csv")
-FIGURE_FILES = ("pull_force.png", "tension_profile.png", "pressure.png")
+              "pressure_profile.csv", "cable_tensions.csv")
+FIGURE_FILES = ("pull_force.png", "tension_profile.png", "pressure.png", "cross_sections.png")
 SUMMARY_FILE = "summary.json"
 
 
@@ -165,6 +168,11 @@ def _write_figures(out: Path, result: RunResult) -> list[Path]:
     if result.pressure_profile is not None:
         plot_pressure(out / "pressure.png", result)
         written.append(out / "pressure.png")
+    if result.cross_sections:
+        x = result.cross_sections
+        plot_cross_sections(out / "cross_sections.png", x["panels"], x["inner_radius_m"], x["cable_radius_m"],
+                            title=result.summary.get("name", ""))
+        written.append(out / "cross_sections.png")
     return written
 
 

@@ -332,6 +332,10 @@ FIELDS: tuple[Field, ...] = (
            "(interpolated between solver steps)"),
     F("output.snapshot_interval", "snapshot_interval_s", "float", "s", None, gt=0.0, ours=True,
       default_doc="none", rule="> 0: also a snapshot at every multiple of it up to `solver.end_time`", why="keeps the run's size finite; at most 10000 snapshots"),
+    F("output.cross_sections", "cross_sections_m", "custom", "m", (), ours=True,
+      default_doc="the middle of each straight and bend (at most 8)",
+      rule="array of places s along the conduit [m], at most 8: several cables (`cable.count` > 1) are drawn "
+           "across the duct there (`cross_sections.png`)"),
     # ---- limits (exucable plan)
     F("limits.max_tension", "max_tension_N", "float", "N", None, gt=0.0, ours=True, default_doc="none",
       rule="> 0: largest allowed pulling tension", le=1.0e9, why="up to 1 GN"),
