@@ -19,6 +19,7 @@ from .output.export import conduit_s
 from .output.figure_process import Figures
 from .output.outdir import owned_out_dir
 from .output.results import RunResult, write_results
+from .output.summary import RunSummary
 from .scenario.specs import Scenario, load_scenario
 from .post.pressure import bend_table, default_window_m, pressure_profile
 from .post.tension import SteadyState, detect_steady_state, profile_stations_m
@@ -157,7 +158,7 @@ def is_loaded(sc) -> bool:
 def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
                  steady_stop: bool | None = None, refine: float = 1.0,
                  check_points_per_element: int | None = None, mode: str | None = None,
-                 error_bar: bool = True) -> RunResult:
+                 error_bar: bool = True, cpu_budget_s: float | None = None) -> RunResult:
     """Run one scenario and (if ``out_dir`` is given) write its result files.
 
     A solver failure does not raise: the result has ``summary["status"] == "failed"`` with the
@@ -170,13 +171,16 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
     ``solver.mode``. ``error_bar``: a steady solve states its uncertainty from a second solve on a
     coarser mesh (:mod:`exucable.solve.error_bar`); False skips that solve (its uncertainty is then
-    None), as ``exucable converge`` does, whose levels are the error bar.
+    None), as ``exucable converge`` does, whose levels are the error bar. ``cpu_budget_s`` (several
+    cables only): the steady solve gives up once it has used this much CPU time [s], checked after
+    each accepted pseudo-time step (status ``failed``, saying so).
     """
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
     if sc.cable.count != 1:
-        solve = _solve_bundle
+        def solve(*args):
+            return _solve_bundle(*args, cpu_budget_s=cpu_budget_s)
     else:
         _refuse_pulling_the_cable_out(sc)
         solve = _solve
@@ -273,82 +277,84 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     cprof, peak_line_load = contact_profile(points)
     rope = model.rope
     pressure_info, bends, pressure_prof = _pressure(model, points, rope)
-    summary = {
-        "name": sc.name,
-        "mode": sp.mode,
-        "mode_rule": sp.mode_rule,
-        "status": out.status,
-        "message": out.message,
-        "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+    has_history = bool(len(h["time_s"]))
+    pull_force_N = float(np.mean(h["pull_force_N"][i0:])) if has_history else None
+    warnings = list(model.mesh.warnings) if model.mesh is not None else []
+    start = None
+    if first is not None:
+        start = {"kind": "steady" if first.layout is not None else "rope",
+                 "steady_pull_force_N": first.pull_force_N if first.layout is not None else None,
+                 "lead_out_m": getattr(model.start, "lead_out_m", 0.0),
+                 "steady_solve_message": first.message, "steady_solve_wall_time_s": first.wall_time_s}
+        if first.layout is None:
+            warnings.append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
+                            "started from the rope instead")
+    status, flags = _assess(model, out, st, h, pull_force_N)
+    if not is_loaded(sc):
+        warnings.append("no load acts on the cable (no gravity, pull.back_tension 0, no pull.force): its "
+                        "rope reference is 0 N; what the run reports is the bending stiffness's share and "
+                        f"inertia's, of the order of ρA·v² = {sc.cable.mass_per_length_kg_per_m * sc.pull.speed_m_per_s**2:.3g} N")
+    message = out.message
+    if flags and not message:
+        message = "; ".join(f["message"] for f in flags)
+    summary = RunSummary(
+        name=sc.name,
+        mode=sp.mode,
+        mode_rule=sp.mode_rule,
+        status=status,
+        message=message,
+        pull_force_N=pull_force_N,
         # scatter about the drift the cable's changing extent explains (none without gravity)
-        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
-        if len(h["time_s"]) else None,
-        "reference_drift_N_per_s": drift,
+        pull_force_std_N=float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:])) if has_history else None,
+        reference_drift_N_per_s=drift,
         **uncertainty,
-        "pull_force_drift_N_per_s": pf.drift_N_per_s + drift if pf else None,
-        "pull_force_unexplained_drift_N_per_s": pf.drift_N_per_s if pf else None,
-        "pull_force_uncertainty": ({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
-                                    "periods": pf.periods, "period_s": pf.period_s,
-                                    "window_s": list(pf.window_s),
-                                    "method": pf.method + (f"; after removing the references' expected drift "
-                                                           f"{drift:.4g} N/s" if drift else "")} if pf
-                                   else bar.to_dict() if bar is not None else None),
-        "steady_quantity": steady_quantity(model),
-        "steady_drift_N": st.drift_N,
-        "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
-        "max_tension_N": float(np.max(h["max_tension_N"][i0:])) if len(h["time_s"]) else None,
-        "steady": st.steady,
-        "steady_from_s": st.from_s,
-        "simulated_time_s": out.end_time_s,
-        "steps": out.steps,
-        "newton_iterations": out.newton_iterations,
+        pull_force_drift_N_per_s=pf.drift_N_per_s + drift if pf else None,
+        pull_force_unexplained_drift_N_per_s=pf.drift_N_per_s if pf else None,
+        pull_force_uncertainty=({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
+                                 "periods": pf.periods, "period_s": pf.period_s,
+                                 "window_s": list(pf.window_s),
+                                 "method": pf.method + (f"; after removing the references' expected drift "
+                                                        f"{drift:.4g} N/s" if drift else "")} if pf
+                                else bar.to_dict() if bar is not None else None),
+        steady_quantity=steady_quantity(model),
+        steady_drift_N=st.drift_N,
+        trailing_tension_N=float(np.mean(h["trailing_tension_N"][i0:])) if has_history else None,
+        max_tension_N=float(np.max(h["max_tension_N"][i0:])) if has_history else None,
+        steady=st.steady,
+        steady_from_s=st.from_s,
+        simulated_time_s=out.end_time_s,
+        steps=out.steps,
+        newton_iterations=out.newton_iterations,
         # all iterations, those of rejected step attempts included, per accepted step
-        "newton_iterations_per_step": out.newton_iterations / out.steps if out.steps else None,
-        "jacobian_updates": out.jacobian_updates,
-        "wall_time_s": out.wall_time_s,
-        "build_time_s": build_s,
-        "kernel_time_s": model.coupling.kernel_time_s if model.coupling is not None else 0.0,
+        newton_iterations_per_step=out.newton_iterations / out.steps if out.steps else None,
+        jacobian_updates=out.jacobian_updates,
+        wall_time_s=out.wall_time_s,
+        build_time_s=build_s,
+        kernel_time_s=model.coupling.kernel_time_s if model.coupling is not None else 0.0,
         # one check point's normal force over its share of the element: depends on the mesh and
         # the contact stiffness at a bend end; kept for cross-checks, not for a cable's limit
-        "max_check_point_line_load_N_per_m": peak_line_load if points is not None else None,
-        "rope_pull_force_N": refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
-        "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
-        "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
-        "rope_clearance_pull_force_N": refs.get("rope_clearance_pull_force_N"),
-        "reference_pulled_out_m": refs.get("pulled_out_m"),
-        "max_sidewall_pressure_N_per_m": None,     # without contact or rope; else pressure_info's
-        **pressure_info,
-        "bends": bends,
-        "mesh": (dict(model.mesh.to_dict(), steady_refine=solve_refine / refine)
-                 if model.mesh is not None else None),
-        "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
-        "scenario": sc.to_dict(),
-        "versions": versions(),
-    }
-    if first is not None:
-        summary["start"] = {"kind": "steady" if first.layout is not None else "rope",
-                            "steady_pull_force_N": first.pull_force_N if first.layout is not None else None,
-                            "lead_out_m": getattr(model.start, "lead_out_m", 0.0),
-                            "steady_solve_message": first.message, "steady_solve_wall_time_s": first.wall_time_s}
-        if first.layout is None:
-            summary["warnings"].append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
-                                       "started from the rope instead")
-    if out.status == "failed":
-        summary["failed_at_s"] = out.end_time_s
-    summary["status"], summary["flags"] = _assess(model, out, st, h, summary["pull_force_N"])
-    if not is_loaded(sc):
-        summary["warnings"].append("no load acts on the cable (no gravity, pull.back_tension 0, no pull.force): its "
-                                   "rope reference is 0 N; what the run reports is the bending stiffness's share and "
-                                   f"inertia's, of the order of ρA·v² = {sc.cable.mass_per_length_kg_per_m * sc.pull.speed_m_per_s**2:.3g} N")
-    summary["trust_limits"] = {"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
-                               "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
-                               "friction_deficit_fraction_of_mu": FRICTION_DEFICIT_LIMIT,
-                               "outside": "cable axis farther from the conduit axis than its inner radius"}
-    if summary["flags"] and not summary["message"]:
-        summary["message"] = "; ".join(f["message"] for f in summary["flags"])
-    if recorder is not None:
-        summary["snapshots_s"] = recorder.recorded_s
-        summary["snapshots_not_reached_s"] = list(recorder.pending)
+        max_check_point_line_load_N_per_m=peak_line_load if points is not None else None,
+        rope_pull_force_N=refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
+        rope_trailing_tension_N=rope.trailing_tension_N if rope is not None else None,
+        rope_max_sidewall_pressure_N_per_m=rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        rope_clearance_pull_force_N=refs.get("rope_clearance_pull_force_N"),
+        reference_pulled_out_m=refs.get("pulled_out_m"),
+        **pressure_info,     # without contact or rope: none, and max_sidewall_pressure_N_per_m is None
+        bends=bends,
+        mesh=(dict(model.mesh.to_dict(), steady_refine=solve_refine / refine) if model.mesh is not None else None),
+        warnings=warnings,
+        scenario=sc.to_dict(),
+        versions=versions(),
+        start=start,
+        failed_at_s=out.end_time_s if out.status == "failed" else None,
+        flags=flags,
+        trust_limits={"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
+                      "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
+                      "friction_deficit_fraction_of_mu": FRICTION_DEFICIT_LIMIT,
+                      "outside": "cable axis farther from the conduit axis than its inner radius"},
+        snapshots_s=recorder.recorded_s if recorder is not None else None,
+        snapshots_not_reached_s=list(recorder.pending) if recorder is not None else None,
+    )
     rope_profile = None
     extras = {}
     if rope is not None:
@@ -377,13 +383,36 @@ def _refuse_snapshot_times_in_steady_mode(sc) -> None:
                           "snapshot (snapshot_*.csv, time_s = 0); remove the key or use the dynamic mode")
 
 
+class _OverBudget(Exception):
+    """The steady solve of a bundle used up its CPU budget."""
+
+
+def _budgeted(progress, budget_s: float | None):
+    """``progress`` whose update (after each accepted pseudo-time step, between Exudyn's solves)
+    raises :class:`_OverBudget` once the process has used ``budget_s`` of CPU time since now."""
+    if budget_s is None:
+        return progress
+    t0, update = time.process_time(), progress.update
+
+    def checked(t, extra=""):
+        update(t, extra)
+        progress.last_step = extra
+        if time.process_time() - t0 > budget_s:
+            raise _OverBudget
+    progress.update = checked
+    progress.last_step = ""
+    return progress
+
+
 def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_element,
-                  error_bar: bool = True) -> RunResult:
+                  error_bar: bool = True, cpu_budget_s: float | None = None) -> RunResult:
     """Several cables in one conduit (``cable.count`` > 1): one steady solve of the bundle
     (:mod:`exucable.model.bundle`), its report in ``summary.json`` and each cable's tension in
     ``cable_tensions.csv``; ``tension_profile.csv`` holds the bundle's, the sum over the cables
     (no files here: :func:`run_scenario` writes them)."""
-    from .model.bundle import build_bundle_model, bundle_report, bundle_tension_profile, check_bundle_supported
+    from .model.bundle import (build_bundle_model, bundle_cross_sections, bundle_report, bundle_sections,
+                               bundle_tension_profile, check_bundle_supported)
+    from .post.bundle import classify_cross_section
     from .solve.dynamic import Progress
     from .solve.steady import solve_steady
 
@@ -394,38 +423,105 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     t_start = time.perf_counter()
     model = build_bundle_model(sc, refine=refine)
     build_s = time.perf_counter() - t_start
-    out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet))
+    t_cpu = time.process_time()
+    progress = _budgeted(Progress(1.0, label=sc.name, enabled=not quiet), cpu_budget_s)
+    try:
+        out = solve_steady(model, progress=progress)
+    except _OverBudget:
+        from .model.recorder import History
+        from .solve.dynamic import SolveOutcome
+
+        bends = sum(1 for p in model.conduit.centreline.pieces if p.is_curved)
+        why = (f"{bends} bend(s): several cables through bends do not yet solve reliably in steady mode" if bends
+               else "a route without bends")
+        out = SolveOutcome(history=History(), status="failed", end_time_s=0.0, steps=0, newton_iterations=0,
+                           jacobian_updates=0, wall_time_s=float("nan"),
+                           message=f"no steady state within the CPU budget of {cpu_budget_s:g} s (used "
+                                   f"{time.process_time() - t_cpu:.3g} s, last step: {progress.last_step}; {why}); "
+                                   "fix: --engine rope (the calculators' weight correction), or a shorter route")
     h = out.history.arrays()
     report = bundle_report(model)
     cables = bundle_tension_profile(model)
     total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
     flags = []
+    panels = None
+    # a failed solve has no state to classify: the keys say so (jam unknown), not a silent false
+    report.update(sections=[], bends=[], jam=None, jam_s_conduit_m=None, cross_sections=[])
+    if out.status != "failed":
+        places = _bundle_places(sc, report, bundle_sections(model))
+        offsets = bundle_cross_sections(model, [p["s_conduit_m"] for p in places])
+        panels = []
+        for p, offs in zip(places, offsets):
+            if np.isnan(offs).any():
+                continue        # outside some cable's extent
+            c = classify_cross_section(offs, sc.conduit.inner_radius_m, sc.cable.radius_m)
+            panels.append(dict(p, offsets_m=offs.tolist(), label=f"{p['label']}: {c['arrangement']}", **c))
+        report["cross_sections"] = [{k: v for k, v in p.items() if k != "label"} for p in panels]
+        if report["jam"]:
+            flags.append(_jam_flag(sc, report))
     if report["contacts_at_window_edge"]:
         flags.append({"flag": "window_edge", "s_conduit_m": None, "time_s": None,
                       "message": f"{report['contacts_at_window_edge']} cable-cable contacts at the broad phase's window "
                                  "edge: the cables slid apart along the route further than it covers"})
     status = out.status if out.status == "failed" or not flags else flags[0]["flag"]
     message = out.message if not flags else "; ".join([out.message] + [f["message"] for f in flags])
-    summary = {
-        "name": sc.name,
-        "mode": "steady",
-        "status": status,
-        "message": message,
-        "flags": flags,
-        **{k: report[k] for k in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
-        "bundle": {k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
-        "steps": out.steps,
-        "newton_iterations": out.newton_iterations,
-        "wall_time_s": out.wall_time_s,
-        "build_time_s": build_s,
-        "mesh": model.mesh.to_dict() if model.mesh is not None else None,
-        "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
-        "scenario": sc.to_dict(),
-        "versions": versions(),
-    }
+    summary = RunSummary(
+        name=sc.name,
+        mode="steady",
+        status=status,
+        message=message,
+        flags=flags,
+        pull_force_N=report["pull_force_N"],
+        trailing_tension_N=report["trailing_tension_N"],
+        max_tension_N=report["max_tension_N"],
+        bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
+        steps=out.steps,
+        newton_iterations=out.newton_iterations,
+        wall_time_s=out.wall_time_s,
+        build_time_s=build_s,
+        mesh=model.mesh.to_dict() if model.mesh is not None else None,
+        warnings=list(model.mesh.warnings) if model.mesh is not None else [],
+        scenario=sc.to_dict(),
+        versions=versions(),
+    )
     result = RunResult(summary=summary, history=h, tension_profile={"x_m": cables["x_m"], "tension_N": total},
-                       cable_tensions=cables, model=model)
+                       cable_tensions=cables, model=model,
+                       cross_sections={"panels": panels, "inner_radius_m": sc.conduit.inner_radius_m,
+                                       "cable_radius_m": sc.cable.radius_m} if panels else None)
     return result
+
+
+def _bundle_places(sc, report: dict, found: dict) -> list[dict]:
+    """Adds the arrangement keys of :func:`exucable.model.bundle.bundle_sections` to ``report`` and
+    returns the places to draw across the duct (``output.cross_sections``, or the middle of each
+    section inside the cables' extent, at most eight evenly chosen), each ``s_conduit_m`` and ``label``."""
+    report.update(found)
+    rows = found["sections"]
+    if sc.output.cross_sections_m:
+        def label(x):
+            row = next((r for r in rows if r["s_conduit_start_m"] <= x <= r["s_conduit_end_m"]), None)
+            return f"{row['kind']} {row['section']}" if row else "outside the cables"
+        return [{"s_conduit_m": x, "label": label(x)} for x in sc.output.cross_sections_m]
+    from .scenario.specs import MAX_CROSS_SECTIONS
+
+    pick = rows if len(rows) <= MAX_CROSS_SECTIONS else [rows[i] for i in np.linspace(0, len(rows) - 1, MAX_CROSS_SECTIONS).round().astype(int)]
+    return [{"s_conduit_m": 0.5 * (r["s_conduit_start_m"] + r["s_conduit_end_m"]), "label": f"{r['kind']} {r['section']}"}
+            for r in pick]
+
+
+def _jam_flag(sc, report: dict) -> dict:
+    """The summary's flag for three cables wedged across the duct: where, and what to change."""
+    from .quasistatic.engineering import JAM_RANGE_D_OVER_d
+
+    lo, hi = JAM_RANGE_D_OVER_d
+    ratio = report["duct_over_cable_diameter"]
+    where = next(r for r in report["sections"] if r["jam"])
+    inside = "inside" if report["in_jam_range"] else "outside"
+    return {"flag": "jam", "s_conduit_m": report["jam_s_conduit_m"], "time_s": None,
+            "message": f"jam: three cables wedged side by side across the duct at s = {report['jam_s_conduit_m']:.4g} m "
+                       f"({where['kind']} {where['section']}), D/d = {ratio:.3g} ({inside} the calculators' jam range "
+                       f"{lo:g}-{hi:g}); fix: a duct with D/d outside {lo:g}-{hi:g} (conduit.inner_radius), or the "
+                       "cables pulled as a bound trefoil"}
 
 
 def _steady_on_the_rule(sc) -> bool:

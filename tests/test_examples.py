@@ -51,3 +51,15 @@ def test_results_into_numpy(tmp_path):
     assert (tmp_path / "pull_force.png").stat().st_size > 0
     assert mean_from_csv == pytest.approx(summary["pull_force_N"], rel=1e-9)
     assert res.pull_force_N == pytest.approx(summary["pull_force_N"], rel=1e-12)
+
+
+def test_three_cables_give_the_rigid_circle_factor():
+    """Three cables cradled at D/d = 3.3 on a coarse 4 m straight: the straight's factor is the
+    calculators' 1 + (4/3)x² within 0.2 % (as tests/test_bundle.py), the arrangement stays cradled."""
+    res = load("three_cables").main(length_m=4.0, elements=8)
+    b = res.summary["bundle"]
+    assert res.status == "ok"
+    x = 0.03 / (0.099 - 0.03)
+    assert b["formula_weight_correction_factor"] == pytest.approx(1 + 4 / 3 * x * x, rel=1e-12)
+    assert b["straights"][0]["weight_correction_factor"] == pytest.approx(1 + 4 / 3 * x * x, rel=2e-3)
+    assert b["sections"][0]["arrangement"] == "cradled" and b["jam"] is False

@@ -147,11 +147,11 @@ def test_bad_inputs_are_refused_with_the_key(over, key):
     assert exc.value.key == key
 
 
-@pytest.mark.parametrize("engine", ["steady", "dynamic"])
-def test_multibody_engines_refuse_several_cables_naming_the_key(engine):
+def test_the_dynamic_engine_refuses_several_cables_naming_the_key():
+    # --engine steady simulates a bundle (tests/test_bundle_report.py)
     scenario, spec = parse_plan_scenario(_data(cable__count=3), ROOT)
     with pytest.raises(ScenarioError, match="--engine rope") as exc:
-        plan_pull(scenario, spec, engine=engine)
+        plan_pull(scenario, spec, engine="dynamic")
     assert exc.value.key == "cable.count"
 
 

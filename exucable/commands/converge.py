@@ -71,9 +71,21 @@ def converge(scenario, out_dir, levels: int = 3, ratio: float = 2.0, quiet: bool
             progress(level, s)
     report = {"name": sc.name, "quantity": q, "ratio": ratio, "mode": mode or sc.solver.mode, "levels": rows,
               "trusted": all(st in TRUSTED_STATUSES for st in statuses)}
-    values = [r["value_N"] for r in rows]
+    # only trusted levels enter the extrapolation: a failed solve's last iterate is not a value of
+    # the sequence (it would be extrapolated as if it were, and look like a converged answer)
+    used = [r for r in rows if r["status"] in TRUSTED_STATUSES]
+    left_out = [r for r in rows if r["status"] not in TRUSTED_STATUSES]
+    report["levels_used"] = [r["level"] for r in used]
+    values = [r["value_N"] for r in used]
     try:
-        ex = extrapolate(values, ratio, [r["uncertainty_N"] for r in rows])
+        if left_out:
+            why = "; ".join(f"level {r['level']} ({r['elements']} elements) is {r['status']}" for r in left_out)
+            if len(used) < 3 or used != rows[:len(used)]:
+                raise ValueError(f"no extrapolation: {why}, and the trusted levels are not three consecutive "
+                                 "from the first (fix: fewer --levels, or the failed level's message)")
+        ex = extrapolate(values, ratio, [r["uncertainty_N"] for r in used])
+        if left_out:
+            ex = type(ex)(ex.value, ex.error, ex.order, f"{ex.method} (over levels 0-{len(used) - 1}: {why})")
         report.update(extrapolated_N=ex.value, error_N=ex.error, observed_order=ex.order, method=ex.method,
                       finest_vs_extrapolated=(values[-1] / ex.value - 1.0) if ex.value else None,
                       default_vs_extrapolated=(values[0] / ex.value - 1.0) if ex.value else None)

@@ -119,6 +119,25 @@ def _print_table(header, rows) -> None:
         print("  " + "  ".join(v.rjust(w) for v, w in zip(c, widths)))
 
 
+def _print_bundle(b: dict, units: str) -> None:
+    """A simulated bundle's values beside the calculators' (``--engine steady``, several cables)."""
+    from exucable.plan.report import fmt_number
+    from exucable.scenario.units import display_unit, from_si
+
+    p = display_unit("force_per_length", units)
+    if b["weight_correction_factor"] is None:
+        return      # the solve failed: the status above says so, the sections are the calculators'
+    print(f"  simulated {b['count']} cables: weight correction factor {fmt_number(b['weight_correction_factor'])} "
+          f"(the calculators' {fmt_number(b['formula_weight_correction_factor'])})"
+          + (f"; JAM at s = {b['jam_s_conduit_m']:.4g} m" if b.get("jam") else ""))
+    for row in b.get("sections") or []:
+        print(f"  {row['kind']} {row['section']}: {row['arrangement']}")
+    for row in b.get("bends") or []:
+        print(f"  bend {row['bend']}: SWBP on cable {row['most_loaded_cable']} "
+              f"{fmt_number(from_si(row['peak_pressure_N_per_m'], 'force_per_length', units))} {p}, the calculators' "
+              f"formula on the simulated tension {fmt_number(from_si(row['formula_pressure_N_per_m'], 'force_per_length', units))} {p}")
+
+
 def main(args) -> int:
     from exucable.plan.report import check_in_units, direction_label, fmt_number, section_rows
     from exucable.scenario.units import display_unit, from_si
@@ -158,6 +177,8 @@ def main(args) -> int:
                   f"{'; ' + d['message'] if d['message'] else ''}; rope: pull force "
                   f"{force(d['rope_pull_force_N'])}, max tension {force(d['rope_max_tension_N'])}")
         _print_table(*section_rows(d, units))
+        if "bundle" in d:
+            _print_bundle(d["bundle"], units)
         if d["slack"]:
             print("  note: the cable runs slack somewhere (a downhill stretch steeper than the friction angle): "
                   "tension 0 there")

@@ -120,6 +120,14 @@ def _print_bundle(s: dict, out_dir: Path) -> int:
     for st in b["straights"]:
         print(f"  straight {st['s_conduit_start_m']:.4g}-{st['s_conduit_end_m']:.4g} m: weight correction "
               f"{_f(st['weight_correction_factor'], '.5g')}")
+    for row in b.get("sections", []):
+        seen = ", ".join(f"{k} {v}" for k, v in row["arrangements_seen"].items())
+        jam = f"  JAM at s = {row['jam_s_conduit_m']:.4g} m" if row["jam"] else ""
+        print(f"  {row['kind']} {row['section']} ({row['s_conduit_start_m']:.4g}-{row['s_conduit_end_m']:.4g} m): "
+              f"{row['arrangement']} (stations: {seen}){jam}")
+    for row in b.get("bends", []):
+        print(f"  bend {row['bend']}: sidewall pressure on cable {row['most_loaded_cable']} {_f(row['peak_pressure_N_per_m'], '.4g')} "
+              f"N/m (the calculators' {row['formula_pressure_N_per_m']:.4g} N/m at T_out {row['tension_out_N']:.4g} N)")
     for c in b["cables"]:
         share = None if c["pull_share"] is None else 100.0 * c["pull_share"]
         print(f"  cable {c['cable']}: pull {_f(c['pull_share_N'])} N ({_f(share, '.3g')} %), "

@@ -38,7 +38,8 @@ from .layout import CableLayout, lay_cable, plan_cable_mesh, steady_lead_out_m
 from .rig import Drive, add_drive, add_end_force
 
 __all__ = ["BundleModel", "arrangement_offsets", "build_bundle_model", "check_bundle_supported", "bundle_arrangement",
-           "bundle_report", "bundle_tension_profile", "straight_weight_correction"]
+           "bundle_report", "bundle_tension_profile", "straight_weight_correction", "bundle_sections",
+           "bundle_cross_sections", "bundle_tension_along_conduit"]
 
 
 def bundle_arrangement(scenario) -> str:
@@ -579,3 +580,79 @@ def bundle_tension_profile(model: BundleModel, points_per_element: int = 4) -> d
     for i, q in enumerate(model.cable_coordinates()):
         out[f"cable_{i + 1}_tension_N"] = tension_at(q, Le, model.axial_stiffness_N, x)
     return out
+
+
+def _extent_m(model) -> tuple[float, float]:
+    """The stretch of the pull-oriented centreline every cable covers [m]."""
+    s_nodes = [lay.node_s_m for lay in model.layout.cables]
+    L = model.conduit.centreline.length_m
+    return max(0.0, max(float(np.min(s)) for s in s_nodes)), min(L, min(float(np.max(s)) for s in s_nodes))
+
+
+def _bundle_tension_at(model):
+    """s along the pull-oriented centreline [m] → the cables' tensions summed there [N] (each
+    cable's material point laid at s, as :func:`straight_weight_correction`)."""
+    Le = model.layout.element_length_m
+    qs = model.cable_coordinates()
+
+    def at(s_m):
+        s = np.atleast_1d(np.asarray(s_m, dtype=float))
+        return sum(tension_at(q, Le, model.axial_stiffness_N, np.interp(s, lay.node_s_m, lay.node_x_m))
+                   for lay, q in zip(model.layout.cables, qs))
+    return at
+
+
+def bundle_sections(model) -> dict:
+    """The arrangement found in each straight and bend, the jam, and the sidewall pressure per bend on
+    the most loaded cable beside the calculators' (:mod:`exucable.post.bundle`): ``sections``,
+    ``bends``, ``jam``, ``jam_s_conduit_m``, ``duct_over_cable_diameter``, ``in_jam_range``,
+    ``formula_sidewall_pressure_factor``."""
+    from ..post.bundle import arrangement_sections, bend_pressures
+    from ..post.pressure import default_window_m
+
+    sc = model.scenario
+    centre = model.conduit.centreline
+    reverse = sc.pull.direction == "reverse"
+    R, r = sc.conduit.inner_radius_m, sc.cable.radius_m
+    qs = model.cable_coordinates()
+    sections = arrangement_sections(centre.pieces, qs, model.layout.element_length_m, centre, R, r,
+                                    _extent_m(model), reverse=reverse)
+    s_pts, f_pts = [], []
+    for q, k in zip(qs, model.walls):
+        pts = k.points(q.reshape(-1), np.zeros(q.size))
+        s = np.asarray(pts.s_conduit_m, dtype=float)
+        keep = np.isfinite(s)
+        s_pts.append(s[keep])
+        f_pts.append(np.asarray(pts.normal_force_N, dtype=float)[keep])
+    n = model.n_cables
+    factor = eng.sidewall_pressure_factor(n, model.arrangement, eng.weight_correction_factor(n, model.arrangement, 2 * R, 2 * r))
+    at = _bundle_tension_at(model)
+    bends = bend_pressures(centre.pieces, s_pts, f_pts, lambda x: float(at(x)[0]), default_window_m(centre), factor,
+                           sc.cable.bending_stiffness_N_m2, reverse=reverse)
+    jams = [row for row in sections if row["jam"]]
+    return {"sections": sections, "bends": bends, "jam": bool(jams),
+            "jam_s_conduit_m": jams[0]["jam_s_conduit_m"] if jams else None,
+            "duct_over_cable_diameter": R / r, "in_jam_range": eng.in_jam_range(n, 2 * R, 2 * r),
+            "formula_sidewall_pressure_factor": factor}
+
+
+def bundle_cross_sections(model, s_conduit_m) -> np.ndarray:
+    """Each cable's axis in the planes across the scenario's conduit at ``s_conduit_m`` [m]:
+    (horizontal, up) from the duct's axis looking along the pull [m], shape (m, n_cables, 2)."""
+    from ..post.bundle import cross_section_offsets
+
+    centre = model.conduit.centreline
+    s = np.asarray(s_conduit_m, dtype=float)
+    if model.scenario.pull.direction == "reverse":
+        s = centre.length_m - s
+    return cross_section_offsets(model.cable_coordinates(), model.layout.element_length_m, centre, s)
+
+
+def bundle_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
+    """The bundle's tension (the cables' summed) [N] at the first cable's node places along the
+    scenario's conduit [m], as :func:`exucable.run.cable_tension_along_conduit` for one cable."""
+    s = np.clip(np.asarray(model.layout.cables[0].node_s_m, dtype=float), 0.0, model.conduit.centreline.length_m)
+    T = _bundle_tension_at(model)(s)
+    if model.scenario.pull.direction == "reverse":
+        s = model.conduit.centreline.length_m - s
+    return s, T

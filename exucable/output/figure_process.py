@@ -26,6 +26,7 @@ import sys
 import threading
 from pathlib import Path
 
+from ..plots.bundle import plot_cross_sections
 from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
 
 __all__ = ["Figures", "draw_figures", "helper_allowed", "HELPER_TIMEOUT_S"]
@@ -101,6 +102,11 @@ def draw_figures(out: Path, result) -> list[Path]:
     if result.pressure_profile is not None:
         plot_pressure(out / "pressure.png", result)
         written.append(out / "pressure.png")
+    if result.cross_sections:
+        x = result.cross_sections
+        plot_cross_sections(out / "cross_sections.png", x["panels"], x["inner_radius_m"], x["cable_radius_m"],
+                            title=result.summary.get("name", ""))
+        written.append(out / "cross_sections.png")
     return written
 
 

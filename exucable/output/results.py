@@ -19,10 +19,12 @@ Files
 ``bends.csv``             one row per bend: tensions in/out, windowed pressure mean/peak, point loads
                           (columns ``exucable.post.pressure.BEND_COLUMNS``)
 ``pressure_profile.csv``  ``s_conduit_m,windowed_pressure_N_per_m,rope_windowed_pressure_N_per_m``
+``cross_sections.png``    several cables: the cables across the duct at places along the route
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +34,7 @@ from ..errors import OutputError
 from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, csv_text, read_csv, write_csv, write_json
 from .figure_process import Figures, draw_figures
 from ..post.pressure import BEND_COLUMNS, PRESSURE_COLUMNS
+from .summary import RunSummary
 
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
            "read_summary", "result_file_names", "draw_figures", "DATA_FILES", "FIGURE_FILES", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
@@ -50,7 +53,7 @@ ROPE_COLUMNS = ("s_conduit_m", "tension_N", "sidewall_pressure_N_per_m")
 class RunResult:
     """Everything a run produced, ready to be written or post-processed."""
 
-    summary: dict
+    summary: RunSummary               # summary.json (a plain dict of its keys is written as it is)
     history: dict                     # HISTORY_COLUMNS -> arrays
     tension_profile: dict             # PROFILE_COLUMNS -> arrays
     contact_profile: dict | None = None
@@ -60,6 +63,7 @@ class RunResult:
     pressure_profile: dict | None = None      # PRESSURE_COLUMNS -> arrays
     snapshots: dict | None = None     # snapshot file name -> {column: array} (exucable.output.snapshots)
     cable_tensions: dict | None = None  # several cables: x_m and cable_<k>_tension_N -> arrays
+    cross_sections: dict | None = None  # several cables: plot_cross_sections' panels, inner_radius_m, cable_radius_m
     model: object | None = field(default=None, repr=False, compare=False)  # the solved model, not written
 
 
@@ -67,8 +71,8 @@ class RunResult:
 #: :data:`exucable.output.formats.SNAPSHOT_FILES`). A new run removes those of an earlier run that it
 #: does not write again, so no file of another run is left beside its ``summary.json``.
 DATA_FILES = ("history.csv", "tension_profile.csv", "contact_profile.csv", "rope_profile.csv", "bends.csv",
-              "pressure_profile.csv")
-FIGURE_FILES = ("pull_force.png", "tension_profile.png", "pressure.png")
+              "pressure_profile.csv", "cable_tensions.csv")
+FIGURE_FILES = ("pull_force.png", "tension_profile.png", "pressure.png", "cross_sections.png")
 SUMMARY_FILE = "summary.json"
 
 
@@ -163,8 +167,12 @@ def _write_data(out: Path, result: RunResult) -> list[Path]:
             from .formats import SNAPSHOT_FILES
             for name, data in result.snapshots.items():
                 add_csv(name, SNAPSHOT_FILES[name], data)
-        result.summary["files"] = dict(contents)
-        written.append(write_json(out / SUMMARY_FILE, result.summary, batch=batch))
+        summary = result.summary
+        if isinstance(summary, RunSummary):
+            result.summary = dataclasses.replace(summary, files=dict(contents))
+        else:
+            summary["files"] = dict(contents)
+        written.append(write_json(out / SUMMARY_FILE, dict(result.summary), batch=batch))
     return written
 
 

@@ -44,6 +44,10 @@ __all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_p
            "ENGINES", "CHECKS", "point_names"]
 
 ENGINES = ("auto", "rope", "steady", "dynamic")
+#: CPU time a simulated bundle's steady solve may take per direction [s] before the plan gives it up
+#: (status failed, saying so): bundles through bends do not yet solve reliably, and a plan must
+#: answer in minutes rather than stall.
+BUNDLE_CPU_BUDGET_S = 60.0
 
 
 def resolve_engine(engine: str, count: int) -> tuple[str, str]:
@@ -54,7 +58,8 @@ def resolve_engine(engine: str, count: int) -> tuple[str, str]:
         return engine, "given (--engine)"
     if count == 1:
         return "steady", "auto: one cable, the multibody model's steady solve (--engine rope for an instant answer)"
-    return "rope", f"auto: {count} cables per duct are not simulated; the rope with the weight correction factor"
+    return "rope", (f"auto: {count} cables per duct, the rope with the weight correction factor (--engine steady "
+                    "simulates them, but does not yet solve reliably through bends)")
 
 
 @dataclass(frozen=True)
@@ -401,8 +406,12 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     from exucable.run import cable_tension_along_conduit, run_scenario  # builds an Exudyn model
 
     sc = dataclasses.replace(scenario, pull=dataclasses.replace(scenario.pull, direction=name))
-    result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine)
+    budget = {"cpu_budget_s": BUNDLE_CPU_BUDGET_S} if sc.cable.count > 1 else {}
+    result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine, **budget)
     summary = result.summary
+    bundle = summary.get("bundle")
+    if bundle is not None:
+        return _bundle_direction(result, name, rope_entry)
     s_c, T_c = cable_tension_along_conduit(result.model)
     order = np.argsort(s_c)
     s_c, T_c = np.asarray(s_c, dtype=float)[order], np.asarray(T_c, dtype=float)[order]
@@ -464,6 +473,75 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     }
 
 
+def _bundle_direction(result, name: str, rope_entry: dict) -> dict:
+    """One direction's plan entry from a simulated bundle (``cable.count`` > 1, steady mode), the
+    calculators' values (the rope with the weight correction factor) kept beside.
+
+    Section tensions are the bundle's (the cables' summed, :func:`exucable.model.bundle.bundle_tension_along_conduit`);
+    a bend's SWBP is the most loaded cable's peak windowed pressure, with the calculators' formula on
+    the simulated exit tension beside it (``formula_sidewall_pressure_N_per_m``). A failed solve
+    keeps the calculators' sections and says so in ``status`` and ``message``.
+    """
+    from exucable.model.bundle import bundle_tension_along_conduit
+
+    summary = result.summary
+    bundle = summary["bundle"]
+    common = {
+        "rope_pull_force_N": rope_entry["pull_force_N"], "rope_max_tension_N": rope_entry["max_tension_N"],
+        "rope_max_sidewall_pressure_N_per_m": rope_entry["max_sidewall_pressure_N_per_m"],
+        "rope_profile": rope_entry["profile"], "status": summary["status"], "message": summary["message"],
+        "flags": summary.get("flags", []), "pull_force_uncertainty_N": None,
+        "pull_force_uncertainty_method": "none: a bundle has no error bar yet",
+        "elements": int(result.model.layout.element_length_m.size), "wall_time_s": summary["wall_time_s"],
+        "bundle": {k: bundle.get(k) for k in ("count", "arrangement", "weight_correction_factor",
+                                              "formula_weight_correction_factor", "straights", "sections", "bends",
+                                              "jam", "jam_s_conduit_m", "cables")},
+    }
+    if summary["status"] == "failed":
+        # no simulated state to report: the calculators' sections and values, marked so by the status
+        common["bundle"] = {k: (v if k in ("count", "arrangement", "formula_weight_correction_factor") else None)
+                            for k, v in common["bundle"].items()}
+        return dict(rope_entry, pull_force_N=float("nan"), **common)
+    s_c, T_c = bundle_tension_along_conduit(result.model)
+    order = np.argsort(s_c)
+    s_c, T_c = s_c[order], T_c[order]
+    L = result.model.scenario.build_conduit().centreline.length_m
+    to_conduit = (lambda s: s) if name == "forward" else (lambda s: L - s)
+
+    def tension(s_pull):
+        return float(np.interp(to_conduit(s_pull), s_c, T_c))
+
+    bends = iter(bundle["bends"] if name == "forward" else bundle["bends"][::-1])
+    rows, running = [], tension(0.0)
+    for r in rope_entry["sections"]:
+        a, b = r["s_start_m"], r["s_start_m"] + r["length_m"]
+        lo, hi = sorted((to_conduit(a), to_conduit(b)))
+        inside = T_c[(s_c >= lo) & (s_c <= hi)]
+        t_in, t_out = tension(a), tension(b)
+        running = max(running, t_in, t_out, float(np.max(inside)) if inside.size else t_out)
+        row = dict(r, tension_in_N=t_in, tension_out_N=t_out, max_tension_so_far_N=running,
+                   rope_tension_in_N=r["tension_in_N"], rope_tension_out_N=r["tension_out_N"],
+                   rope_sidewall_pressure_N_per_m=r["sidewall_pressure_N_per_m"])
+        if r["sidewall_pressure_N_per_m"] is not None:
+            bend = next(bends)
+            row.update(sidewall_pressure_N_per_m=float(bend["peak_pressure_N_per_m"]),
+                       mean_sidewall_pressure_N_per_m=_finite_or_none(bend["mean_pressure_N_per_m"]),
+                       formula_sidewall_pressure_N_per_m=float(bend["formula_pressure_N_per_m"]),
+                       most_loaded_cable=int(bend["most_loaded_cable"]))
+        rows.append(row)
+    pressures = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
+    order = np.argsort([to_conduit(s) for s in s_c])
+    return {
+        "pull_force_N": summary["pull_force_N"],
+        "max_tension_N": max([r["max_tension_so_far_N"] for r in rows] + [float(summary["pull_force_N"])]),
+        "max_sidewall_pressure_N_per_m": max(pressures) if pressures else None,
+        "slack": rope_entry["slack"],
+        "sections": rows,
+        "profile": {"s_m": [float(np.clip(to_conduit(s), 0.0, L)) for s in s_c[order]], "tension_N": T_c[order].tolist()},
+        **common,
+    }
+
+
 def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress: bool = False) -> dict:
     """Plan a pull in both directions.
 
@@ -477,7 +555,8 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
         ``"rope"``: the quasi-static rope (instant). ``"steady"`` / ``"dynamic"``: the multibody model of
         one cable (:func:`exucable.run.run_scenario` in that solver mode, one run per direction, the
         reverse run on the reversed route); the rope's values stay beside each section's
-        (``rope_*`` keys), see :func:`_multibody_direction`.
+        (``rope_*`` keys), see :func:`_multibody_direction`. Several cables: ``"steady"`` simulates the
+        bundle (:func:`_bundle_direction`, the calculators' values beside).
     progress : bool
         Show the multibody runs' progress bars on a terminal (stderr).
 
@@ -495,15 +574,15 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
     Raises
     ------
     ExucableError
-        An unknown ``engine``; ``cable.count`` > 1 with a multibody engine (it simulates one cable).
+        An unknown ``engine``; ``cable.count`` > 1 with the dynamic engine (it simulates one cable).
     """
     if engine not in ENGINES:
         raise ExucableError(f"--engine: must be one of {', '.join(ENGINES)}, got {engine!r}")
     engine, engine_rule = resolve_engine(engine, spec.count)
-    if engine != "rope" and spec.count != 1:
-        raise ScenarioError("cable.count", f"--engine {engine} simulates one cable, got {spec.count}; plan "
+    if engine == "dynamic" and spec.count != 1:
+        raise ScenarioError("cable.count", f"--engine dynamic simulates one cable, got {spec.count}; plan "
                                            "several cables per duct with --engine rope (weight correction "
-                                           "factor), or set cable.count = 1")
+                                           "factor) or --engine steady (simulated), or set cable.count = 1")
     if scenario.pull.force_N is not None:
         raise ScenarioError("pull.force", "exucable plan computes the pulling force from the back tension; give "
                                           "pull.back_tension (the reel's) instead of a prescribed pull.force")

@@ -26,7 +26,7 @@ __all__ = [
     "ARRANGEMENTS", "CONDUCTOR_STRESS_IEC_Pa", "CONDUCTOR_STRESS_US_LB_PER_CMIL",
     "auto_arrangement", "check_arrangement", "check_fit", "weight_correction_factor", "sidewall_pressure_factor",
     "jam_ratio", "jam_risk", "clearance_m", "max_tension_from_conductors_N", "JamAssessment", "conduit_fill_percent",
-    "NEC_MAX_FILL_PERCENT",
+    "NEC_MAX_FILL_PERCENT", "JAM_RANGE_D_OVER_d", "in_jam_range",
 ]
 
 ARRANGEMENTS = ("single", "triangular", "cradled", "diamond")
@@ -183,6 +183,20 @@ def jam_risk(count: int, duct_inner_diameter_m: float, cable_diameter_m: float) 
     else:
         risk = "significant"
     return JamAssessment(jr, risk)
+
+
+#: Duct inner diameter over cable diameter D/d between which three cables may jam [-]: NFPA 70
+#: (National Electrical Code), Chapter 9, Table 1, Informational Note No. 2 ("When pulling three
+#: conductors or cables into a raceway, if the ratio of the raceway (inside diameter) to the conductor
+#: or cable (outside diameter) is between 2.8 and 3.2, jamming can occur"); IEEE 1185 and Polywater
+#: print the same band as "probable" (Cableizer CJ_pull's table of references).
+JAM_RANGE_D_OVER_d = (2.8, 3.2)
+
+
+def in_jam_range(count: int, duct_inner_diameter_m: float, cable_diameter_m: float) -> bool:
+    """Whether ``count`` cables have D/d in :data:`JAM_RANGE_D_OVER_d` (only three cables jam)."""
+    lo, hi = JAM_RANGE_D_OVER_d
+    return count == 3 and lo <= duct_inner_diameter_m / cable_diameter_m <= hi
 
 
 def clearance_m(count: int, arrangement: str, duct_inner_diameter_m: float, cable_diameter_m: float) -> float:

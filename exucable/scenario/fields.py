@@ -304,6 +304,9 @@ FIELDS: tuple[Field, ...] = (
       rule="`\"auto\"`: `\"steady\"`, unless the scenario asks for what only the time integration gives "
            "(`[output]` snapshots) or what steady mode cannot start without (`solver.pretension = false`): then "
            "`\"dynamic\"`; the summary's `mode` and `mode_rule` say which and why (README, \"Two solver modes\"). "
+           "Why steady by default: a velocity-controlled pull's answer is its steady sliding state, which steady "
+           "mode finds in seconds with an error bar (a second solve on a coarser mesh), where a dynamic run "
+           "rings and drifts for seconds of simulated time before it is steady. "
            "`\"dynamic\"`: integrate the dynamics in time (paper Sect. 2.6); `\"steady\"`: one static solve "
            "of the steady sliding state (friction along the cable's tangent, no start-up, no time history; "
            "needs `solver.pretension = true`; on a route ending in a bend the start is laid out past the exit so that "
@@ -336,6 +339,10 @@ FIELDS: tuple[Field, ...] = (
            "(interpolated between solver steps)"),
     F("output.snapshot_interval", "snapshot_interval_s", "float", "s", None, gt=0.0, ours=True,
       default_doc="none", rule="> 0: also a snapshot at every multiple of it up to `solver.end_time`", why="keeps the run's size finite; at most 10000 snapshots"),
+    F("output.cross_sections", "cross_sections_m", "custom", "m", (), ours=True,
+      default_doc="the middle of each straight and bend (at most 8)",
+      rule="array of places s along the conduit [m], at most 8: several cables (`cable.count` > 1) are drawn "
+           "across the duct there (`cross_sections.png`)"),
     # ---- limits (exucable plan)
     F("limits.max_tension", "max_tension_N", "float", "N", None, gt=0.0, ours=True, default_doc="none",
       rule="> 0: largest allowed pulling tension", le=1.0e9, why="up to 1 GN"),

@@ -542,6 +542,10 @@ class GravitySpec(_Spec):
     g_m_per_s2: float = _default("gravity.g")
 
 
+#: Most places of ``output.cross_sections``: the panels of one figure.
+MAX_CROSS_SECTIONS = 8
+
+
 @dataclass(frozen=True)
 class OutputSpec(_Spec):
     """What is written besides the histories and final profiles.
@@ -553,12 +557,17 @@ class OutputSpec(_Spec):
         <= ``solver.end_time``, checked by the scenario).
     snapshot_interval_s : float or None
         Also a snapshot every this many seconds, at k·interval, k = 1, 2, … [s].
+    cross_sections_m : tuple of float
+        Places s along the conduit where several cables are drawn across the duct [m], sorted,
+        each >= 0 (and <= the conduit's length, checked by the scenario); empty: the middle of
+        each straight and bend.
     """
 
     _SECTION: ClassVar[str] = "output"
 
     snapshots_s: tuple = ()
     snapshot_interval_s: float | None = None
+    cross_sections_m: tuple = ()
 
     def _check(self) -> None:
         raw = self.snapshots_s
@@ -573,6 +582,20 @@ class OutputSpec(_Spec):
             _check_range(key, v, "s", ge=0.0)
             times.append(v)
         object.__setattr__(self, "snapshots_s", tuple(sorted(set(times))))
+        raw = self.cross_sections_m
+        if not isinstance(raw, (list, tuple)):
+            raise ScenarioError("output.cross_sections", f"must be an array of places s along the conduit [m], got "
+                                                         f"{_describe(raw)}")
+        if len(raw) > MAX_CROSS_SECTIONS:
+            raise ScenarioError("output.cross_sections", f"must have at most {MAX_CROSS_SECTIONS} places (one "
+                                                         f"figure's panels), got {len(raw)}")
+        places = []
+        for i, value in enumerate(raw):
+            key = f"output.cross_sections[{i}]"
+            v = _as_float(key, value, "m")
+            _check_range(key, v, "m", ge=0.0)
+            places.append(v)
+        object.__setattr__(self, "cross_sections_m", tuple(sorted(set(places))))
 
     def times_s(self, end_time_s: float) -> tuple:
         """All snapshot times up to ``end_time_s`` [s], sorted, duplicates merged."""
@@ -957,6 +980,11 @@ class Scenario:
             steady = ", or set solver.mode = \"steady\" (no end_time)" if self.solver.pretension else ""
             raise ScenarioError("solver.end_time", f"required in dynamic mode{why}: give the simulated time [s], "
                                                    f"e.g. end_time = 3.0 with steady_stop = true{steady}")
+        far = [x for x in self.output.cross_sections_m if x > self.build_conduit().centreline.length_m * (1 + 1e-12)]
+        if far:
+            i = self.output.cross_sections_m.index(far[0])
+            raise ScenarioError(f"output.cross_sections[{i}]", f"must be <= the conduit's length "
+                                f"{self.build_conduit().centreline.length_m:.6g} m, got {far[0]!r}")
         late = [t for t in self.output.snapshots_s
                 if self.solver.end_time_s is not None and t > self.solver.end_time_s]
         if late:

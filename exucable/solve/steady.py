@@ -662,6 +662,8 @@ class SteadySolver:
                 message = (f"the static solve found an equilibrium with {outside} more check points outside "
                            f"the conduit than at the start: the cable left the conduit (start too far from "
                            f"the steady state?)")
+        if status == "ok":
+            status, message = _check_balance(model, message)
         wall = time.perf_counter() - t_wall
         if self.progress is not None:
             self.progress.close()
@@ -684,6 +686,28 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float | Non
     if tolerance is not None:
         settings = replace(settings, steady_residual=float(tolerance))
     return SteadySolver(model, settings, progress).solve()
+
+
+#: What to change when a steady solve ends in a state that is not the steady pull.
+BALANCE_FIX = ('fix: the rule\'s mesh (omit `cable.element_length`/`cable.elements`) or the dynamic run '
+               '(`solver.mode = "dynamic"` with `solver.start_from = "steady"`)')
+
+
+def _check_balance(model, message: str) -> tuple[str, str]:
+    """``("failed", why)`` when the solved state is not a steady pull (:mod:`exucable.post.balance`),
+    else ``("ok", message)``: a residual below the stop tolerance alone does not prove it."""
+    loads_of = getattr(model, "loads", None)
+    if loads_of is None:          # several cables (exucable.model.bundle): not checked yet
+        return "ok", message
+    from ..post.balance import steady_balance
+
+    c = model.scenario.contact
+    q, _ = model.coordinates()
+    check = steady_balance(loads_of(), q, float(np.sum(model.layout.element_length_m)), c.friction,
+                           c.static_friction)
+    if check.ok:
+        return "ok", message
+    return "failed", f"the steady solve ended in a state that is not the steady pull: {check.message}; {BALANCE_FIX}"
 
 
 def _cable_part(model, q_all) -> np.ndarray:
