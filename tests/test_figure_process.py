@@ -54,7 +54,7 @@ def test_the_helpers_figures_are_those_drawn_here(tmp_path):
         helper = write_results(tmp_path / "helper", _result(), plots=figures)
     here = write_results(tmp_path / "here", _result(), plots=True)
     assert [p.name for p in helper] == [p.name for p in here]
-    for name in FIGURE_FILES:
+    for name in set(FIGURE_FILES) & {p.name for p in here}:
         assert (tmp_path / "helper" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
     assert not figures.helper_running and figures.helper_reason == ""
 
@@ -66,8 +66,9 @@ def test_a_dead_helper_costs_no_figure(tmp_path):
         figures._proc.kill()
         figures._proc.join()
         paths = write_results(tmp_path, _result(), plots=figures)
-    assert {p.name for p in paths} >= set(FIGURE_FILES)
-    assert all((tmp_path / n).stat().st_size > 1000 for n in FIGURE_FILES)
+    drawn = {"pull_force.png", "tension_profile.png", "pressure.png"}      # one cable: no cross sections
+    assert {p.name for p in paths} >= drawn
+    assert all((tmp_path / n).stat().st_size > 1000 for n in drawn)
     assert "helper" in figures.helper_reason
 
 
