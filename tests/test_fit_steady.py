@@ -81,3 +81,31 @@ def test_separate_and_several_cables_are_refused_naming_the_flag_or_key(ex2):
         fit_friction(sc, _log(sc, truth, 0), family=family, separate=True)
     with pytest.raises(Exception, match="cable.count"):
         SteadyFamily(sc.replace(**{"cable.count": 2}), mu_nodes=[MU], points=4)
+
+
+def test_the_command_fits_against_the_multibody_history(ex2, tmp_path, capsys):
+    """``exucable fit --engine steady``: fit.json says the engine, the histories' μ and the rope fit beside;
+    auto stays the rope."""
+    from exucable.cli import main as cli_main
+
+    sc, rope, truth = ex2
+    raw = synthetic_log(sc, MU, seed=1, speed_m_per_s=0.025, noise_N=1.5,
+                        history=(truth.pulled_length_m, truth.pull_force_N))
+    log = tmp_path / "log.csv"
+    log.write_text(synthetic_log_csv(raw))
+    scenario = str(data_path("scenarios", "fast", "paper_ex2_bend90.toml"))
+    out = tmp_path / "fit"
+    status = cli_main(["fit", scenario, str(log), "--engine", "steady", "--out", str(out), "--bootstrap", "199",
+                       "--no-plots"])
+    printed = capsys.readouterr().out
+    assert status == 0, printed
+    import json
+    data = json.loads((out / "fit.json").read_text())
+    assert data["engine"] == "steady" and len(data["steady"]["mu_nodes"]) == 3
+    assert data["friction_interval"][0] <= MU <= data["friction_interval"][1]
+    assert data["steady"]["rope_friction"] > 0
+    assert "engine: steady (given (--engine))" in printed and "the rope fit of the same log" in printed
+    assert cli_main(["fit", scenario, str(log), "--out", str(tmp_path / "r"), "--bootstrap", "199",
+                     "--no-plots"]) == 0
+    assert "engine: rope (auto" in capsys.readouterr().out
+    assert json.loads((tmp_path / "r" / "fit.json").read_text())["engine"] == "rope"

@@ -55,6 +55,8 @@ def test_grid_has_the_piece_ends_and_no_near_duplicates():
     x = pull_in_grid_m(10.0, 5, [1.0, 4.0005, 6.0])
     assert x[0] == 0.0 and x[-1] == 10.0
     assert 1.0 in x and 6.0 in x and 4.0005 not in x      # 4.0005 lies within 1 % of a step of 4.0
+    bend = pull_in_grid_m(10.0, 2, [4.0, 5.0], [(4.0, 5.0)])
+    assert np.allclose(bend[(bend > 4.0) & (bend < 5.0)], [4.25, 4.5, 4.75])
     assert np.all(np.diff(x) > 0)
 
 
@@ -119,3 +121,29 @@ def test_bad_input_names_the_key():
         steady_pull_in(sc.replace(**{"cable.length": 2.0}), 4)
     with pytest.raises(ScenarioError, match="pull_in"):
         steady_pull_in(sc, x_m=[3.5])
+
+
+def test_plan_with_the_steady_engine_writes_the_multibody_history(tmp_path):
+    """``exucable plan --engine steady`` with ``pull.feed_from_reel``: the history is the multibody one, it
+    ends at the direction's pull force (the same model, from another start) and stays within
+    0.2 % of the rope beside it (the capstan, as above); the CSV carries both. The end: measured 2.9e-5
+    after 60 solves each from the last (the fixture's 8: 6.7e-6); bound 1e-4, the floor of a steady run's
+    own error bar (RESOLUTION_FLOOR · F, exucable/solve/error_bar.py)."""
+    from exucable.commands.plan import write_plan
+    from exucable.output.results import read_csv
+    from exucable.plan.pull import plan_pull, plan_spec
+
+    sc = fast("paper_ex2_bend90").replace(**{"pull.feed_from_reel": True})
+    plan = plan_pull(sc, plan_spec(sc), engine="steady")
+    for name in ("forward", "reverse"):
+        d = plan["directions"][name]
+        h = d["pull_in"]
+        assert h["engine"] == "steady" and h["failed_points"] == 0
+        assert h["pull_force_N"][-1] == pytest.approx(d["pull_force_N"], rel=1e-4)
+        assert np.max(np.abs(np.array(h["pull_force_N"]) / np.array(h["rope_pull_force_N"]) - 1.0)) < 2e-3
+    write_plan(tmp_path, plan, sc, "si")
+    table = read_csv(tmp_path / "pull_in_forward.csv")
+    assert list(table) == ["pulled_length_m", "pull_force_N", "rope_pull_force_N"]
+    assert "multibody model" in (tmp_path / "report.html").read_text()
+    # the rope engine's history stays the rope's
+    assert plan_pull(sc, plan_spec(sc), engine="rope")["directions"]["forward"]["pull_in"]["engine"] == "rope"

@@ -35,7 +35,7 @@ from exucable.plan.pull import PlanSpec, plan_spec, pull_in_rope
 from exucable.quasistatic import engineering as eng
 from exucable.scenario.specs import Scenario
 
-__all__ = ["FrictionFit", "RopeFamily", "SteadyFamily", "fit_friction_steady", "STEADY_NODE_FACTORS", "fit_friction", "SEPARABLE_CORRELATION", "SEPARABLE_HALF_WIDTH", "block_length", "GRID_STEP", "FINE_BELOW", "ONE_COEFFICIENT_P", "CONFIDENCE"]
+__all__ = ["FrictionFit", "RopeFamily", "SteadyFamily", "fit_friction_steady", "FIT_ENGINES", "resolve_fit_engine", "STEADY_NODE_FACTORS", "fit_friction", "SEPARABLE_CORRELATION", "SEPARABLE_HALF_WIDTH", "block_length", "GRID_STEP", "FINE_BELOW", "ONE_COEFFICIENT_P", "CONFIDENCE"]
 
 #: Step of the μ grid on which the rope is solved [-], a fifth of it below :data:`FINE_BELOW`; between, a
 #: cubic spline in μ (error of the interpolated history against a direct solve: tests/test_fit.py).
@@ -667,6 +667,26 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
                        straights_and_bends=separate_fit)
 
 
+#: The engines ``exucable fit`` fits against.
+FIT_ENGINES = ("auto", "rope", "steady")
+
+
+def resolve_fit_engine(engine: str, count: int = 1) -> tuple[str, str]:
+    """The engine ``"auto"`` stands for, and why: the rope. A fit is made on site and refitted at every
+    change of a growing log (``--watch``), where the rope's histories cost milliseconds and the multibody
+    ones seconds to minutes (three histories of one steady solve per head position); where the cable's
+    stiffness or free spans matter, the two fits differ (``studies/fit_engines.py``) and
+    ``--engine steady`` gives the friction the multibody model needs."""
+    if engine not in FIT_ENGINES:
+        raise LogError("--engine", f"must be one of {', '.join(FIT_ENGINES)}, got {engine!r}")
+    if engine == "steady" and count != 1:
+        raise ScenarioError("cable.count", f"--engine steady simulates one cable, got {count}; fit several cables "
+                                           "per duct with --engine rope")
+    if engine != "auto":
+        return engine, "given (--engine)"
+    return "rope", "auto: the rope, instant (--engine steady for the multibody model's history)"
+
+
 #: The multibody histories of :func:`fit_friction_steady` at these multiples of the rope's fitted μ [-].
 STEADY_NODE_FACTORS = (0.8, 1.0, 1.25)
 
@@ -700,10 +720,10 @@ def fit_friction_steady(scenario: Scenario, log: PullLog, *, spec: PlanSpec | No
     if hi > family.mu_span[1]:
         extra.append(min(mu_max, hi + 0.05 * (hi - lo)))
     if extra:
-        # the quadratic through the middle three: keep the nodes nearest the fit, with the new ends
-        keep = [m for m in nodes if lo <= m <= hi] or [min(nodes, key=lambda m: abs(m - fit.friction))]
+        # at most four histories (a cubic in μ): the new ends, and of the others those nearest the fit
+        kept = sorted(nodes, key=lambda m: abs(m - fit.friction))[:4 - len(extra)]
         family = SteadyFamily(scenario, rope_family.spec, rope_family.direction, mu_max,
-                              mu_nodes=sorted(set(keep[:2]) | set(extra)), points=points, solved=family.solved)
+                              mu_nodes=sorted(set(kept) | set(extra)), points=points, solved=family.solved)
         fit = fit_friction(scenario, log, family=family, **kwargs)
     fit.steady = {"mu_nodes": [float(m) for m in family.steady_mu], "rope_friction": rope.friction,
                   "rope_friction_interval": list(rope.friction_interval),

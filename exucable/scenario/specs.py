@@ -1036,7 +1036,8 @@ class Scenario:
         """The pull with the cable's head ``length_m`` [m] into the conduit: the conduit as the pull
         meets it (reversed for ``pull.direction = "reverse"``) cut at the head
         (:meth:`exucable.geometry.Conduit.truncated`), pulled forward, the cable filling it on
-        ``elements`` elements. A step of the multibody pull-in history (:mod:`exucable.solve.pull_in`).
+        ``elements`` elements. A step of the multibody pull-in history (:mod:`exucable.solve.pull_in`): a
+        scenario to build a model from, not to write back (its ``[conduit]`` table still names the whole route).
 
         Raises
         ------

@@ -79,14 +79,21 @@ class SteadyPullIn:
         return sum(s == "failed" for s in self.status)
 
 
-def pull_in_grid_m(length_m: float, points: int, boundaries_m=()) -> np.ndarray:
+#: Head positions inside every bend or helix at least (besides its ends): the head tension grows there
+#: by e^(μθ), which a straight line between its ends misses by up to μ²θ²/8 of it.
+BEND_POINTS = 3
+
+
+def pull_in_grid_m(length_m: float, points: int, boundaries_m=(), curved_m=()) -> np.ndarray:
     """Head positions [m]: 0, ``points`` uniform positions up to ``length_m`` (the first at
-    ``length_m / points``), and the route's piece boundaries ``boundaries_m`` (bend ends, where the
-    history's slope changes), sorted, one each."""
+    ``length_m / points``), the route's piece boundaries ``boundaries_m`` (bend ends, where the
+    history's slope changes) and :data:`BEND_POINTS` evenly inside each curved range ``curved_m``
+    ((start, end) pairs), sorted, one each."""
     if int(points) < 1:
         raise ValueError(f"points must be >= 1, got {points!r}")
     L = float(length_m)
-    x = np.concatenate([[0.0], np.linspace(L / points, L, int(points)), np.asarray(boundaries_m, float)])
+    inside = [np.linspace(a, b, BEND_POINTS + 2)[1:-1] for a, b in curved_m]
+    x = np.concatenate([[0.0], np.linspace(L / points, L, int(points)), np.asarray(boundaries_m, float)] + inside)
     x = np.unique(np.clip(x, 0.0, L))
     # a boundary within a hundredth of a step of a uniform position adds nothing but a solve
     keep = np.concatenate([[True], np.diff(x) > 0.01 * L / points])
@@ -178,7 +185,8 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
         Solved in steady mode (``solver.mode`` is set to ``"steady"``); velocity-controlled
         (``pull.back_tension``), without ``cable.length``.
     points : int
-        Uniform head positions (:func:`pull_in_grid_m`; the route's piece boundaries are added).
+        Uniform head positions (:func:`pull_in_grid_m`; the route's piece boundaries and
+        :data:`BEND_POINTS` inside each bend are added).
     x_m : array_like, optional
         The head positions [m] instead (ascending, in (0, L]; 0 is added).
     refine : float
@@ -198,7 +206,7 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
     exucable.errors.ScenarioError
         A prescribed ``pull.force`` or a given ``cable.length``.
     """
-    from ..errors import ScenarioError
+    from ..errors import ExucableError, ScenarioError
     from ..model.build import build_model
     from ..model.layout import initial_layout
     from .steady import solve_steady, steady_forces
@@ -211,7 +219,7 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
     curve = conduit.centreline if sc.pull.direction == "forward" else conduit.centreline.reversed()
     L = curve.length_m
     if x_m is None:
-        grid = pull_in_grid_m(L, points, [p.s_end_m for p in curve.pieces[:-1]])
+        grid = pull_in_grid_m(L, points, [p.s_end_m for p in curve.pieces[:-1]], curve.curved_ranges_m())
     else:
         grid = np.unique(np.concatenate([[0.0], np.asarray(x_m, dtype=float)]))
         if grid[0] < 0.0 or grid[-1] > L * (1.0 + 1e-9):
@@ -232,7 +240,14 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
         n_el = max(2, int(math.ceil(x / element_m * (1.0 - 1e-9))))
         sc_x = sc.pulled_in(x, n_el)
         elements[i] = n_el
-        start = initial_layout(sc_x, check_points_per_element=check_points)
+        try:
+            start = initial_layout(sc_x, check_points_per_element=check_points)
+        except ExucableError as exc:
+            # a cable this short cannot be laid as a steady solve needs (its lead-out past the cut longer
+            # than itself): the point has no multibody state; the history goes on from the last one
+            status.append("failed")
+            messages.append(f"head at {x:.4g} m: {exc}")
+            continue
         tries = []
         if warm_start and last is not None:
             extended = _extended_start(start, last, last_x, sc.pull.speed_m_per_s)
