@@ -4,8 +4,7 @@ With the cable's head x metres into the conduit, the cable fills the route's fir
 back tension at its tail, the pulling line (taken as free of friction, as the rope's history takes it)
 holding its head. At a steady pull speed that cable slides in the steady state of the route cut at x
 (:meth:`exucable.scenario.specs.Scenario.pulled_in`), so the history is a sequence of steady solves
-(:func:`exucable.solve.steady.solve_steady`, the public entry point; ``solver.steady_residual`` its
-stop), one per head position, the cable lengthened from a short lead to the whole route.
+(:func:`exucable.solve.steady.solve_steady`, the public entry point, with ``exucable run``'s settings), one per head position, the cable lengthened from a short lead to the whole route.
 
 What changes from one head position to the next is only the cable's far end: the wall it meets before
 its old head is the whole conduit's (the cut conduit keeps the whole conduit's segments), and its tail
@@ -176,7 +175,7 @@ def _extended_start(start, last_model, last_length_m: float, speed_m_per_s: floa
 
 
 def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: float = 1.0,
-                   warm_start: bool = True, progress=None) -> SteadyPullIn:
+                   warm_start: bool = True, settings=None, progress=None) -> SteadyPullIn:
     """The multibody pull-in history of ``scenario`` in its ``pull.direction``.
 
     Parameters
@@ -194,6 +193,9 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
     warm_start : bool
         Start each solve from the last converged state, extended (:func:`_extended_start`); False:
         from the rope start, as a single steady run does.
+    settings : exucable.solve.steady.SteadySettings, optional
+        The steady solves' settings (default: the scenario's, :meth:`SteadySettings.from_solver`, as
+        ``exucable run``).
     progress : callable, optional
         Called ``progress(i, n, x_m, pull_force_N)`` after each point.
 
@@ -209,7 +211,7 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
     from ..errors import ExucableError, ScenarioError
     from ..model.build import build_model
     from ..model.layout import initial_layout
-    from .steady import solve_steady, steady_forces
+    from .steady import SteadySettings, solve_steady, steady_forces
 
     if scenario.pull.force_N is not None:
         raise ScenarioError("pull.force", "a pull-in history starts from the reel's back tension; give "
@@ -225,7 +227,7 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
         if grid[0] < 0.0 or grid[-1] > L * (1.0 + 1e-9):
             raise ScenarioError("pull_in", f"head positions must lie in [0, {L:.6g}] m")
     element_m, check_points = _full_mesh(sc, refine)
-    tolerance = sc.solver.steady_residual
+    settings = SteadySettings.from_solver(sc.solver) if settings is None else settings
     t_wall, t_cpu = time.perf_counter(), time.process_time()
     n = grid.size
     force = np.full(n, np.nan)
@@ -257,7 +259,7 @@ def steady_pull_in(scenario, points: int = DEFAULT_POINTS, *, x_m=None, refine: 
         outcome, model = None, None
         for lay, is_warm in tries:
             model = build_model(sc_x, check_points_per_element=check_points, start=lay)
-            outcome = solve_steady(model, tolerance=tolerance)
+            outcome = solve_steady(model, settings=settings)
             newton[i] += outcome.newton_iterations
             if outcome.status != "failed":
                 warm[i] = is_warm
