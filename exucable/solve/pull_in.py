@@ -4,15 +4,16 @@ With the cable's head x metres into the conduit, the cable fills the route's fir
 back tension at its tail, the pulling line (taken as free of friction, as the rope's history takes it)
 holding its head. At a steady pull speed that cable slides in the steady state of the route cut at x
 (:meth:`exucable.scenario.specs.Scenario.pulled_in`), so the history is a sequence of steady solves
-(:func:`exucable.solve.steady.solve_steady`, the public entry point, with ``exucable run``'s settings), one per head position, the cable lengthened from a short lead to the whole route.
+(:func:`exucable.solve.steady.solve_steady`, the public entry point, with ``exucable run``'s settings),
+one per head position, the cable lengthened from a short lead to the whole route.
 
 What changes from one head position to the next is only the cable's far end: the wall it meets before
 its old head is the whole conduit's (the cut conduit keeps the whole conduit's segments), and its tail
-carries the same back tension. So each solve starts from the last converged state, extended: the new
-cable's nodes take the last state's shape at the same place along the route (nodes matched by their
-material distance from the tail, measured in the last state's own stretch), and only the new length
-beyond the old head starts on the rope's path (the rope solution of the new length, as a single steady
-solve starts). A start that does not converge is solved again from the rope start alone.
+carries the same back tension. So each solve starts from the last converged state, extended
+(:func:`_extended_start`): the new cable's nodes take the last state's shape at the same place along the
+route, up to a few bending lengths before the old head, and beyond that the rope start of the new length
+(as a single steady solve starts), shifted along the cable to join it. A start that does not converge
+is solved again from the rope start alone.
 
 The mesh is the single run's (:func:`exucable.model.layout.initial_layout` of the whole route, the same
 ``refine``): the same element length at every head position, so the last point is the full run's
