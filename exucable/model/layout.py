@@ -431,6 +431,8 @@ def steady_lead_out_m(centreline, bending_stiffness_N_m2: float, exit_tension_N:
     """
     if bending_stiffness_N_m2 <= 0.0 or exit_tension_N <= 0.0:
         return 0.0
+    if not any(piece.is_curved for piece in centreline.pieces):
+        return 0.0      # no bend, no boundary layer to leave (a straight route, or a pull-in's first metres)
     straight = 0.0
     for piece in reversed(centreline.pieces):
         if piece.is_curved:
