@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import resource
 import statistics
 import subprocess
 import sys
@@ -69,26 +70,31 @@ def main(argv=None) -> int:
     for count, arrangement in ((1, "single"), (args.count, args.arrangement)):
         path = out / f"bundle_route_{count}.toml"
         atomic_write_text(path, SCENARIO.format(count=count, arrangement=arrangement, straight=f"{straight:.6g}"))
-        rows[count] = {"times": []}
+        rows[count] = {"times": [], "cpu": []}
     for _ in range(args.repeat):
         for count in rows:        # interleaved: one cable, then the bundle
             t0 = time.perf_counter()
+            c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             proc = subprocess.run([str(exe), "run", str(out / f"bundle_route_{count}.toml"), "--out",
                                    str(out / f"run_{count}"), "--no-plots", "--quiet"], capture_output=True, text=True)
             rows[count]["times"].append(time.perf_counter() - t0)
+            c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            rows[count]["cpu"].append(c1.ru_utime - c0.ru_utime + c1.ru_stime - c0.ru_stime)
             rows[count]["exit"] = proc.returncode
             rows[count]["summary"] = json.loads((out / f"run_{count}" / "summary.json").read_text())
     one, many = rows[1], rows[args.count]
     t1, tn = statistics.median(one["times"]), statistics.median(many["times"])
+    c1, cn = statistics.median(one["cpu"]), statistics.median(many["cpu"])
     s1, sn = one["summary"], many["summary"]
     b = sn["bundle"]
     print(f"route {args.length:.0f} m (straights {straight:.4g} m, 4 bends), whole process, median of {args.repeat}:")
-    print(f"  1 cable : {t1:7.2f} s, status {s1['status']}, pull {s1['pull_force_N']:.6g} N, "
+    print(f"  1 cable : {t1:7.2f} s wall, {c1:7.2f} s CPU, status {s1['status']}, pull {s1['pull_force_N']:.6g} N, "
           f"{s1['mesh']['elements']} elements, {s1['newton_iterations']} Newton iterations")
-    print(f"  {args.count} cables: {tn:7.2f} s, status {sn['status']}, pull {sn['pull_force_N']:.6g} N, "
-          f"{sn['mesh']['elements']} elements each, {sn['newton_iterations']} Newton iterations "
+    print(f"  {args.count} cables: {tn:7.2f} s wall, {cn:7.2f} s CPU, status {sn['status']}, pull {sn['pull_force_N']:.6g} N, "
+          f"{sn['mesh']['elements']} elements each ({sn['mesh']['element_length_m']:.3g} m, {sn['mesh']['check_points_per_element']} check points), {sn['newton_iterations']} Newton iterations "
           f"({sn['message']})")
-    print(f"  ratio bundle / one cable: {tn / t1:.2f}x; target ≤ 60 s: {'met' if tn <= 60.0 else 'NOT met'}")
+    print(f"  ratio bundle / one cable: {tn / t1:.2f}x wall, {cn / c1:.2f}x CPU; target ≤ 60 s whole process: "
+          f"{'met' if tn <= 60.0 else 'NOT met'} (wall), {'met' if cn <= 60.0 else 'NOT met'} (CPU)")
     print(f"  weight correction factor {b['weight_correction_factor']:.5g} (calculators' "
           f"{b['formula_weight_correction_factor']:.5g}); per straight: "
           + ", ".join(f"{st['weight_correction_factor']:.4g}" if st['weight_correction_factor'] is not None else "n/a"
