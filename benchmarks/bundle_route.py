@@ -1,15 +1,17 @@
-"""Whole-process wall time of a bundle run: three cables through a 100 m route with four bends, steady mode.
+"""Whole-process wall and CPU time of a bundle run: three cables through a 100 m route with four bends, steady mode.
 
     nice .venv/bin/python benchmarks/bundle_route.py [--count 3] [--arrangement triangular]
         [--length 100] [--repeat 1] [--out DIR]
 
-Writes the scenario (four 90° bends of 5 m radius, two left, one up, one right, joined by equal straights;
-cables of 30 mm diameter, 1.4 kg/m, in a 100 mm duct; μ 0.3, back tension 300 N) and times
-``exucable run SCENARIO --no-plots`` in a fresh process per repeat (scenario → build → solve → files),
-next to the same route with one cable (``cable.count = 1``) timed in the same run, and prints the
-ratio, the bundle's pull force, its weight correction factor beside the calculators' and its status.
-Target (issue "Three cables in one conduit"): ≤ 60 s whole process. The machine is shared: compare
-the rows of one run with each other.
+Writes the scenario (bends of 5 m radius: 90° left, 90° left, 30° up, 90° right, joined by equal
+straights; cables of 30 mm diameter, 1.4 kg/m, in a 100 mm duct, D/d 3.33; μ 0.3, back tension 300 N)
+and times ``exucable run SCENARIO --no-plots`` in a fresh process per repeat (scenario → build → solve
+→ files; CPU time of the child process), next to the same route with one cable (``cable.count = 1``)
+timed in the same run, and prints the ratio, the bundle's pull force, its weight correction factor
+beside the calculators' and its status. Mesh: the scenario's rule (printed); a bundle run states no
+error bar yet (the one-cable run's is the coarse-mesh Richardson estimate). Target (issue "Three
+cables in one conduit"): ≤ 60 s whole process. The machine is shared: compare the rows of one run
+with each other.
 """
 
 from __future__ import annotations
@@ -57,9 +59,9 @@ def main(argv=None) -> int:
     p.add_argument("--length", type=float, default=100.0, help="route length [m] (approximately)")
     p.add_argument("--repeat", type=int, default=1)
     p.add_argument("--out", default="out/bundle-benchmark")
-    p.add_argument("--quick", action="store_true", help="two cables on a 12 m route (a smoke run)")
+    p.add_argument("--quick", action="store_true", help="two cables on the shortest route, 1 m straights, 34 m (a smoke run)")
     args = p.parse_args(argv)
-    if args.quick:      # the smoke run: two cables on a short route
+    if args.quick:      # the smoke run: two cables on the shortest route (the straights' floor of 1 m)
         args.count, args.length, args.repeat = 2, 12.0, 1
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -87,7 +89,8 @@ def main(argv=None) -> int:
     c1, cn = statistics.median(one["cpu"]), statistics.median(many["cpu"])
     s1, sn = one["summary"], many["summary"]
     b = sn["bundle"]
-    print(f"route {args.length:.0f} m (straights {straight:.4g} m, 4 bends), whole process, median of {args.repeat}:")
+    print(f"route {5 * straight + bends_m:.0f} m (straights {straight:.4g} m, 4 bends), whole process, "
+          f"median of {args.repeat}:")
     print(f"  1 cable : {t1:7.2f} s wall, {c1:7.2f} s CPU, status {s1['status']}, pull {s1['pull_force_N']:.6g} N, "
           f"{s1['mesh']['elements']} elements, {s1['newton_iterations']} Newton iterations")
     print(f"  {args.count} cables: {tn:7.2f} s wall, {cn:7.2f} s CPU, status {sn['status']}, pull {sn['pull_force_N']:.6g} N, "
