@@ -6,16 +6,17 @@ that the straights between the vertical bends slope; the mesh and the check poin
 scenario's default rules (:func:`route_data`).
 
 Each length runs in its own process (so that its peak memory is its own): the process imports
-exucable, parses the scenario, builds the model (the start layout and both rope references
-included), solves steady, post-processes (tension profile, check-point loads, pressure, bends,
-trust), writes the result files and draws the three figures, each stage timed on its own. The
-parent times the whole child process (interpreter start to exit). Printed per length: elements,
-check points, Newton iterations, the wall time of each stage and its share of the whole, the CPU
-time of the whole process and of each stage (on a shared, loaded machine the CPU times are the ones
-to compare), the
-contact kernel's share of the solve, the solve's time per Newton iteration, peak memory (ru_maxrss)
-and the pulling force against the rope with clearance; then the exponent p of a least-squares fit
-whole-process wall (and CPU time) ∝ L^p, measured in this one run.
+exucable, parses the scenario, builds the models (the rule's coarse mesh for the error bar and the
+solved mesh, the start layout and both rope references included), solves steady, solves the error
+bar's coarse mesh, post-processes (tension profile, check-point loads, pressure, bends, trust),
+writes the result files and draws the three figures, each stage timed on its own (wall and CPU
+time). The parent times the whole child process (interpreter start to exit, wall and CPU). Printed
+per length: elements, check points, Newton iterations of the solve and of the error bar's, the CPU
+time of the whole process and of each stage with its share (on a shared, loaded machine the CPU
+times are the ones to compare), the rope references' part of the build, the solve's CPU time per
+Newton iteration, peak memory (ru_maxrss) and the pulling force against the rope with clearance;
+then the exponent p of a least-squares fit CPU time ∝ L^p (whole process, the solves, the rest),
+measured in this one run.
 
 ``--profile`` runs the longest route once more under cProfile (in this process, after a short
 warm-up) and prints Exudyn's own timers of its static solver per Newton iteration (system
@@ -97,24 +98,68 @@ class _Clock:
         self._t = now
 
 
+class _Timed:
+    """Wall and CPU time [s] summed over the calls of the functions it wraps, per stage name,
+    and the outcomes of the steady solves (main solve first, then the error bar's coarse one)."""
+
+    def __init__(self):
+        self.wall, self.cpu, self.solves = {}, {}, []
+
+    def wrap(self, module, name: str, stage):
+        """Replace ``module.name`` by a timed copy; ``stage(call_number)`` names the stage of a call."""
+        f = getattr(module, name)
+        calls = [0]
+
+        def timed(*args, **kwargs):
+            key = stage(calls[0])
+            calls[0] += 1
+            w, c = time.perf_counter(), time.process_time()
+            out = f(*args, **kwargs)
+            self.wall[key] = self.wall.get(key, 0.0) + time.perf_counter() - w
+            self.cpu[key] = self.cpu.get(key, 0.0) + time.process_time() - c
+            if name == "solve_steady":
+                self.solves.append(out)
+            return out
+
+        setattr(module, name, timed)
+
+
 def one_case(length_m: float, figures: bool = True) -> dict:
-    """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints)."""
+    """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints).
+
+    Stages: import, parse, build (every model built, the rope references included), of it the
+    references (the centreline rope's solves and the rope with clearance), solve (the steady
+    solve), error bar (the second steady solve on the coarse mesh), post (the rest of
+    ``run_scenario``: tension profile, check-point loads, pressure, bends, trust), write (CSV and
+    JSON), figures; wall and CPU time of each."""
     clock = _Clock()
     from exucable.output.results import write_results
     from exucable.plots.results import plot_pressure, plot_pull_force, plot_tension_profile
     from exucable.run import run_scenario
     from exucable.scenario.specs import parse_scenario
+    import exucable.model.build as build
+    import exucable.quasistatic.clearance as clearance
+    import exucable.quasistatic.rope as rope
+    import exucable.solve.steady as steady
     clock.lap("import_s")
     sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
     clock.lap("parse_s")
+    # run_scenario and the error bar import these at call time: the timed copies are the ones called
+    timed = _Timed()
+    timed.wrap(build, "build_model", lambda i: "build_s")
+    timed.wrap(steady, "solve_steady", lambda i: "solve_s" if i == 0 else "error_bar_s")
+    for module, name in ((rope, "solve_rope"), (rope, "rope_pull_force_N"), (rope, "solve_rope_for_pull_force"),
+                         (clearance, "solve_rope_with_clearance")):
+        timed.wrap(module, name, lambda i: "references_s")
     res = run_scenario(sc, None, plots=False)
     clock.lap("run_s")
     s = res.summary
-    # run_scenario times its build and its solve; the rest of it is post-processing
-    t = {k: clock.wall[k] for k in ("import_s", "parse_s")}
-    t["build_s"] = s["build_time_s"]
-    t["solve_s"] = s["wall_time_s"]
-    t["post_s"] = clock.wall["run_s"] - s["build_time_s"] - s["wall_time_s"]
+    wall = {k: clock.wall[k] for k in ("import_s", "parse_s")}
+    cpu = {k: clock.cpu[k] for k in ("import_s", "parse_s")}
+    for k in ("build_s", "references_s", "solve_s", "error_bar_s"):
+        wall[k], cpu[k] = timed.wall.get(k, 0.0), timed.cpu.get(k, 0.0)
+    wall["post_s"] = clock.wall["run_s"] - wall["build_s"] - wall["solve_s"] - wall["error_bar_s"]
+    cpu["post_s"] = clock.cpu["run_s"] - cpu["build_s"] - cpu["solve_s"] - cpu["error_bar_s"]
 
     out = Path(tempfile.mkdtemp(prefix="exucable-long-routes-"))
     try:
@@ -129,16 +174,18 @@ def one_case(length_m: float, figures: bool = True) -> dict:
         clock.lap("figures_s")
     finally:
         shutil.rmtree(out, ignore_errors=True)
+    for k in ("write_s", "figures_s"):
+        wall[k], cpu[k] = clock.wall[k], clock.cpu[k]
+    bar = timed.solves[1] if len(timed.solves) > 1 else None
     return {"length_m": length_m, "status": s["status"], "message": s["message"],
             "elements": s["scenario"]["cable"]["elements"],
             "check_points": s["scenario"]["cable"]["elements"] * s["mesh"]["check_points_per_element"],
             "newton_iterations": s["newton_iterations"], "steps": s["steps"],
+            "error_bar_newton_iterations": bar.newton_iterations if bar is not None else 0,
             "kernel_s": s["kernel_time_s"], "pull_force_N": s["pull_force_N"],
             "rope_clearance_pull_force_N": s["rope_clearance_pull_force_N"],
             "rope_pull_force_N": s["rope_pull_force_N"],
-            "write_s": clock.wall["write_s"], "figures_s": clock.wall["figures_s"],
-            "cpu_s": {k: v for k, v in clock.cpu.items() if k != "rest"},
-            "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **t}
+            "cpu_s": cpu, "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **wall}
 
 
 def in_child(length_m: float, figures: bool) -> dict:
@@ -155,24 +202,23 @@ def in_child(length_m: float, figures: bool) -> dict:
     return dict(json.loads(done.stdout.strip().splitlines()[-1]), process_s=wall, process_cpu_s=cpu)
 
 
-STAGES = ("import_s", "parse_s", "build_s", "solve_s", "post_s", "write_s", "figures_s")
+STAGES = ("import_s", "parse_s", "build_s", "solve_s", "error_bar_s", "post_s", "write_s", "figures_s")
 
 
 def report(r: dict) -> str:
-    whole = r["process_s"]
-    stages = "  ".join(f"{k[:-2]} {r[k]:6.2f} ({100 * r[k] / whole:3.0f} %)" for k in STAGES)
+    cpu, whole = r["cpu_s"], r["process_cpu_s"]
+    stages = "  ".join(f"{k[:-2].replace('_', ' ')} {cpu[k]:6.2f} ({100 * cpu[k] / whole:3.0f} %)" for k in STAGES)
     n = max(r["newton_iterations"], 1)
     F, Fc = r["pull_force_N"], r["rope_clearance_pull_force_N"]
     vs = f"{100 * (F / Fc - 1):+.2f} %" if F is not None and Fc else "-"
-    return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process {whole:6.2f} s  "
+    return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process CPU {whole:6.2f} s (wall {r['process_s']:6.2f} s)  "
             f"elements {r['elements']:5d}  check points {r['check_points']:7d}  Newton {r['newton_iterations']:4d} "
-            f"({r['steps']} pseudo-time steps)  peak RSS {r['peak_rss_MB']:5.0f} MB\n"
-            f"{'':9s}{stages}  (outside them: interpreter start and exit "
-            f"{whole - sum(r[k] for k in STAGES):5.2f})\n"
-            f"{'':9s}CPU time: whole process {r['process_cpu_s']:6.2f} s; "
-            + "  ".join(f"{k[:-2]} {v:6.2f}" for k, v in r["cpu_s"].items()) + "\n"
-            f"{'':9s}solve per Newton iteration {1e3 * r['solve_s'] / n:6.1f} ms, of which contact kernel "
-            f"{1e3 * r['kernel_s'] / n:6.1f} ms ({100 * r['kernel_s'] / max(r['solve_s'], 1e-12):3.0f} %);  "
+            f"({r['steps']} pseudo-time steps; error bar's coarse solve {r['error_bar_newton_iterations']})  "
+            f"peak RSS {r['peak_rss_MB']:5.0f} MB\n"
+            f"{'':9s}CPU per stage [s]: {stages}  (outside them: interpreter start and exit "
+            f"{whole - sum(cpu[k] for k in STAGES):5.2f}); of the build, the rope references {cpu['references_s']:6.2f}\n"
+            f"{'':9s}solve's CPU per Newton iteration {1e3 * cpu['solve_s'] / n:6.1f} ms (wall {1e3 * r['solve_s'] / n:6.1f} ms), "
+            f"of which contact kernel (wall) {1e3 * r['kernel_s'] / n:6.1f} ms;  "
             f"F {'-' if F is None else f'{F:.1f}'} N, vs rope with clearance {vs}"
             + (f"\n{'':9s}{r['message']}" if r["message"] else ""))
 
@@ -275,20 +321,22 @@ def main() -> None:
         print(json.dumps(one_case(float(args.case), figures=not args.no_figures)))
         return
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
-    walls = []
+    rows = []
     for L in lengths:
         r = in_child(L, figures=not args.no_figures)
         print(report(r), flush=True)
         if r["status"] != "failed":
-            walls.append((L, r["process_s"], r["solve_s"], r["process_s"] - r["solve_s"], r["process_cpu_s"]))
-    if len(walls) >= 2:
+            solves = r["cpu_s"]["solve_s"] + r["cpu_s"]["error_bar_s"]
+            rows.append((L, r["process_cpu_s"], solves, r["process_cpu_s"] - solves, r["process_s"]))
+    if len(rows) >= 2:
         import numpy as np
 
-        L, w, solve, rest, cpu = np.array(walls).T
+        L, cpu, solve, rest, w = np.array(rows).T
         fit = lambda y: np.polyfit(np.log(L), np.log(y), 1)[0]
-        print(f"whole process ∝ L^{fit(w):.2f}, solve ∝ L^{fit(solve):.2f}, everything but the solve ∝ "
-              f"L^{fit(rest):.2f}, whole process's CPU time ∝ L^{fit(cpu):.2f} over {', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
-        print(f"share of everything but the solve at {L[-1]:g} m: {100 * rest[-1] / w[-1]:.0f} %")
+        print(f"CPU time: whole process ∝ L^{fit(cpu):.2f}, the two steady solves ∝ L^{fit(solve):.2f}, everything "
+              f"but the solves ∝ L^{fit(rest):.2f}; whole process wall ∝ L^{fit(w):.2f}; over "
+              f"{', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
+        print(f"share of everything but the solve at {L[-1]:g} m (CPU time): {100 * rest[-1] / cpu[-1]:.0f} %")
     if args.clearance_spacing:
         clearance_spacing(lengths[-1])
     if args.profile:
