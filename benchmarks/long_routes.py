@@ -23,7 +23,11 @@ warm-up) and prints Exudyn's own timers of its static solver per Newton iteratio
 Jacobian, factorisation, residual) and the functions with the most own and cumulative time (the
 contact kernel, our coupling's and the pseudo-time spring's user functions, the build's parts).
 
-Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--clearance-spacing]``;
+``--newton-parts`` times each part of one Newton iteration of the longest route on its own (CPU
+time): the residual, the ODE2 Jacobian with and without the loads' Jacobian, our contact
+coupling's user functions within them, and one whole one-iteration static solve.
+
+Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing]``;
 ``--clearance-spacing`` solves the longest route's rope with clearance at a 2 cm node spacing and at
 the default rule's, with the pulling force's change and the CPU time of each.
 ``--quick`` is a smoke run (a 200 m and a 400 m route).
@@ -104,6 +108,7 @@ class _Timed:
 
     def __init__(self):
         self.wall, self.cpu, self.solves = {}, {}, []
+        self._inside = set()
 
     def wrap(self, module, name: str, stage):
         """Replace ``module.name`` by a timed copy; ``stage(call_number)`` names the stage of a call."""
@@ -113,8 +118,14 @@ class _Timed:
         def timed(*args, **kwargs):
             key = stage(calls[0])
             calls[0] += 1
+            if key in self._inside:     # a call within a timed call of the same stage: counted there
+                return f(*args, **kwargs)
+            self._inside.add(key)
             w, c = time.perf_counter(), time.process_time()
-            out = f(*args, **kwargs)
+            try:
+                out = f(*args, **kwargs)
+            finally:
+                self._inside.discard(key)
             self.wall[key] = self.wall.get(key, 0.0) + time.perf_counter() - w
             self.cpu[key] = self.cpu.get(key, 0.0) + time.process_time() - c
             if name == "solve_steady":
@@ -178,8 +189,9 @@ def one_case(length_m: float, figures: bool = True) -> dict:
         wall[k], cpu[k] = clock.wall[k], clock.cpu[k]
     bar = timed.solves[1] if len(timed.solves) > 1 else None
     return {"length_m": length_m, "status": s["status"], "message": s["message"],
-            "elements": s["scenario"]["cable"]["elements"],
-            "check_points": s["scenario"]["cable"]["elements"] * s["mesh"]["check_points_per_element"],
+            # the solved mesh's (steady mode refines the rule's; the error bar solves the rule's)
+            "elements": s["mesh"]["elements"],
+            "check_points": s["mesh"]["elements"] * s["mesh"]["check_points_per_element"],
             "newton_iterations": s["newton_iterations"], "steps": s["steps"],
             "error_bar_newton_iterations": bar.newton_iterations if bar is not None else 0,
             "kernel_s": s["kernel_time_s"], "pull_force_N": s["pull_force_N"],
@@ -284,6 +296,66 @@ def profile(length_m: float, top: int = 25) -> None:
     print(buf.getvalue())
 
 
+def newton_parts(length_m: float, reps: int = 5) -> None:
+    """CPU time of each part of one Newton iteration of the steady solve on the solved mesh of the
+    route of ``length_m`` [m], each part called ``reps`` times on its own through Exudyn's solver
+    methods (after one warm-up residual): the residual (the ANCF elements inside Exudyn, our contact
+    coupling's user function with the kernel, the pseudo-time spring's), the ODE2 Jacobian (the
+    ANCF elements' by automatic differentiation inside Exudyn, the two user functions' sparse
+    blocks) with and without the loads' Jacobian, and one whole one-iteration static solve (adds
+    the sparse matrix's assembly, its LU factorisation and a second residual)."""
+    import types
+
+    import numpy as np
+    import exudyn as exu
+
+    import exucable.model.coupling as coupling
+    import exucable.solve.steady as steady
+    from exucable.model.build import build_model
+    from exucable.scenario.specs import parse_scenario
+
+    # the coupling's own timers then count this process's CPU time, not wall
+    coupling.time = types.SimpleNamespace(perf_counter=time.process_time)
+    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    first = build_model(sc)
+    model = build_model(sc, refine=2.0, check_points_per_element=first.mesh.check_points_per_element,
+                        references=first.start)
+    mbs = model.mbs
+    spring = steady.PseudoTimeSpring(model)
+    spring.rate = steady.initial_spring_rate(model)
+    n = mbs.systemData.ODE2Size()
+    print(f"one Newton iteration's parts, {length_m / 1000:g} km: {model.mesh.elements} elements x "
+          f"{model.mesh.check_points_per_element} check points, {n} coordinates; CPU time per call, "
+          f"mean of {reps}:")
+    q0 = np.array(mbs.systemData.GetODE2Coordinates())
+    rng = np.random.default_rng(0)
+
+    def moved():   # new coordinates each call, so that the coupling's reuse of a kernel pass does not hide it
+        mbs.systemData.SetODE2Coordinates(list(q0 + 1e-12 * rng.random(n)))
+
+    def timed(name, f, count=reps):
+        c = model.coupling
+        t, u, k = time.process_time(), c.user_time_s, c.kernel_time_s
+        for _ in range(count):
+            f()
+        dt, du, dk = [(x1 - x0) / count for x0, x1 in ((t, time.process_time()), (u, c.user_time_s), (k, c.kernel_time_s))]
+        print(f"  {name:58s} {1e3 * dt:8.2f} ms  (contact coupling's user functions {1e3 * du:7.2f}, of it the kernel "
+              f"{1e3 * dk:7.2f}; the rest {1e3 * (dt - du):7.2f})", flush=True)
+        return dt
+
+    solver = exu.MainSolverStatic()
+    settings = steady.static_settings()
+    solver.InitializeSolver(mbs, settings)
+    moved()
+    solver.ComputeODE2RHS(mbs)                  # warm-up: the kernel's first call loads it from numba's cache
+    timed("residual (ODE2 RHS) at new coordinates", lambda: (moved(), solver.ComputeODE2RHS(mbs)))
+    jac = timed("ODE2 Jacobian, no loads' Jacobian (the settings)", lambda: solver.ComputeJacobianODE2RHS(mbs, -1.0, 0.0, 0.0, 0))
+    timed("ODE2 Jacobian with the loads' Jacobian (Exudyn's default)", lambda: solver.ComputeJacobianODE2RHS(mbs, -1.0, 0.0, 0.0, 1))
+    one = steady.static_settings(tolerance=1.0, max_iterations=1)
+    whole = timed("one whole static solve of one Newton iteration", lambda: (moved(), exu.MainSolverStatic().SolveSystem(mbs, one)))
+    print(f"  the Jacobian is {100 * jac / whole:.0f} % of the whole iteration")
+
+
 def clearance_spacing(length_m: float, spacings_m=(0.02, None)) -> None:
     """The rope with clearance of the route of ``length_m`` [m] at node spacings ``spacings_m``
     (None: the default rule), with its pulling force and the CPU time of each solve."""
@@ -314,6 +386,8 @@ def main() -> None:
     ap.add_argument("--profile", action="store_true", help="also cProfile the longest route")
     ap.add_argument("--clearance-spacing", action="store_true",
                     help="also the longest route's rope with clearance at 2 cm and at the default node spacing")
+    ap.add_argument("--newton-parts", action="store_true",
+                    help="also the CPU time of each part of one Newton iteration on the longest route")
     ap.add_argument("--no-figures", action="store_true", help="skip the figures stage")
     ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -339,6 +413,8 @@ def main() -> None:
         print(f"share of everything but the solve at {L[-1]:g} m (CPU time): {100 * rest[-1] / cpu[-1]:.0f} %")
     if args.clearance_spacing:
         clearance_spacing(lengths[-1])
+    if args.newton_parts:
+        newton_parts(lengths[-1])
     if args.profile:
         profile(lengths[-1])
 
