@@ -119,31 +119,6 @@ def test_default_run_is_steady_with_an_error_bar_that_covers_a_finer_mesh(tmp_pa
     assert finer.summary["pull_force_N"] == pytest.approx(CAPSTAN_N, rel=1e-3)
 
 
-def test_the_error_bars_coarse_solve_starts_on_the_solved_state(tmp_path):
-    """The coarse mesh's nodes are every other node of the solved one: started there, its solve
-    reaches the same equilibrium as from its own rope start, in fewer Newton iterations. Both stop
-    with an unbalanced force ≤ STATIC_TOLERANCE × the rope's largest tension, which bounds each
-    one's error in the pulling force (the reaction at the rig): they differ by at most twice that."""
-    from exucable.model.build import build_model
-    from exucable.solve.error_bar import _start_on_the_solved_state
-    from exucable.solve.steady import STATIC_TOLERANCE, solve_steady, steady_forces
-
-    sc = parse_scenario(_data(), tmp_path)
-    first = build_model(sc)
-    k = first.mesh.check_points_per_element
-    solved = build_model(sc, refine=2.0, check_points_per_element=k, references=first.start)
-    assert solved.layout.n_elements == 2 * first.layout.n_elements
-    assert solve_steady(solved).status == "ok"
-    cold = solve_steady(first)
-    warm_model = build_model(sc, check_points_per_element=k, references=first.start)
-    assert _start_on_the_solved_state(warm_model, solved)
-    warm = solve_steady(warm_model)
-    assert cold.status == warm.status == "ok"
-    assert warm.newton_iterations < cold.newton_iterations
-    bound = 2.0 * STATIC_TOLERANCE * first.rope.max_tension_N
-    assert abs(steady_forces(warm_model)[0] - steady_forces(first)[0]) <= bound
-
-
 def test_a_given_mesh_is_solved_as_given_and_its_half_gives_the_bar(tmp_path):
     from exucable.run import run_scenario
 

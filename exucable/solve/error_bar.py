@@ -92,34 +92,6 @@ def combine(value_N: float, coarse_N: float, elements: int, coarse_elements: int
     return mesh, mesh + solve_N
 
 
-def _start_on_the_solved_state(coarse, model) -> bool:
-    """Start ``coarse`` on ``model``'s solved state where its nodes are a subset of ``model``'s
-    (the solved mesh is the coarse one refined an integer number of times: every r-th node): the
-    absolute nodal positions and slopes there, as displacements from the coarse layout. Returns
-    whether it did.
-
-    Why: from its own rope start the coarse solve costs as many Newton iterations as the solved
-    one; from the solved state it is a small correction (the discretisation's difference). Both
-    stop at the same equilibrium residual, so the coarse value differs by no more than the stop
-    tolerance allows, and the pulling force of the solved mesh is untouched.
-    """
-    import numpy as np
-
-    n, m = model.layout.n_elements, coarse.layout.n_elements
-    if m <= 0 or n % m != 0 or getattr(model.layout, "n_cables", 1) != 1:
-        return False
-    r = n // m
-    q_fine, _ = model.coordinates()                          # absolute, (n + 1, 6)
-    q_disp = q_fine[::r] - coarse.layout.coordinates
-    # as the nodes' initial displacements: the steady solve assembles the system again (its
-    # pseudo-time spring), which resets the state to them
-    mbs = coarse.mbs
-    for node, q in zip(coarse.cable.nodes, q_disp):
-        mbs.SetNodeParameter(node, "initialCoordinates", [float(x) for x in q])
-    mbs.Assemble()
-    return True
-
-
 def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None,
                      refine: float = 1.0) -> SteadyErrorBar:
     """Solve ``scenario`` again on a mesh ``COARSE_RATIO`` times coarser than ``model``'s and state
@@ -154,13 +126,7 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
     if m >= n:
         return SteadyErrorBar(None, None, solve_N, None, m, f"{head} not possible: {n} elements cannot be coarsened",
                               time.perf_counter() - t0)
-    warm = _start_on_the_solved_state(coarse, model)
     out = solve_steady(coarse)
-    if out.status == "failed" and warm:
-        # the solved state is a start, not a requirement: the rule's own start as a fallback
-        coarse = build_model(scenario, refine=refine / COARSE_RATIO, check_points_per_element=k,
-                             references=getattr(model, "start", None))
-        out = solve_steady(coarse)
     if out.status == "failed":
         return SteadyErrorBar(None, None, solve_N, None, m, f"{head} failed ({out.message})", time.perf_counter() - t0)
     pull, trail, _ = steady_forces(coarse)
