@@ -42,8 +42,8 @@ def quiet_sparse(s: exu.SimulationSettings) -> exu.SimulationSettings:
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     # The loads (each element's weight, the end forces) do not depend on the coordinates, so their
     # Jacobian is zero; the static solver's default differentiates every element's weight
-    # numerically each Newton iteration (8-10 % of one at 1 km), as the
-    # time integration's default already does not.
+    # numerically each Newton iteration (8-10 % of one at 1 km). The time integration's default
+    # already skips it.
     s.staticSolver.computeLoadsJacobian = False
     s.solution.file.write = False
     s.solution.sensors.active = False
