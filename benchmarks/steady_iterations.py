@@ -7,9 +7,8 @@ Newton iterations, the pseudo-time steps tried (rejected ones included), the con
 passes, the solve's wall time, the pulling force and whether the exact-step continuation ran
 (Newton iterations > steps tried: a one-iteration step takes exactly one).
 
-``--set NAME=VALUE`` overrides a constant of :mod:`exucable.solve.steady` (e.g. ``RATE_FALL=16``)
-to compare a rule across all cases (the solver takes no settings object: the constant is set for
-this script's solves and restored after them); ``--tight`` also solves each case to 1/1000 of the stop
+``--set NAME=VALUE`` overrides a field of :class:`exucable.solve.steady.SteadySettings` (e.g.
+``rate_fall=16``) to compare a rule across all cases (passed to every solve of this run); ``--tight`` also solves each case to 1/1000 of the stop
 tolerance and prints how far the pulling force moves (how converged it is); ``--trace CASE``
 prints, for each accepted pseudo-time step of one case, its residual and the check points whose
 contact state (δ > 0) still differs from the converged one.
@@ -22,6 +21,7 @@ contact state (δ > 0) still differs from the converged one.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -31,7 +31,7 @@ import numpy as np
 from exucable.model.build import build_model
 from exucable.scenario.specs import load_scenario, parse_scenario
 from exucable.sweep.spec import load_sweep
-import exucable.solve.steady as solve_steady_module
+from exucable.solve.steady import SteadySettings, solve_steady
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -82,11 +82,11 @@ class _StateTrace:
         pass
 
 
-def trace(name: str, scenario) -> None:
+def trace(name: str, scenario, settings: SteadySettings) -> None:
     """Per accepted step: residual, check points in contact, and those whose state differs from the last."""
     model = build_model(steady(scenario, name))
     sink = _StateTrace(model)
-    out = solve_steady_module.solve_steady(model, progress=sink)
+    out = solve_steady(model, progress=sink, settings=settings)
     kernel = model.kernel
     zero = np.zeros_like(sink.states[-1])
     final = kernel.points(sink.states[-1], zero).penetration_m > 0.0
@@ -98,10 +98,10 @@ def trace(name: str, scenario) -> None:
         print(f"{i + 1:4d}  {sink.residuals[i]:>12s}  {int(touch.sum()):10d}  {int(np.count_nonzero(touch != final)):10d}")
 
 
-def solve(name: str, scenario, tolerance: float) -> dict:
+def solve(name: str, scenario, settings: SteadySettings) -> dict:
     model = build_model(steady(scenario, name))
     t0 = time.perf_counter()
-    out = solve_steady_module.solve_steady(model, tolerance=tolerance)
+    out = solve_steady(model, settings=settings)
     wall = time.perf_counter() - t0
     F = out.history.pull_force_N[-1] if out.history.pull_force_N else float("nan")
     return {"status": out.status, "newton": out.newton_iterations, "steps": out.steps,
@@ -115,53 +115,48 @@ def main(argv=None) -> int:
     ap.add_argument("--long", action="store_true", help="include the 1 km benchmark route")
     ap.add_argument("--tight", action="store_true", help="also solve to 1/1000 of the stop tolerance")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                    help="override a constant of exucable.solve.steady")
+                    help="override a field of exucable.solve.steady.SteadySettings")
     ap.add_argument("--trace", metavar="CASE", help="per-step residual and contact state of one case")
     ap.add_argument("--quick", action="store_true", help="smoke run: the case ex2-coarse only")
     args = ap.parse_args(argv)
     if args.quick and not args.only:
         args.only = "ex2-coarse"
+    kinds = {f.name: f.type for f in dataclasses.fields(SteadySettings)}
     overrides = {}
     for item in args.set:
-        key, value = item.split("=", 1)
-        if not hasattr(solve_steady_module, key):
-            ap.error(f"--set {item}: exucable.solve.steady has no {key}")
-        overrides[key] = type(getattr(solve_steady_module, key))(float(value))
-    saved = {key: getattr(solve_steady_module, key) for key in overrides}
-    for key, value in overrides.items():
-        setattr(solve_steady_module, key, value)
-    try:
-        return run(ap, args)
-    finally:
-        for key, value in saved.items():
-            setattr(solve_steady_module, key, value)
+        key, _, value = item.partition("=")
+        key = key.strip().lower()
+        if key not in kinds:
+            ap.error(f"--set {item}: SteadySettings has no field {key!r}; fields: {', '.join(kinds)}")
+        overrides[key] = int(float(value)) if kinds[key] == "int" else float(value)
+    return run(ap, args, dataclasses.replace(SteadySettings(), **overrides))
 
 
-def run(ap, args) -> int:
+def run(ap, args, settings: SteadySettings) -> int:
     """The table (or the trace) of the cases ``args`` names."""
     table = cases(long=args.long or (args.only is not None and "bench-1km" in args.only))
     if args.trace:
         if args.trace not in table:
             ap.error(f"--trace: no case {args.trace!r}; cases: {', '.join(table)}")
-        trace(args.trace, table[args.trace]())
+        trace(args.trace, table[args.trace](), settings)
         return 0
     wanted = args.only.split(",") if args.only else list(table)
     unknown = [w for w in wanted if w not in table]
     if unknown:
         ap.error(f"--only: no case {', '.join(unknown)}; cases: {', '.join(table)}")
-    tol = solve_steady_module.STATIC_TOLERANCE
+    tight = dataclasses.replace(settings, steady_residual=settings.steady_residual / 1000.0)
     # compile the kernels before the first timed solve
-    solve("warm-up", table["ex1-coarse"](), tol)
+    solve("warm-up", table["ex1-coarse"](), settings)
     print(f"{'case':34s} {'status':6s} {'Newton':>6s} {'steps':>5s} {'kept':>4s} {'passes':>6s} {'solve [s]':>9s} "
           f"{'pulling force [N]':>18s}" + ("  vs tol/1000" if args.tight else "") + "  exact steps")
     totals = np.zeros(3)
     for name in wanted:
-        r = solve(name, table[name](), tol)
+        r = solve(name, table[name](), settings)
         totals += (r["newton"], r["passes"], r["wall_s"])
         line = (f"{name:34s} {r['status']:6s} {r['newton']:6d} {r['steps']:5d} {r['accepted']:4d} {r['passes']:6d} "
                 f"{r['wall_s']:9.2f} {r['F']:18.10g}")
         if args.tight:
-            t = solve(name, table[name](), tol / 1000.0)
+            t = solve(name, table[name](), tight)
             line += f"  {r['F'] / t['F'] - 1:+.1e}" if t["status"] == "ok" else f"  ({t['status']})"
         line += "  yes" if r["newton"] > r["steps"] else "  no"
         print(line, flush=True)

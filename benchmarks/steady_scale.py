@@ -150,10 +150,11 @@ def mesh_check(length_m: float, base: dict) -> str:
 def tolerance_check(length_m: float) -> str:
     """Pulling force of the steady solve at the default stop tolerance and at 1/100 of it."""
     from exucable.model.build import build_model
-    from exucable.solve.steady import STATIC_TOLERANCE, solve_steady, steady_forces
+    from exucable.solve.steady import SteadySettings, solve_steady, steady_forces
 
     forces = []
-    for tol in (STATIC_TOLERANCE, STATIC_TOLERANCE / 100.0):
+    default = SteadySettings().steady_residual
+    for tol in (default, default / 100.0):
         model = build_model(route_scenario(length_m))
         out = solve_steady(model, tolerance=tol)
         if out.status != "ok":

@@ -218,9 +218,9 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     bar = None
     if sp.mode == "steady":
         from .output.snapshots import SnapshotRecorder
-        from .solve.steady import solve_steady
+        from .solve.steady import SteadySettings, solve_steady
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet),
-                           tolerance=sp.steady_residual)
+                           settings=SteadySettings.from_solver(sp))
         h = out.history.arrays()
         # the steady state is the result: written as the one snapshot, so that a cross-check
         # needs the files only

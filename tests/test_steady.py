@@ -109,7 +109,7 @@ def test_force_controlled_pull_holds_the_trailing_end():
     assert abs(s["trailing_tension_N"] / T2 - 1) < 2e-3
 
 
-def test_a_route_that_needs_continuation(monkeypatch):
+def test_a_route_that_needs_continuation():
     """Where the pseudo-time steps at the full loads fail, the loads are ramped (friction,
     gravity, end forces) from the start. Forced here by allowing the full-load attempt from the
     start only 2 pseudo-time steps (Example 2 needs 9), with one Newton iteration each and then
@@ -126,25 +126,24 @@ def test_a_route_that_needs_continuation(monkeypatch):
     assert direct.status == "ok" and "continuation" not in direct.message
 
     stages = []
-    set_scale = ss._set_scale
+    short = replace(ss.SteadySettings(), max_one_iteration_steps=2, max_pseudo_steps_total=2)
 
-    def budgeted(model, lam):
-        # the first two calls are the full-load attempts from the start (one-iteration steps,
-        # then exact ones): 2 steps each; then the default
-        monkeypatch.setattr(ss, "MAX_PSEUDO_STEPS_TOTAL", 2 if len(stages) < 2 else 400)
-        stages.append(lam)
-        set_scale(model, lam)
+    class Budgeted(ss.SteadySolver):
+        def at_scale(self, lam):
+            # the first two stages are the full-load attempts from the start (one-iteration
+            # steps, then exact ones): 2 steps each; then the default budget
+            self.settings = short if len(stages) < 2 else ss.SteadySettings()
+            stages.append(lam)
+            super().at_scale(lam)
 
-    monkeypatch.setattr(ss, "_set_scale", budgeted)
-    monkeypatch.setattr(ss, "MAX_ONE_ITERATION_STEPS", 2)
-    out = ss.solve_steady(build_model(sc))
+    out = Budgeted(build_model(sc), short).solve()
     assert out.status == "ok", out.message
     assert "continuation in the load scale" in out.message
     assert stages[:2] == [1.0, 1.0] and len(stages) >= 4 and stages[-1] == 1.0
     assert abs(out.history.pull_force_N[-1] / direct.history.pull_force_N[-1] - 1) < 1e-5
 
 
-def test_pseudo_time_budget_is_on_progress_not_on_the_count(monkeypatch):
+def test_pseudo_time_budget_is_on_progress_not_on_the_count():
     """A solve that keeps making progress is not cut off: Example 2 (coarse) takes 13 pseudo-time
     steps (11 converged), its residual halving at least every 4, so a budget of 5 steps *without
     halving* lets it finish at the full loads (a budget of 5 steps in all would have sent it to the
@@ -155,18 +154,17 @@ def test_pseudo_time_budget_is_on_progress_not_on_the_count(monkeypatch):
     import exucable.solve.steady as ss
     from exucable.model.build import build_model
 
-    monkeypatch.setattr(ss, "MAX_ONE_ITERATION_STEPS", 0)
+    exact_steps = ss.SteadySettings(max_one_iteration_steps=0)
     sc = fast("paper_ex2_bend90")
     sc = replace(sc, solver=replace(sc.solver, mode="steady"))
-    default = ss.solve_steady(build_model(sc))
-    monkeypatch.setattr(ss, "MAX_PSEUDO_STEPS", 5)
-    out = ss.solve_steady(build_model(sc))
+    default = ss.solve_steady(build_model(sc), settings=exact_steps)
+    out = ss.solve_steady(build_model(sc), settings=replace(exact_steps, max_pseudo_steps=5))
     assert out.status == "ok" and "continuation" not in out.message, out.message
     assert out.steps > 5
     assert out.history.pull_force_N[-1] == pytest.approx(default.history.pull_force_N[-1], rel=1e-12)
 
 
-def test_one_iteration_steps_reach_the_exact_step_answer(monkeypatch):
+def test_one_iteration_steps_reach_the_exact_step_answer():
     """The one-iteration pseudo-time steps stop on the true residual (the solver's residual minus
     the spring force), not on the spring force of an inexact step: on Example 2 (coarse) they
     stop at the default tolerance without falling back to the exact steps (one Newton iteration
@@ -182,8 +180,9 @@ def test_one_iteration_steps_reach_the_exact_step_answer(monkeypatch):
     sc = replace(sc, solver=replace(sc.solver, mode="steady"))
     one = ss.solve_steady(build_model(sc))
     assert one.status == "ok" and one.newton_iterations == one.steps, one.message
-    monkeypatch.setattr(ss, "MAX_ONE_ITERATION_STEPS", 0)
-    tight = ss.solve_steady(build_model(sc), tolerance=ss.STATIC_TOLERANCE / 1000.0)
+    default = ss.SteadySettings()
+    tight = ss.solve_steady(build_model(sc), settings=replace(
+        default, max_one_iteration_steps=0, steady_residual=default.steady_residual / 1000.0))
     assert tight.status == "ok"
     F_one, F_tight = one.history.pull_force_N[-1], tight.history.pull_force_N[-1]
     assert abs(F_one / F_tight - 1) < 1e-8
@@ -214,7 +213,7 @@ def test_a_rejected_step_restarts_from_the_saved_kernel_pass(monkeypatch):
     assert without.newton_iterations == out.newton_iterations
 
 
-def test_exact_steps_stop_above_the_round_off_floor(monkeypatch):
+def test_exact_steps_stop_above_the_round_off_floor():
     """What stalled the fine industry meshes (Gera 2032, MachineCalcs 4064 elements): the residual has a
     round-off floor that grows with the mesh (2e-5 N at Gera's 2032 elements), the exact pseudo-time
     steps' Newton tolerance was below it (1e-3 × the stop tolerance, and 1e-8 of the initial residual),
@@ -223,7 +222,7 @@ def test_exact_steps_stop_above_the_round_off_floor(monkeypatch):
     Reproduced on Example 2 (coarse, 20 elements, floor measured 1.8e-10 N): the relative Newton
     tolerance made unreachable (1e-30) and the stop tolerance tightened to 5e-10 × 205 N = 1.0e-7 N.
     With the former share (1e-3: Newton to 1e-10 N, below the floor) the solve stalls and says where,
-    why and which keys to change; with EXACT_NEWTON_SHARE (1e-8 N) it converges to the default solve's
+    why and which keys to change; with the default ``exact_newton_share`` (1e-8 N) it converges to the default solve's
     pulling force (within 1e-6). (The exact-step continuation: the one-iteration steps tried before
     it are switched off.)"""
     from dataclasses import replace
@@ -233,18 +232,16 @@ def test_exact_steps_stop_above_the_round_off_floor(monkeypatch):
 
     sc = fast("paper_ex2_bend90")
     sc = replace(sc, solver=replace(sc.solver, mode="steady"))
-    monkeypatch.setattr(ss, "MAX_ONE_ITERATION_STEPS", 0)
-    default = ss.solve_steady(build_model(sc))
+    exact_steps = ss.SteadySettings(max_one_iteration_steps=0)
+    default = ss.solve_steady(build_model(sc), settings=exact_steps)
     assert default.status == "ok", default.message
-    monkeypatch.setattr(ss, "NEWTON_TOLERANCE", 1e-30)
-    monkeypatch.setattr(ss, "MIN_CONTINUATION_STEP", 0.5)   # one continuation stage is enough to show it
-    tight = 5e-10
-    out = ss.solve_steady(build_model(sc), tolerance=tight)
+    # one continuation stage is enough to show it
+    floor = replace(exact_steps, newton_tolerance=1e-30, min_continuation_step=0.5, steady_residual=5e-10)
+    out = ss.solve_steady(build_model(sc), settings=floor)
     assert out.status == "ok", out.message
     assert out.history.pull_force_N[-1] == pytest.approx(default.history.pull_force_N[-1], rel=1e-6)
 
-    monkeypatch.setattr(ss, "EXACT_NEWTON_SHARE", 1e-3)
-    stalled = ss.solve_steady(build_model(sc), tolerance=tight)
+    stalled = ss.solve_steady(build_model(sc), settings=replace(floor, exact_newton_share=1e-3))
     assert stalled.status == "failed"
     for part in ("continuation stalled at load scale", "round-off floor", "Newton residual stayed at",
                  "`cable.element_length`", '`solver.mode = "dynamic"`'):
@@ -309,3 +306,47 @@ def test_steady_lead_out_given_is_used_and_bounded():
     assert initial_layout(sc).lead_out_m == pytest.approx(0.05)
     with pytest.raises(ModelError, match=r"solver\.steady_lead_out"):
         initial_layout(sc.replace(**{"solver.steady_lead_out": sc.cable_length_m}))
+
+
+def test_steady_settings_are_frozen_and_checked():
+    """The solver's rules are a frozen value (a variant is ``dataclasses.replace``), and a
+    nonsensical one is refused naming its field."""
+    import dataclasses
+
+    from exucable.errors import SolverError
+    from exucable.solve.steady import SteadySettings
+
+    s = SteadySettings()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        s.rate_fall = 16.0
+    assert dataclasses.replace(s, rate_fall=16.0).rate_fall == 16.0 and s.rate_fall == 8.0
+    for bad in ({"rate_fall": -1.0}, {"steady_residual": float("nan")}, {"max_pseudo_steps": 2.5},
+                {"max_one_iteration_steps": -1}):
+        (name, value), = bad.items()
+        with pytest.raises(SolverError, match=f"SteadySettings.{name} = "):
+            SteadySettings(**bad)
+    assert SteadySettings(max_one_iteration_steps=0).max_one_iteration_steps == 0   # 0 skips that phase
+
+
+def test_the_steady_residual_key_maps_to_the_settings():
+    """``[solver] steady_residual`` becomes :attr:`SteadySettings.steady_residual`; the solver
+    object and the ``solve_steady(tolerance=...)`` entry point give the same iterates (Example 2,
+    coarse, at a looser stop), and a solver solves once."""
+    from dataclasses import replace
+
+    from exucable.errors import SolverError
+    from exucable.model.build import build_model
+    from exucable.solve.steady import SteadySettings, SteadySolver, solve_steady
+
+    sc = fast("paper_ex2_bend90")
+    sc = replace(sc, solver=replace(sc.solver, mode="steady", steady_residual=1e-5))
+    settings = SteadySettings.from_solver(sc.solver)
+    assert settings == SteadySettings(steady_residual=1e-5)
+    solver = SteadySolver(build_model(sc), settings)
+    out = solver.solve()
+    assert out.status == "ok", out.message
+    again = solve_steady(build_model(sc), tolerance=1e-5)
+    assert again.history.pull_force_N == out.history.pull_force_N
+    assert again.newton_iterations == out.newton_iterations and again.steps == out.steps
+    with pytest.raises(SolverError, match="runs once"):
+        solver.solve()

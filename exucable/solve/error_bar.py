@@ -11,9 +11,9 @@ from the mesh rule: the same scenario is solved again on a mesh ``COARSE_RATIO``
 Richardson's error estimate of F_h for an assumed order p, plus a floor for the wiggle that the
 check points' places along the bends leave once the sequence has converged (two meshes can agree
 by chance closer than either is to the limit). The solve's part is its stop residual:
-``STATIC_TOLERANCE`` × the rope's largest tension bounds the unbalanced force left, which moves the
-pulling force by at most that much. The parts are added (not in quadrature: they may push the
-same way).
+``steady_residual`` (:class:`exucable.solve.steady.SteadySettings`) × the rope's largest tension
+bounds the unbalanced force left, which moves the pulling force by at most that much. The parts
+are added (not in quadrature: they may push the same way).
 
 Measured (``benchmarks/steady_error_bar.py``, against the value on meshes 4 and 8 times finer): the
 rule's mesh is not yet in the asymptotic range on every route (a 60° down-bend with gravity: +0.13 %
@@ -107,11 +107,12 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
     """
     from ..errors import ModelError
     from ..model.build import build_model
-    from .steady import STATIC_TOLERANCE, solve_steady, steady_forces
+    from .steady import SteadySettings, solve_steady, steady_forces
 
     t0 = time.perf_counter()
     T_max = model.rope.max_tension_N if getattr(model, "rope", None) is not None else abs(value_N)
-    solve_N = STATIC_TOLERANCE * T_max
+    stop = SteadySettings().steady_residual   # the coarse solve's (the default) stop residual [-]
+    solve_N = stop * T_max
     n = model.mesh.elements
     k = model.mesh.check_points_per_element
     head = f"second steady solve on a mesh {COARSE_RATIO:g}x coarser"
@@ -137,7 +138,7 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
               f"mesh = |F - F_coarse| / "
               f"(r^p - 1) with r = {r:.4g} and an assumed order p = {ASSUMED_ORDER:g} "
               f"(Richardson's error estimate) + {RESOLUTION_FLOOR:g} x |F|; plus the steady solve's stop residual "
-              f"{STATIC_TOLERANCE:g} x the rope's largest tension; added")
+              f"{stop:g} x the rope's largest tension; added")
     if not math.isfinite(total):
         return SteadyErrorBar(None, None, solve_N, coarse_N, m, f"{head}: not finite", time.perf_counter() - t0)
     return SteadyErrorBar(total, mesh_N, solve_N, coarse_N, m, method, time.perf_counter() - t0)

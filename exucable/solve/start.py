@@ -56,12 +56,12 @@ def steady_start(scenario, refine: float = 1.0, check_points_per_element: int | 
 
     from ..model.build import build_model
     from ..model.layout import initial_layout, sliding_layout
-    from .steady import solve_steady
+    from .steady import SteadySettings, solve_steady
 
     t0 = time.perf_counter()
     sc_steady = scenario.replace(**{"solver.mode": "steady"})
     model = build_model(sc_steady, refine=refine, check_points_per_element=check_points_per_element)
-    out = solve_steady(model, tolerance=model.scenario.solver.steady_residual)
+    out = solve_steady(model, settings=SteadySettings.from_solver(model.scenario.solver))
     if out.status == "failed":
         return SteadyStart(None, float("nan"), out.message, time.perf_counter() - t0)
     from .steady import steady_forces

@@ -25,107 +25,145 @@ coordinate, anchored at the previous solve's state q̄ (m_k the lumped nodal mas
 slopes), which makes every Newton problem well posed; c starts at an element's axial stiffness
 per mass and falls by 4 after each converged solve (rises by 4 after a failed one). The spring's force at convergence is exactly the
 residual of the unregularised equilibrium, so the solve stops once its norm is below
-``STATIC_TOLERANCE`` times the rope solution's largest tension. Far from it a step's Newton
-problem is solved only to ``INEXACT_NEWTON_TOLERANCE`` (each step need only make progress: inexact
-continuation, 59 → 36 Newton iterations on Example 4); within ``EXACT_WITHIN`` tolerances of the
-stop, and always for the step that stops, to ``NEWTON_TOLERANCE``, so that the spring's force is the
+``steady_residual`` (:class:`SteadySettings`) times the rope solution's largest tension. Far from
+it a step's Newton problem is solved only to ``inexact_newton_tolerance`` (each step need only make
+progress: inexact continuation, 59 → 36 Newton iterations on Example 4); within ``exact_within`` tolerances of the
+stop, and always for the step that stops, to ``newton_tolerance``, so that the spring's force is the
 whole residual there.
 
 First, though, the same continuation is tried with one Newton iteration per pseudo-time step,
-steered by the true residual (:func:`solve_steady`'s ``relax_one_iteration``): after each step the
+steered by the true residual (:meth:`SteadySolver.relax_one_iteration`): after each step the
 unregularised residual is the static solver's residual at the new state minus the spring's force
 there, so no step need be solved exactly to know how far the state is from equilibrium. A step
-whose residual grows more than ``REJECT_GROWTH``-fold is undone and retried with c × 4; an accepted
-step divides c by ``RATE_FALL`` (by ``RATE_FALL_AFTER_REJECT`` right after a rejection), so the
+whose residual grows more than ``reject_growth``-fold is undone and retried with c × 4; an accepted
+step divides c by ``rate_fall`` (by ``rate_fall_after_reject`` right after a rejection), so the
 steps become plain Newton steps near the solution. The solve stops once that residual is below the
 tolerance: Example 4 in 17 Newton iterations instead of 36, its pulling force 1e-9 (not 7e-7) from
 the one at 1/1000 of the stop tolerance (reference/README.md, "Speed"). Where it does not converge within its budget, the
 exact-step continuation above runs from the start.
 Where that does not converge either, the loads themselves are ramped (friction, gravity and end forces
-scaled by λ) with the increment halved on failure.
+scaled by λ) with the increment halved on failure (:meth:`SteadySolver.ramp_loads`).
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 import exudyn as exu
 
+from ..errors import SolverError
 from .dynamic import History, Progress, SolveOutcome, quiet_sparse
 from ..post.tension import TensionStations, profile_stations_m
 
-__all__ = ["solve_steady", "static_settings", "STATIC_TOLERANCE"]
+__all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
 
-#: Residual of the steady equilibrium at which the solve stops, relative to the largest tension of
-#: the rope solution [-]: the spring force c·m·(q - q̄) left at the last pseudo-time step.
-STATIC_TOLERANCE = 1e-6
 
-#: Newton's relative tolerance inside one pseudo-time step (its problem is well posed).
-NEWTON_TOLERANCE = 1e-8
+@dataclass(frozen=True)
+class SteadySettings:
+    """How the steady solve iterates and when it stops (:class:`SteadySolver`).
 
-#: Newton's relative tolerance inside a pseudo-time step still far from the steady state: each
-#: step only has to make progress toward it (inexact pseudo-transient continuation, Kelley & Keyes
-#: 1998 Sect. 4); the step that stops the solve is converged to NEWTON_TOLERANCE.
-INEXACT_NEWTON_TOLERANCE = 0.1
+    Frozen: a variant is ``dataclasses.replace(SteadySettings(), rate_fall=16.0)``, never a
+    changed module constant, so that one solve's rules cannot leak into another's. Only
+    ``steady_residual`` is a scenario key (``[solver] steady_residual``, :meth:`from_solver`); the
+    others are the solver's tuning, measured on the paper's examples and the industry scenarios
+    (``benchmarks/steady_iterations.py --set NAME=VALUE`` compares a change across them).
 
-#: Residual, in stop tolerances, below which the pseudo-time steps are solved exactly [-].
-EXACT_WITHIN = 1000.0
+    Attributes
+    ----------
+    steady_residual : float
+        Residual of the steady equilibrium at which the solve stops, relative to the largest
+        tension of the rope solution [-]: the spring force c·m·(q - q̄) left at the last
+        pseudo-time step. Why 1e-6: the pulling force then moves by less than 1e-7 relative
+        against a solve to 1/1000 of it (``benchmarks/steady_iterations.py --tight``).
+    newton_tolerance : float
+        Newton's relative tolerance inside one exact pseudo-time step [-] (its problem is well posed).
+    inexact_newton_tolerance : float
+        Newton's relative tolerance inside a pseudo-time step still far from the steady state [-]:
+        each step only has to make progress toward it (inexact pseudo-transient continuation,
+        Kelley & Keyes 1998 Sect. 4); the step that stops the solve is converged to
+        ``newton_tolerance``. Why 0.1: 59 → 36 Newton iterations on Example 4.
+    exact_within : float
+        Residual, in stop tolerances, below which the pseudo-time steps are solved exactly [-].
+    exact_newton_share : float
+        Newton's absolute tolerance in an exact pseudo-time step, as a share of the stop
+        tolerance [-]; the Newton residual left over counts toward the stop test (spring force +
+        leftover ≤ tolerance). Why not tighter: the residual has a round-off floor that grows with
+        the mesh (2e-5 N at Gera's 2032 elements, above a share of 1e-3 there: every exact step
+        failed and the solve stalled at load scale 0). At 0.1 the floor is 30× below the Newton
+        tolerance there, and the stop test stays honest (residual ≤ 1.1 × tolerance);
+        ``tests/test_steady.py::test_exact_steps_stop_above_the_round_off_floor``.
+    axial_share : float
+        Weight of the pseudo-time spring along the cable's axis relative to across it at the first
+        step of a continuation [-] (see :class:`PseudoTimeSpring`: 0 lets a long cable's first step
+        slide it by the start's strain misfit and fail, 1 solves 300 m in 21 pseudo-time steps).
+    axial_release : float
+        Factor on the axial share after each converged pseudo-time step [-]: the axial mode is
+        linear (EA) and, on a long cable, so soft (1 km: ~1 s⁻² per unit mass) that a spring
+        falling like the lateral one would hold it for hundreds of steps.
+    max_pseudo_steps : int
+        Exact-step continuation: pseudo-time steps (failed attempts included) without the residual
+        halving before the solve at one load scale is declared failed. A budget on progress, not on
+        the count: 1 km from the centreline rope's start the residual falls from 900 N to 8 N in the
+        first 80 steps (a count budget of 80 declared it failed), then converges after 51 more.
+    max_pseudo_steps_total : int
+        Exact-step continuation: pseudo-time steps at one load scale in all before the solve there
+        is declared failed.
+    reject_growth : float
+        Growth of the true residual over the last accepted step's [-] above which a one-iteration
+        pseudo-time step is undone and retried with a 4× stiffer spring (a trust-region test).
+    rate_fall, rate_fall_after_reject : float
+        Factor by which the spring rate falls after an accepted one-iteration step, and right after
+        a rejected one [-]. Measured (Newton iterations, one-iteration steps vs the exact-step
+        continuation): Ex4 17 vs 36, Gera 60 vs 102, coarse Ex2 29 vs 55, Ex3 27 vs 19, route100 43
+        vs 25; a fall by 4 after a rejection too gave 34 on Ex3 and 60 on coarse Ex2, a fall by 4
+        throughout fell back to the exact steps on Ex4 (60).
+    max_one_iteration_steps : int
+        Pseudo-time steps (accepted and rejected) the one-iteration continuation may take before the
+        exact-step continuation takes over [-]; 0 skips it.
+    max_one_iteration_stall : int
+        Pseudo-time steps (accepted and rejected) without the true residual halving after which the
+        one-iteration continuation gives up for the exact-step one [-]. Gera's route at 4× the mesh
+        wandered at 10-200 N for 48 accepted steps (210 Newton iterations in all against 130 for the
+        exact steps alone); 10 sent Ex. 3 and the coarse Ex. 2-4 to the exact steps too, 20 none of
+        the paper's examples.
+    min_continuation_step : float
+        Smallest increment of the load scale λ [-] in the load continuation before the solve is
+        declared failed.
+    """
 
-#: Newton's absolute tolerance in an exact pseudo-time step, as a share of the stop tolerance [-];
-#: the Newton residual left over counts toward the stop test (spring force + leftover ≤ tolerance).
-#: Why not tighter: the residual has a round-off floor that grows with the mesh. Measured on Gera's
-#: route: 2e-5 N at 2032 elements, while the former absolute tolerance 1e-3 × the stop
-#: tolerance was 6e-7 N and the relative one 1e-8 × the initial residual 6.5e-6 N; every exact step
-#: then failed (12 iterations stuck at 2e-5 N), the spring rate rose a million-fold without helping,
-#: and the solve was reported as "continuation stalled at load scale 0". At 0.1 the floor is 30×
-#: below the Newton tolerance there, and the stop test stays honest (residual ≤ 1.1 × tolerance).
-EXACT_NEWTON_SHARE = 0.1
+    steady_residual: float = 1e-6
+    newton_tolerance: float = 1e-8
+    inexact_newton_tolerance: float = 0.1
+    exact_within: float = 1000.0
+    exact_newton_share: float = 0.1
+    axial_share: float = 1.0
+    axial_release: float = 0.25
+    max_pseudo_steps: int = 80
+    max_pseudo_steps_total: int = 400
+    reject_growth: float = 2.0
+    rate_fall: float = 8.0
+    rate_fall_after_reject: float = 2.0
+    max_one_iteration_steps: int = 80
+    max_one_iteration_stall: int = 20
+    min_continuation_step: float = 1.0 / 16.0
 
-#: Weight of the pseudo-time spring along the cable's axis relative to across it (see
-#: :class:`PseudoTimeSpring`).
-AXIAL_SHARE = 1.0
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.type == "int":
+                if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                    raise SolverError(f"SteadySettings.{f.name} = {value!r}: must be a whole number >= 0")
+            elif isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+                    or not np.isfinite(value) or value <= 0:
+                raise SolverError(f"SteadySettings.{f.name} = {value!r}: must be a finite number > 0")
 
-#: Factor on the axial share after each converged pseudo-time step: the axial mode is linear (EA)
-#: and, on a long cable, so soft (1 km: ~1 s⁻² per unit mass) that a spring falling like the
-#: lateral one would hold it for hundreds of steps.
-AXIAL_RELEASE = 0.25
-
-#: Pseudo-time steps (failed attempts included) without the residual halving before the solve at
-#: one load scale is declared failed. A budget on progress, not on the count: from a start far from
-#: the steady state (1 km from the centreline rope's start, the cable 6 % too tense and pressed where
-#: it should hang free) the residual falls steadily but slowly, 900 N to 8 N in the first 80 steps
-#: (a count budget of 80 declared it failed), and converges after 51 converged steps.
-MAX_PSEUDO_STEPS = 80
-
-#: Pseudo-time steps at one load scale in all before the solve there is declared failed.
-MAX_PSEUDO_STEPS_TOTAL = 400
-
-#: Growth of the true residual [-] over the last accepted step's above which a one-iteration
-#: pseudo-time step is undone and retried with a 4× stiffer spring (a trust-region test).
-REJECT_GROWTH = 2.0
-
-#: Factor by which the spring rate falls after an accepted one-iteration step, and right after a
-#: rejected one [-]. Measured on the paper's examples and industry scenarios (Newton iterations,
-#: one-iteration steps vs the exact-step continuation): Ex4 17 vs 36, Gera 60 vs 102, fast Ex2 29 vs
-#: 55, Ex3 27 vs 19, route100 43 vs 25; a fall by 4 after a rejection too gave 34 on Ex3 and 60 on
-#: fast Ex2, a fall by 4 throughout fell back to the exact steps on Ex4 (60).
-RATE_FALL = 8.0
-RATE_FALL_AFTER_REJECT = 2.0
-
-#: Pseudo-time steps (accepted and rejected) the one-iteration continuation may take before the
-#: exact-step continuation takes over [-].
-MAX_ONE_ITERATION_STEPS = 80
-
-#: Pseudo-time steps (accepted and rejected) without the true residual halving after which the
-#: one-iteration continuation gives up for the exact-step one [-]. Gera's route at 4× the mesh
-#: wandered at 10-200 N for 48 accepted steps (80 steps, then the exact steps from the start:
-#: 210 Newton iterations against their 130 alone); 10 sent Ex. 3 and the coarse Ex. 2-4 to the
-#: exact steps too, 20 none of the paper's examples.
-MAX_ONE_ITERATION_STALL = 20
-
-#: Smallest continuation increment of the load scale before the solve is declared failed.
-MIN_CONTINUATION_STEP = 1.0 / 16.0
+    @classmethod
+    def from_solver(cls, solver) -> "SteadySettings":
+        """The settings of a scenario's ``[solver]`` table (:class:`exucable.scenario.specs.SolverSpec`):
+        its ``steady_residual``, the defaults otherwise."""
+        return cls(steady_residual=float(solver.steady_residual))
 
 
 def initial_spring_rate(model) -> float:
@@ -135,7 +173,7 @@ def initial_spring_rate(model) -> float:
     return model.axial_stiffness_N / (model.properties.mass_per_length_kg_per_m * L_e * L_e)
 
 
-def static_settings(tolerance: float = NEWTON_TOLERANCE, max_iterations: int = 12,
+def static_settings(tolerance: float = SteadySettings.newton_tolerance, max_iterations: int = 12,
                     absolute_tolerance_N: float = 1e-10) -> exu.SimulationSettings:
     """Exudyn's static solver settings of one pseudo-time step: one load step, plain Newton.
 
@@ -162,13 +200,13 @@ class PseudoTimeSpring:
     ``ObjectGenericODE2`` with a force and a sparse Jacobian user function.
 
     m_k: lumped nodal mass [kg] for positions, times L_e² [kg·m²] for slopes.
-    P_k = I - (1 - AXIAL_SHARE) t tᵀ weights the spring along the cable's tangent t at node k
-    (at the anchor). Measured: releasing the axial direction entirely (share 0) lets a long
+    P_k = I - (1 - s) t tᵀ weights the spring along the cable's tangent t at node k
+    (at the anchor) by the axial share s [-] (:attr:`SteadySettings.axial_share`). Measured: releasing the axial direction entirely (share 0) lets a long
     cable's first Newton step slide it by the start's strain misfit (decimetres on 300 m) and
     the step fails; the isotropic spring (share 1) solves 300 m in 21 pseudo-time steps.
     """
 
-    def __init__(self, model):
+    def __init__(self, model, axial_share: float = SteadySettings.axial_share):
         from exudyn.itemInterface import ObjectGenericODE2
 
         Le = np.asarray(model.layout.element_length_m, dtype=float)
@@ -186,7 +224,7 @@ class PseudoTimeSpring:
         self.block_mass[:, 0] = m_node
         self.block_mass[:, 1] = m_node * L_node**2
         self.rate = 0.0                       # c [1/s²]
-        self.axial_share = AXIAL_SHARE        # weight along the tangent [-]
+        self.axial_share = axial_share        # weight along the tangent [-]
         self.anchor = np.zeros(self.n)        # q̄ (displacement coordinates)
         self._proj = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
         base = 6 * np.arange(self.n_nodes)[:, None, None, None] + 3 * np.arange(2)[None, :, None, None]
@@ -355,218 +393,268 @@ def _set_scale(model, lam: float) -> None:
         model.coupling.forget_evaluation()
 
 
-def solve_steady(model, progress: Progress | None = None, tolerance: float = STATIC_TOLERANCE) -> SolveOutcome:
-    """Solve ``model`` (built with ``solver.mode = "steady"``) for its steady sliding state.
+class SteadySolver:
+    """The steady sliding state of ``model`` (built with ``solver.mode = "steady"``) by
+    pseudo-transient continuation (the module's notes); :meth:`solve` runs it, once.
 
-    ``tolerance`` [-] is the equilibrium residual at which it stops, relative to the rope
-    solution's largest tension (default :data:`STATIC_TOLERANCE`; a tighter one shows how
-    converged the pulling force is, ``benchmarks/steady_scale.py --tolerance-check``).
+    The phases are methods: :meth:`relax_one_iteration` (one Newton iteration per pseudo-time step,
+    steered by the true residual), :meth:`relax` (inexact, then exact pseudo-time steps) and
+    :meth:`ramp_loads` (continuation in the load scale); they share the state in attributes (the stored state to
+    restart from, the spring, the counters, the history).
 
-    Pseudo-transient continuation from the pre-tensioned start at the full loads, first with one
-    Newton iteration per pseudo-time step steered by the true residual, then (if that does not
-    converge) with the inexact/exact steps; if that fails too,
-    continuation in the load scale λ (friction, gravity, end forces) from the start, each stage
-    solved the same way, the increment doubled after a success and halved after a failure. The
-    history has one row per converged pseudo-time step; its ``time_s`` column holds the step's
-    number [-] (not a time: a static solve has none).
-
-    Never raises for a diverging solve: the outcome has ``status == "failed"`` and the message.
+    Parameters
+    ----------
+    model : exucable.model.build.Model
+        A steady-mode model, at its pre-tensioned start. Constructing the solver adds the
+        pseudo-time spring to its system.
+    settings : SteadySettings
+        The stop tolerance and the continuation's rules.
+    progress : Progress, optional
+        Told the residual reached after every accepted pseudo-time step, closed at the end.
     """
-    mbs = model.mbs
-    history = History()
-    spring = PseudoTimeSpring(model)
-    store = _StateStore(mbs, model.coupling)
-    start = store.saved
-    counters = {"newton": 0, "jacobian": 0, "steps": 0}
-    scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
-                  model.back_tension_N, 1.0)
-    tolerance_N = float(tolerance) * scale_N
-    settings = static_settings(tolerance=NEWTON_TOLERANCE, absolute_tolerance_N=EXACT_NEWTON_SHARE * tolerance_N)
-    inexact = static_settings(tolerance=INEXACT_NEWTON_TOLERANCE, absolute_tolerance_N=1e-3 * tolerance_N)
-    c0 = initial_spring_rate(model)
-    t_wall = time.perf_counter()
-    total = [0]
 
-    stations = force_stations(model)
-    one_iteration = static_settings(tolerance=1.0, max_iterations=1, absolute_tolerance_N=1e-3 * tolerance_N)
-    last_solver = [None]
+    def __init__(self, model, settings: SteadySettings = SteadySettings(), progress: Progress | None = None):
+        self.model = model
+        self.settings = settings
+        self.progress = progress
+        self.mbs = model.mbs
+        self.history = History()
+        self.spring = PseudoTimeSpring(model, axial_share=settings.axial_share)
+        self.store = _StateStore(self.mbs, model.coupling)
+        self.start = self.store.saved
+        self.newton_iterations = 0
+        self.jacobian_updates = 0
+        self.steps = 0            # pseudo-time steps tried (rejected and failed ones included)
+        self.accepted = 0         # pseudo-time steps kept (the history's rows)
+        scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
+                      model.back_tension_N, 1.0)
+        #: the stop tolerance [N]
+        self.tolerance_N = float(settings.steady_residual) * scale_N
+        self.exact_settings = static_settings(tolerance=settings.newton_tolerance,
+                                              absolute_tolerance_N=settings.exact_newton_share * self.tolerance_N)
+        self.inexact_settings = static_settings(tolerance=settings.inexact_newton_tolerance,
+                                                absolute_tolerance_N=1e-3 * self.tolerance_N)
+        self.c0 = initial_spring_rate(model)
+        self.stations = force_stations(model)
+        self.one_iteration_settings = static_settings(tolerance=1.0, max_iterations=1,
+                                                      absolute_tolerance_N=1e-3 * self.tolerance_N)
+        self._last_solver = None
+        self._solved = False
 
-    def one_solve(exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
+    def one_solve(self, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
         """One static solve with the exact, inexact or given settings: converged?, message, and
         Newton's last residual norm [N]."""
         solver = exu.MainSolverStatic()
-        last_solver[0] = solver
-        chosen = exact if isinstance(exact, exu.SimulationSettings) else (settings if exact else inexact)
+        self._last_solver = solver
+        if isinstance(exact, exu.SimulationSettings):
+            chosen = exact
+        else:
+            chosen = self.exact_settings if exact else self.inexact_settings
         try:
-            ok = solver.SolveSystem(mbs, chosen)
+            ok = solver.SolveSystem(self.mbs, chosen)
             message = "" if ok else (solver.GetErrorString() or "Newton did not converge")
         except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
             ok, message = False, f"{type(exc).__name__}: {exc}".strip()
-        counters["newton"] += int(solver.it.newtonStepsCount)
-        counters["jacobian"] += int(solver.it.newtonJacobiCount)
+        self.newton_iterations += int(solver.it.newtonStepsCount)
+        self.jacobian_updates += int(solver.it.newtonJacobiCount)
         return ok, message, float(solver.conv.residual)
 
-    def pseudo_step(c: float, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
-        """One pseudo-time step at spring rate ``c`` [1/s²] from the stored state (see one_solve)."""
-        store.restore_as_initial()
-        spring.anchor_at(_cable_part(model, store.saved[0]))
-        spring.rate = c
-        counters["steps"] += 1
-        return one_solve(exact)
+    def pseudo_step(self, c: float, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
+        """One pseudo-time step at spring rate ``c`` [1/s²] from the stored state (see :meth:`one_solve`)."""
+        self.store.restore_as_initial()
+        self.spring.anchor_at(_cable_part(self.model, self.store.saved[0]))
+        self.spring.rate = c
+        self.steps += 1
+        return self.one_solve(exact)
 
-    def record(lam: float, residual: float) -> None:
+    def record(self, lam: float, residual: float) -> None:
         """One history row (and the progress bar) for an accepted pseudo-time step."""
-        total[0] += 1
-        pull, trail, tmax = steady_forces(model, stations)
-        history.time_s.append(float(total[0]))
-        history.pull_force_N.append(pull)
-        history.trailing_tension_N.append(trail)
-        history.max_tension_N.append(tmax)
-        if progress is not None:
-            progress.update(min(1.0, tolerance_N / max(residual, 1e-300)),
-                            f"λ = {lam:.3g}, residual {residual:.2e} N, F = {pull:.5g} N")
+        self.accepted += 1
+        pull, trail, tmax = steady_forces(self.model, self.stations)
+        self.history.time_s.append(float(self.accepted))
+        self.history.pull_force_N.append(pull)
+        self.history.trailing_tension_N.append(trail)
+        self.history.max_tension_N.append(tmax)
+        if self.progress is not None:
+            self.progress.update(min(1.0, self.tolerance_N / max(residual, 1e-300)),
+                                 f"λ = {lam:.3g}, residual {residual:.2e} N, F = {pull:.5g} N")
 
-    def true_residual() -> float:
+    def true_residual(self) -> float:
         """Norm [N] of the unregularised equilibrium residual at the current state: the last
         solve's residual there (Exudyn evaluates it after its last update) minus the spring's force."""
-        sd = mbs.systemData
+        sd = self.mbs.systemData
         q_all = np.array(sd.GetODE2Coordinates())
-        r = np.array(last_solver[0].GetSystemResidual())[:q_all.size]
-        r[model.ode2_index] -= spring.force(_cable_part(model, q_all))
+        r = np.array(self._last_solver.GetSystemResidual())[:q_all.size]
+        r[self.model.ode2_index] -= self.spring.force(_cable_part(self.model, q_all))
         return float(np.linalg.norm(r))
 
-    def at_scale(lam: float) -> None:
+    def at_scale(self, lam: float) -> None:
         """Loads and friction at scale ``lam`` [-]; the stored state's kernel pass was of another."""
-        _set_scale(model, lam)
-        store.saved = store.saved[:2] + (None,)
+        _set_scale(self.model, lam)
+        self.store.saved = self.store.saved[:2] + (None,)
 
-    def relax_one_iteration(lam: float) -> tuple[bool, str]:
-        """Pseudo-time steps of one Newton iteration each at load scale ``lam`` from the stored
-        state, accepted while the true residual does not grow more than REJECT_GROWTH-fold, until
-        it is below the tolerance."""
-        at_scale(lam)
-        c = c0
-        spring.axial_share = AXIAL_SHARE
+    def relax_one_iteration(self, lam: float) -> tuple[bool, str]:
+        """Pseudo-time steps of one Newton iteration each at load scale ``lam`` [-] from the stored
+        state, accepted while the true residual does not grow more than ``reject_growth``-fold,
+        until it is below the tolerance: converged?, and why not."""
+        self.at_scale(lam)
+        s = self.settings
+        c = self.c0
+        self.spring.axial_share = s.axial_share
         previous, after_reject, message = np.inf, False, ""
         best, stalled = np.inf, 0
-        for _ in range(MAX_ONE_ITERATION_STEPS):
-            if stalled >= MAX_ONE_ITERATION_STALL:
+        for _ in range(s.max_one_iteration_steps):
+            if stalled >= s.max_one_iteration_stall:
                 return False, (f"one-iteration pseudo-time steps: the residual did not halve in "
-                               f"{MAX_ONE_ITERATION_STALL} steps (smallest {best:.3g} N)")
+                               f"{s.max_one_iteration_stall} steps (smallest {best:.3g} N)")
             stalled += 1
-            ok, message, _ = pseudo_step(c, one_iteration)
-            residual = true_residual() if ok else np.inf
-            if residual > REJECT_GROWTH * previous or not ok:
+            ok, message, _ = self.pseudo_step(c, self.one_iteration_settings)
+            residual = self.true_residual() if ok else np.inf
+            if residual > s.reject_growth * previous or not ok:
                 c *= 4.0
                 after_reject = True
-                if c > 1e6 * c0:
+                if c > 1e6 * self.c0:
                     break
                 continue
-            store.save()
-            record(lam, residual)
-            if residual <= tolerance_N:
+            self.store.save()
+            self.record(lam, residual)
+            if residual <= self.tolerance_N:
                 return True, ""
             if residual <= 0.5 * best:
                 best, stalled = residual, 0
-            c /= RATE_FALL_AFTER_REJECT if after_reject else RATE_FALL
+            c /= s.rate_fall_after_reject if after_reject else s.rate_fall
             after_reject = False
-            spring.axial_share *= AXIAL_RELEASE
+            self.spring.axial_share *= s.axial_release
             previous = residual
-        return False, (f"one-iteration pseudo-time steps: no equilibrium after {MAX_ONE_ITERATION_STEPS} "
+        return False, (f"one-iteration pseudo-time steps: no equilibrium after {s.max_one_iteration_steps} "
                        f"steps{f' ({message})' if message else ''}")
 
-    def relax(lam: float) -> tuple[bool, str]:
-        """Pseudo-time steps at load scale ``lam`` from the stored state until the equilibrium
-        residual is below the tolerance."""
-        at_scale(lam)
-        c = c0
-        spring.axial_share = AXIAL_SHARE
+    def relax(self, lam: float) -> tuple[bool, str]:
+        """Pseudo-time steps (inexact far from the steady state, exact near it) at load scale
+        ``lam`` [-] from the stored state until the equilibrium residual is below the tolerance:
+        converged?, and why not."""
+        self.at_scale(lam)
+        s = self.settings
+        c = self.c0
+        self.spring.axial_share = s.axial_share
         message = ""
         best, stalled = np.inf, 0
         stuck = _FailedSteps()
-        exact = INEXACT_NEWTON_TOLERANCE <= NEWTON_TOLERANCE   # only the stopping step need be exact
-        for _ in range(MAX_PSEUDO_STEPS_TOTAL):
-            if stalled >= MAX_PSEUDO_STEPS:
+        exact = s.inexact_newton_tolerance <= s.newton_tolerance   # only the stopping step need be exact
+        for _ in range(s.max_pseudo_steps_total):
+            if stalled >= s.max_pseudo_steps:
                 return False, (f"no equilibrium at load scale {lam:.3g}: the residual did not halve in "
-                               f"{MAX_PSEUDO_STEPS} pseudo-time steps (smallest {best:.3g} N, stop at "
-                               f"{tolerance_N:.3g} N)")
+                               f"{s.max_pseudo_steps} pseudo-time steps (smallest {best:.3g} N, stop at "
+                               f"{self.tolerance_N:.3g} N)")
             stalled += 1
-            ok, message, leftover = pseudo_step(c, exact)
+            ok, message, leftover = self.pseudo_step(c, exact)
             if not ok:
                 stuck.record(exact, leftover)
                 c *= 4.0
-                if c > 1e6 * c0:
-                    return False, stuck.why(message, lam, best, tolerance_N, settings)
+                if c > 1e6 * self.c0:
+                    return False, stuck.why(message, lam, best, self.tolerance_N, self.exact_settings)
                 continue
-            q_now = _cable_part(model, np.array(mbs.systemData.GetODE2Coordinates()))
+            q_now = _cable_part(self.model, np.array(self.mbs.systemData.GetODE2Coordinates()))
             # the equilibrium residual is at most the spring's force plus what Newton left over
-            residual = float(np.linalg.norm(spring.force(q_now))) + (leftover if exact else 0.0)
-            store.save()
-            record(lam, residual)
-            if residual <= tolerance_N:
+            residual = float(np.linalg.norm(self.spring.force(q_now))) + (leftover if exact else 0.0)
+            self.store.save()
+            self.record(lam, residual)
+            if residual <= self.tolerance_N:
                 if exact:
                     return True, ""
                 # an inexact step's spring force is not yet the whole residual: confirm with a
-                # step at the same rate whose Newton problem is solved to NEWTON_TOLERANCE
+                # step at the same rate whose Newton problem is solved to newton_tolerance
                 exact = True
                 continue
             if residual <= 0.5 * best:
                 best, stalled = residual, 0
             # near the steady state the steps are exact: the one that stops must be, and an exact
             # solve from a loosely converged state near grazing contact may fail (2-cycle)
-            exact = exact or residual <= EXACT_WITHIN * tolerance_N
+            exact = exact or residual <= s.exact_within * self.tolerance_N
             c /= 4.0
-            spring.axial_share *= AXIAL_RELEASE
-        return False, (f"no equilibrium at load scale {lam:.3g} after {MAX_PSEUDO_STEPS_TOTAL} pseudo-time steps "
-                       f"(smallest residual {best:.3g} N, stop at {tolerance_N:.3g} N)")
+            self.spring.axial_share *= s.axial_release
+        return False, (f"no equilibrium at load scale {lam:.3g} after {s.max_pseudo_steps_total} pseudo-time "
+                       f"steps (smallest residual {best:.3g} N, stop at {self.tolerance_N:.3g} N)")
 
-    status, message = "ok", ""
-    outside_at_start = _outside_points(model)
-    ok, first_message = relax_one_iteration(1.0)
-    if not ok:
-        store.saved = start
-        ok, first_message = relax(1.0)
-    if ok:
-        message = f"{total[0]} pseudo-time steps"
-    else:
-        store.saved = start
+    def ramp_loads(self, first_message: str) -> tuple[str, str]:
+        """Continuation in the load scale λ (friction, gravity, end forces) from the start, each
+        stage solved by :meth:`relax`, the increment doubled after a success and halved after a
+        failure: status ("ok" or "failed") and message."""
+        self.store.saved = self.start
         lam, step, stages = 0.0, 0.5, 0
         while lam < 1.0:
             target = min(1.0, lam + step)
-            before = store.saved
-            ok, msg = relax(target)
+            before = self.store.saved
+            ok, msg = self.relax(target)
             stages += 1
             if ok:
                 lam = target
                 step = min(2.0 * step, 1.0)
             else:
-                store.saved = before
+                self.store.saved = before
                 step *= 0.5
-                if step < MIN_CONTINUATION_STEP:
-                    status = "failed"
-                    message = (f"no steady state found: continuation stalled at load scale {lam:.4g} "
-                               f"(at full load: {first_message}; last: {msg}); {STALL_FIX}")
-                    break
+                if step < self.settings.min_continuation_step:
+                    return "failed", (f"no steady state found: continuation stalled at load scale {lam:.4g} "
+                                      f"(at full load: {first_message}; last: {msg}); {STALL_FIX}")
+        return "ok", (f"continuation in the load scale, {stages} stages, {self.accepted} pseudo-time steps "
+                      f"(at full load from the start: {first_message})")
+
+    def solve(self) -> SolveOutcome:
+        """Solve for the steady sliding state: one-iteration steps at the full loads from the start,
+        then (if they do not converge) the exact-step continuation, then the load ramp.
+
+        The history has one row per accepted pseudo-time step; its ``time_s`` column holds the
+        step's number [-] (not a time: a static solve has none). Never raises for a diverging
+        solve: the outcome has ``status == "failed"`` and the message.
+        """
+        if self._solved:
+            raise SolverError("SteadySolver.solve() runs once: build a new SteadySolver for another solve")
+        self._solved = True
+        t_wall = time.perf_counter()
+        model = self.model
+        status, message = "ok", ""
+        outside_at_start = _outside_points(model)
+        ok, first_message = self.relax_one_iteration(1.0)
+        if not ok:
+            self.store.saved = self.start
+            ok, first_message = self.relax(1.0)
+        if ok:
+            message = f"{self.accepted} pseudo-time steps"
+        else:
+            status, message = self.ramp_loads(first_message)
+        self.store.restore_as_initial()
+        self.spring.rate = 0.0
         if status == "ok":
-            message = (f"continuation in the load scale, {stages} stages, {total[0]} pseudo-time steps "
-                       f"(at full load from the start: {first_message})")
-    store.restore_as_initial()
-    spring.rate = 0.0
-    if status == "ok":
-        # an equilibrium with the cable pulled out of the conduit (straight across its walls) is
-        # a solution of the same equations, but not the steady pull
-        outside = _outside_points(model) - outside_at_start
-        if outside > model.kernel.n_check_points:
-            status = "failed"
-            message = (f"the static solve found an equilibrium with {outside} more check points outside "
-                       f"the conduit than at the start: the cable left the conduit (start too far from "
-                       f"the steady state?)")
-    wall = time.perf_counter() - t_wall
-    if progress is not None:
-        progress.close()
-    return SolveOutcome(history=history, status=status, message=message, end_time_s=0.0,
-                        steps=counters["steps"], newton_iterations=counters["newton"],
-                        jacobian_updates=counters["jacobian"], wall_time_s=wall)
+            # an equilibrium with the cable pulled out of the conduit (straight across its walls) is
+            # a solution of the same equations, but not the steady pull
+            outside = _outside_points(model) - outside_at_start
+            if outside > model.kernel.n_check_points:
+                status = "failed"
+                message = (f"the static solve found an equilibrium with {outside} more check points outside "
+                           f"the conduit than at the start: the cable left the conduit (start too far from "
+                           f"the steady state?)")
+        wall = time.perf_counter() - t_wall
+        if self.progress is not None:
+            self.progress.close()
+        return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
+                            steps=self.steps, newton_iterations=self.newton_iterations,
+                            jacobian_updates=self.jacobian_updates, wall_time_s=wall)
+
+
+def solve_steady(model, progress: Progress | None = None, tolerance: float | None = None,
+                 settings: SteadySettings | None = None) -> SolveOutcome:
+    """Solve ``model`` (built with ``solver.mode = "steady"``) for its steady sliding state:
+    ``SteadySolver(model, settings, progress).solve()``.
+
+    ``tolerance`` [-]: the stop residual relative to the rope solution's largest tension
+    (:attr:`SteadySettings.steady_residual`, the scenario's ``[solver] steady_residual``; a tighter
+    one shows how converged the pulling force is, ``benchmarks/steady_scale.py --tolerance-check``);
+    given, it replaces that of ``settings`` (default :class:`SteadySettings`).
+    """
+    settings = SteadySettings() if settings is None else settings
+    if tolerance is not None:
+        settings = replace(settings, steady_residual=float(tolerance))
+    return SteadySolver(model, settings, progress).solve()
 
 
 def _cable_part(model, q_all) -> np.ndarray:
