@@ -43,6 +43,7 @@ from .scenario.specs import (
     _parse_conduit,
     _quantities_to_si,
 )
+from .output.summary import RunSummary
 from .scenario.fields import REQUIRED, fields_of
 
 if TYPE_CHECKING:  # for the annotation only: Exudyn is imported when a run is asked for
@@ -251,29 +252,18 @@ class TensionProfile:
 
 @dataclass(frozen=True)
 class Result:
-    """What :func:`run` gives back.
+    """What :func:`run` gives back: the run's typed summary, its histories and profiles, the model.
+
+    The numbers are the summary's (:class:`~exucable.output.summary.RunSummary`, what ``summary.json``
+    holds), read as attributes; a number the run has none of reads as NaN here (None in the summary).
 
     Attributes
     ----------
-    pull_force_N : float
-        Mean pulling force in the steady window [N] (NaN if nothing was recorded); in steady mode the
-        pulling force of the steady sliding state.
-    pull_force_uncertainty_N : float
-        Its uncertainty [N], ``summary["pull_force_uncertainty_N"]`` (NaN where the summary has
-        none): in steady mode the discretisation's and the solve's (a second solve on a coarser
-        mesh, :mod:`exucable.solve.error_bar`), in dynamic mode the steady window's scatter and
-        drift; ``summary["pull_force_uncertainty_method"]`` says which.
-    status : str
-        ``"ok"``, ``"steady"`` (stopped once steady), ``"failed"``, or for a result that must not be
-        trusted the first of ``"dynamic"``, ``"outside_conduit"``, ``"penetration"``, ``"not_steady"``
-        (README "Results format"; every cause is in ``summary["flags"]``).
-    message : str
-        What the solver or the trust checks said: the failure, the flags' causes, or in steady mode how
-        the static solve converged; ``""`` when there is nothing to say.
+    summary : RunSummary
+        Everything ``summary.json`` holds (docs/results-format.md), typed: ``summary.flags``,
+        ``summary.bends``, ``summary.pull_force_uncertainty_method``, ...; also readable by key.
     history : History
     tension_profile : TensionProfile
-    summary : dict
-        Everything ``summary.json`` holds (docs/results-format.md).
     model : exucable.model.build.Model
         The solved model: final coordinates (``model.coordinates()``), ``kernel``, ``mbs``.
     scenario : Scenario
@@ -281,55 +271,72 @@ class Result:
         Where the files went, if anywhere.
     """
 
-    pull_force_N: float
-    pull_force_uncertainty_N: float
-    status: str
-    message: str
+    summary: RunSummary
     history: History
     tension_profile: TensionProfile
-    summary: dict
     model: Model
     scenario: Scenario
     out_dir: Path | None
 
     def __repr__(self) -> str:
         s = self.summary
-        mode = s.get("mode", "dynamic")
         u = self.pull_force_uncertainty_N
         force = f"{self.pull_force_N:.6g} N" + ("" if math.isnan(u) else f" ± {u:.2g} N")
-        return (f"Result(status={self.status!r}, mode={mode!r}, pull_force_N={force}, "
-                f"rope_pull_force_N={self.rope_pull_force_N:.6g} N, steps={s.get('steps')}, "
-                f"wall_time_s={s.get('wall_time_s', float('nan')):.3g}, out_dir={self.out_dir!r})")
+        return (f"Result(status={self.status!r}, mode={s.mode!r}, pull_force_N={force}, "
+                f"rope_pull_force_N={self.rope_pull_force_N:.6g} N, steps={s.steps}, "
+                f"wall_time_s={_number(s.wall_time_s):.3g}, out_dir={self.out_dir!r})")
+
+    @property
+    def pull_force_N(self) -> float:
+        """Mean pulling force in the steady window [N] (NaN if nothing was recorded); in steady mode the
+        pulling force of the steady sliding state."""
+        return _number(self.summary.pull_force_N)
+
+    @property
+    def pull_force_uncertainty_N(self) -> float:
+        """Its uncertainty [N] (NaN where the summary has none: a made-up substitute would read as a
+        bound): in steady mode the discretisation's and the solve's (a second solve on a coarser mesh,
+        :mod:`exucable.solve.error_bar`), in dynamic mode the steady window's scatter and drift;
+        ``summary.pull_force_uncertainty_method`` says which."""
+        return _number(self.summary.pull_force_uncertainty_N)
+
+    @property
+    def status(self) -> str:
+        """``"ok"``, ``"steady"`` (stopped once steady), ``"failed"``, or for a result that must not be
+        trusted the first of ``"dynamic"``, ``"outside_conduit"``, ``"penetration"``, ``"not_steady"``
+        (docs/results-format.md "Status"; every cause is in ``summary.flags``)."""
+        return self.summary.status
+
+    @property
+    def message(self) -> str:
+        """What the solver or the trust checks said: the failure, the flags' causes, or in steady mode how
+        the static solve converged; ``""`` when there is nothing to say."""
+        return self.summary.message or ""
 
     @property
     def trailing_tension_N(self) -> float:
         """Mean trailing-end tension in the steady window [N]."""
-        return _number(self.summary.get("trailing_tension_N"))
+        return _number(self.summary.trailing_tension_N)
 
     @property
     def max_tension_N(self) -> float:
-        """Largest tension along the cable [N] (``summary["max_tension_N"]``)."""
-        return _number(self.summary.get("max_tension_N"))
+        """Largest tension along the cable [N]."""
+        return _number(self.summary.max_tension_N)
 
     @property
     def max_sidewall_pressure_N_per_m(self) -> float:
         """Largest windowed sidewall pressure [N/m]: the contact force within s ± w/2 over the window
-        w (``summary["pressure_window_m"]``), the calculators' SWBP; NaN without contact."""
-        return _number(self.summary.get("max_sidewall_pressure_N_per_m"))
+        w (``summary.pressure_window_m``), the calculators' SWBP; NaN without contact."""
+        return _number(self.summary.max_sidewall_pressure_N_per_m)
 
     @property
     def rope_pull_force_N(self) -> float:
         """The quasi-static rope solver's pulling force, the reference [N]."""
-        return _number(self.summary.get("rope_pull_force_N"))
+        return _number(self.summary.rope_pull_force_N)
 
 
 def _number(value) -> float:
     return float("nan") if value is None else float(value)
-
-
-def _uncertainty(summary: dict) -> float:
-    # the summary's own value, NaN where it states none: a made-up substitute would read as a bound
-    return _number(summary.get("pull_force_uncertainty_N"))
 
 
 def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False, mode: str | None = None) -> Result:
@@ -357,17 +364,12 @@ def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False, m
         raise ScenarioError("solver.mode", f"mode must be \"dynamic\" or \"steady\", got {mode!r}")
     raw = run_scenario(scenario, out_dir, quiet=not progress, plots=out_dir is not None, mode=mode)
     h = raw.history
-    s = raw.summary
     return Result(
-        pull_force_N=_number(s.get("pull_force_N")),
-        pull_force_uncertainty_N=_uncertainty(s),
-        status=s["status"],
-        message=s.get("message", ""),
         history=History(**{k: np.asarray(h[k], dtype=float) for k in
                            ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N")}),
         tension_profile=TensionProfile(x_m=np.asarray(raw.tension_profile["x_m"], dtype=float),
                                        tension_N=np.asarray(raw.tension_profile["tension_N"], dtype=float)),
-        summary=s,
+        summary=raw.summary,
         model=raw.model,
         scenario=raw.model.scenario,
         out_dir=Path(out_dir) if out_dir is not None else None,

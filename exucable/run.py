@@ -17,6 +17,7 @@ from .output.versions import versions
 from .output.export import conduit_s
 from .output.outdir import owned_out_dir
 from .output.results import RunResult, write_results
+from .output.summary import RunSummary
 from .scenario.specs import Scenario, load_scenario
 from .post.pressure import bend_table, default_window_m, pressure_profile
 from .post.tension import SteadyState, detect_steady_state, profile_stations_m
@@ -272,82 +273,84 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     cprof, peak_line_load = contact_profile(points)
     rope = model.rope
     pressure_info, bends, pressure_prof = _pressure(model, points, rope)
-    summary = {
-        "name": sc.name,
-        "mode": sp.mode,
-        "mode_rule": sp.mode_rule,
-        "status": out.status,
-        "message": out.message,
-        "pull_force_N": float(np.mean(h["pull_force_N"][i0:])) if len(h["time_s"]) else None,
+    has_history = bool(len(h["time_s"]))
+    pull_force_N = float(np.mean(h["pull_force_N"][i0:])) if has_history else None
+    warnings = list(model.mesh.warnings) if model.mesh is not None else []
+    start = None
+    if first is not None:
+        start = {"kind": "steady" if first.layout is not None else "rope",
+                 "steady_pull_force_N": first.pull_force_N if first.layout is not None else None,
+                 "lead_out_m": getattr(model.start, "lead_out_m", 0.0),
+                 "steady_solve_message": first.message, "steady_solve_wall_time_s": first.wall_time_s}
+        if first.layout is None:
+            warnings.append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
+                            "started from the rope instead")
+    status, flags = _assess(model, out, st, h, pull_force_N)
+    if not is_loaded(sc):
+        warnings.append("no load acts on the cable (no gravity, pull.back_tension 0, no pull.force): its "
+                        "rope reference is 0 N; what the run reports is the bending stiffness's share and "
+                        f"inertia's, of the order of ρA·v² = {sc.cable.mass_per_length_kg_per_m * sc.pull.speed_m_per_s**2:.3g} N")
+    message = out.message
+    if flags and not message:
+        message = "; ".join(f["message"] for f in flags)
+    summary = RunSummary(
+        name=sc.name,
+        mode=sp.mode,
+        mode_rule=sp.mode_rule,
+        status=status,
+        message=message,
+        pull_force_N=pull_force_N,
         # scatter about the drift the cable's changing extent explains (none without gravity)
-        "pull_force_std_N": float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:]))
-        if len(h["time_s"]) else None,
-        "reference_drift_N_per_s": drift,
+        pull_force_std_N=float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:])) if has_history else None,
+        reference_drift_N_per_s=drift,
         **uncertainty,
-        "pull_force_drift_N_per_s": pf.drift_N_per_s + drift if pf else None,
-        "pull_force_unexplained_drift_N_per_s": pf.drift_N_per_s if pf else None,
-        "pull_force_uncertainty": ({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
-                                    "periods": pf.periods, "period_s": pf.period_s,
-                                    "window_s": list(pf.window_s),
-                                    "method": pf.method + (f"; after removing the references' expected drift "
-                                                           f"{drift:.4g} N/s" if drift else "")} if pf
-                                   else bar.to_dict() if bar is not None else None),
-        "steady_quantity": steady_quantity(model),
-        "steady_drift_N": st.drift_N,
-        "trailing_tension_N": float(np.mean(h["trailing_tension_N"][i0:])) if len(h["time_s"]) else None,
-        "max_tension_N": float(np.max(h["max_tension_N"][i0:])) if len(h["time_s"]) else None,
-        "steady": st.steady,
-        "steady_from_s": st.from_s,
-        "simulated_time_s": out.end_time_s,
-        "steps": out.steps,
-        "newton_iterations": out.newton_iterations,
+        pull_force_drift_N_per_s=pf.drift_N_per_s + drift if pf else None,
+        pull_force_unexplained_drift_N_per_s=pf.drift_N_per_s if pf else None,
+        pull_force_uncertainty=({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
+                                 "periods": pf.periods, "period_s": pf.period_s,
+                                 "window_s": list(pf.window_s),
+                                 "method": pf.method + (f"; after removing the references' expected drift "
+                                                        f"{drift:.4g} N/s" if drift else "")} if pf
+                                else bar.to_dict() if bar is not None else None),
+        steady_quantity=steady_quantity(model),
+        steady_drift_N=st.drift_N,
+        trailing_tension_N=float(np.mean(h["trailing_tension_N"][i0:])) if has_history else None,
+        max_tension_N=float(np.max(h["max_tension_N"][i0:])) if has_history else None,
+        steady=st.steady,
+        steady_from_s=st.from_s,
+        simulated_time_s=out.end_time_s,
+        steps=out.steps,
+        newton_iterations=out.newton_iterations,
         # all iterations, those of rejected step attempts included, per accepted step
-        "newton_iterations_per_step": out.newton_iterations / out.steps if out.steps else None,
-        "jacobian_updates": out.jacobian_updates,
-        "wall_time_s": out.wall_time_s,
-        "build_time_s": build_s,
-        "kernel_time_s": model.coupling.kernel_time_s if model.coupling is not None else 0.0,
+        newton_iterations_per_step=out.newton_iterations / out.steps if out.steps else None,
+        jacobian_updates=out.jacobian_updates,
+        wall_time_s=out.wall_time_s,
+        build_time_s=build_s,
+        kernel_time_s=model.coupling.kernel_time_s if model.coupling is not None else 0.0,
         # one check point's normal force over its share of the element: depends on the mesh and
         # the contact stiffness at a bend end; kept for cross-checks, not for a cable's limit
-        "max_check_point_line_load_N_per_m": peak_line_load if points is not None else None,
-        "rope_pull_force_N": refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
-        "rope_trailing_tension_N": rope.trailing_tension_N if rope is not None else None,
-        "rope_max_sidewall_pressure_N_per_m": rope.max_sidewall_pressure_N_per_m if rope is not None else None,
-        "rope_clearance_pull_force_N": refs.get("rope_clearance_pull_force_N"),
-        "reference_pulled_out_m": refs.get("pulled_out_m"),
-        "max_sidewall_pressure_N_per_m": None,     # without contact or rope; else pressure_info's
-        **pressure_info,
-        "bends": bends,
-        "mesh": (dict(model.mesh.to_dict(), steady_refine=solve_refine / refine)
-                 if model.mesh is not None else None),
-        "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
-        "scenario": sc.to_dict(),
-        "versions": versions(),
-    }
-    if first is not None:
-        summary["start"] = {"kind": "steady" if first.layout is not None else "rope",
-                            "steady_pull_force_N": first.pull_force_N if first.layout is not None else None,
-                            "lead_out_m": getattr(model.start, "lead_out_m", 0.0),
-                            "steady_solve_message": first.message, "steady_solve_wall_time_s": first.wall_time_s}
-        if first.layout is None:
-            summary["warnings"].append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
-                                       "started from the rope instead")
-    if out.status == "failed":
-        summary["failed_at_s"] = out.end_time_s
-    summary["status"], summary["flags"] = _assess(model, out, st, h, summary["pull_force_N"])
-    if not is_loaded(sc):
-        summary["warnings"].append("no load acts on the cable (no gravity, pull.back_tension 0, no pull.force): its "
-                                   "rope reference is 0 N; what the run reports is the bending stiffness's share and "
-                                   f"inertia's, of the order of ρA·v² = {sc.cable.mass_per_length_kg_per_m * sc.pull.speed_m_per_s**2:.3g} N")
-    summary["trust_limits"] = {"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
-                               "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
-                               "friction_deficit_fraction_of_mu": FRICTION_DEFICIT_LIMIT,
-                               "outside": "cable axis farther from the conduit axis than its inner radius"}
-    if summary["flags"] and not summary["message"]:
-        summary["message"] = "; ".join(f["message"] for f in summary["flags"])
-    if recorder is not None:
-        summary["snapshots_s"] = recorder.recorded_s
-        summary["snapshots_not_reached_s"] = list(recorder.pending)
+        max_check_point_line_load_N_per_m=peak_line_load if points is not None else None,
+        rope_pull_force_N=refs.get("rope_pull_force_N", rope.pull_force_N if rope is not None else None),
+        rope_trailing_tension_N=rope.trailing_tension_N if rope is not None else None,
+        rope_max_sidewall_pressure_N_per_m=rope.max_sidewall_pressure_N_per_m if rope is not None else None,
+        rope_clearance_pull_force_N=refs.get("rope_clearance_pull_force_N"),
+        reference_pulled_out_m=refs.get("pulled_out_m"),
+        **pressure_info,     # without contact or rope: none, and max_sidewall_pressure_N_per_m is None
+        bends=bends,
+        mesh=(dict(model.mesh.to_dict(), steady_refine=solve_refine / refine) if model.mesh is not None else None),
+        warnings=warnings,
+        scenario=sc.to_dict(),
+        versions=versions(),
+        start=start,
+        failed_at_s=out.end_time_s if out.status == "failed" else None,
+        flags=flags,
+        trust_limits={"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
+                      "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
+                      "friction_deficit_fraction_of_mu": FRICTION_DEFICIT_LIMIT,
+                      "outside": "cable axis farther from the conduit axis than its inner radius"},
+        snapshots_s=recorder.recorded_s if recorder is not None else None,
+        snapshots_not_reached_s=list(recorder.pending) if recorder is not None else None,
+    )
     rope_profile = None
     extras = {}
     if rope is not None:
@@ -405,23 +408,25 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
                                  "edge: the cables slid apart along the route further than it covers"})
     status = out.status if out.status == "failed" or not flags else flags[0]["flag"]
     message = out.message if not flags else "; ".join([out.message] + [f["message"] for f in flags])
-    summary = {
-        "name": sc.name,
-        "mode": "steady",
-        "status": status,
-        "message": message,
-        "flags": flags,
-        **{k: report[k] for k in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
-        "bundle": {k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
-        "steps": out.steps,
-        "newton_iterations": out.newton_iterations,
-        "wall_time_s": out.wall_time_s,
-        "build_time_s": build_s,
-        "mesh": model.mesh.to_dict() if model.mesh is not None else None,
-        "warnings": list(model.mesh.warnings) if model.mesh is not None else [],
-        "scenario": sc.to_dict(),
-        "versions": versions(),
-    }
+    summary = RunSummary(
+        name=sc.name,
+        mode="steady",
+        status=status,
+        message=message,
+        flags=flags,
+        pull_force_N=report["pull_force_N"],
+        trailing_tension_N=report["trailing_tension_N"],
+        max_tension_N=report["max_tension_N"],
+        bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
+        steps=out.steps,
+        newton_iterations=out.newton_iterations,
+        wall_time_s=out.wall_time_s,
+        build_time_s=build_s,
+        mesh=model.mesh.to_dict() if model.mesh is not None else None,
+        warnings=list(model.mesh.warnings) if model.mesh is not None else [],
+        scenario=sc.to_dict(),
+        versions=versions(),
+    )
     result = RunResult(summary=summary, history=h, tension_profile={"x_m": cables["x_m"], "tension_N": total},
                        cable_tensions=cables, model=model)
     return result

@@ -345,3 +345,14 @@ def test_only_the_command_line_prints_and_exits():
                     and getattr(node.exc.func, "id", "") == "SystemExit":
                 offenders.append(f"{name}:{node.lineno} raise SystemExit")
     assert offenders == []
+
+
+def test_code_and_guides_keep_no_diary():
+    """Code, the guides in docs/ and reference/README.md state rules and sources, not when or in which
+    working session something was measured: no ISO dates, no sessions (history: CHANGELOG.md and
+    docs/decisions/)."""
+    diary = re.compile(r"\b20\d\d-\d\d-\d\d\b|(?<!Python )\bsession\b", re.IGNORECASE)
+    files = [*PACKAGE.rglob("*.py"), *(ROOT / "docs").glob("*.md"), ROOT / "reference" / "README.md"]
+    offenders = [f"{f.relative_to(ROOT)}:{i}" for f in files
+                 for i, line in enumerate(f.read_text(encoding="utf-8").splitlines(), 1) if diary.search(line)]
+    assert offenders == []

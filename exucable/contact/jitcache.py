@@ -33,9 +33,9 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import importlib
 import sys
 import warnings
-from importlib import metadata
 from pathlib import Path
 
 from ..io import atomic_write_text
@@ -57,9 +57,11 @@ def sources_key(sources: Path | None = None) -> str:
         h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     versions = [sys.version]
     for dist in ("numpy", "numba", "llvmlite"):
+        # the modules' own versions (the same strings as their distributions'): whoever asks for a
+        # kernel imports them anyway, and no metadata search runs on every call
         try:
-            versions.append(metadata.version(dist))
-        except metadata.PackageNotFoundError:
+            versions.append(importlib.import_module(dist).__version__)
+        except ImportError:
             versions.append("-")
     h.update("\0".join(versions).encode())
     return h.hexdigest()[:24]

@@ -36,7 +36,6 @@ from ..geometry.segments import Segments
 from ..scenario.fields import default_of
 from .checkpoints import check_points, hermite_unit
 from .law import ContactLaw, damping_onset
-from .numpy_kernel import ReferenceKernel
 from .smooth import SmoothWall, closest_point_angles
 
 __all__ = [
@@ -269,6 +268,7 @@ class ContactKernel:
                                     self.reference_spacing_m, broad_phase, self.open_ends,
                                     self.wall)
         else:
+            from .numpy_kernel import ReferenceKernel   # the numpy backend only: not imported by compiled runs
             self._impl = ReferenceKernel(self)
         self._last_point_state = None   # (q, q_t, state) of the last per-point pass
 

@@ -22,6 +22,7 @@ Files
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,6 +32,7 @@ from ..errors import OutputError
 from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, csv_text, read_csv, write_csv, write_json
 from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
 from ..post.pressure import BEND_COLUMNS, PRESSURE_COLUMNS
+from .summary import RunSummary
 
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
            "read_summary", "result_file_names", "DATA_FILES", "FIGURE_FILES", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
@@ -49,7 +51,7 @@ ROPE_COLUMNS = ("s_conduit_m", "tension_N", "sidewall_pressure_N_per_m")
 class RunResult:
     """Everything a run produced, ready to be written or post-processed."""
 
-    summary: dict
+    summary: RunSummary               # summary.json (a plain dict of its keys is written as it is)
     history: dict                     # HISTORY_COLUMNS -> arrays
     tension_profile: dict             # PROFILE_COLUMNS -> arrays
     contact_profile: dict | None = None
@@ -143,8 +145,12 @@ def _write_data(out: Path, result: RunResult) -> list[Path]:
             from .formats import SNAPSHOT_FILES
             for name, data in result.snapshots.items():
                 add_csv(name, SNAPSHOT_FILES[name], data)
-        result.summary["files"] = dict(contents)
-        written.append(write_json(out / SUMMARY_FILE, result.summary, batch=batch))
+        summary = result.summary
+        if isinstance(summary, RunSummary):
+            result.summary = dataclasses.replace(summary, files=dict(contents))
+        else:
+            summary["files"] = dict(contents)
+        written.append(write_json(out / SUMMARY_FILE, dict(result.summary), batch=batch))
     return written
 
 

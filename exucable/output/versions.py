@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import platform
+import sys
 from functools import lru_cache
-from importlib.metadata import PackageNotFoundError, version
 
 from ..version import __version__
 
@@ -25,8 +25,13 @@ def versions() -> dict[str, str]:
 
 @lru_cache(maxsize=None)
 def _installed_version(distribution: str) -> str:
-    """An installed distribution's version, read once per process (the metadata search costs
-    ~2 ms, a hundredth of a steady Example 4 run)."""
+    """An installed distribution's version, read once per process: the imported module's own
+    ``__version__`` when a run has imported it (no metadata search), else its distribution's metadata
+    (``--version``, which does not import Exudyn)."""
+    module = sys.modules.get(distribution)
+    if isinstance(getattr(module, "__version__", None), str):
+        return module.__version__
+    from importlib.metadata import PackageNotFoundError, version
     try:
         return version(distribution)
     except PackageNotFoundError:
