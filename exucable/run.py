@@ -212,8 +212,10 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
             coarse = build_model(sc, refine=refine, check_points_per_element=points)
             points = coarse.mesh.check_points_per_element
         solve_refine = refine * STEADY_REFINE
+    # the coarse build's rope references are the scenario's, whatever the mesh: not solved twice
     model = build_model(sc, refine=solve_refine, check_points_per_element=points,
-                        start=first.layout if first is not None else None)
+                        start=first.layout if first is not None else None,
+                        references=coarse.start if coarse is not None else None)
     build_s = time.perf_counter() - t_start
     sp = sc.solver
     recorder = None

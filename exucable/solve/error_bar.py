@@ -118,7 +118,8 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
     head = f"second steady solve on a mesh {COARSE_RATIO:g}x coarser"
     if coarse is None:
         try:
-            coarse = build_model(scenario, refine=refine / COARSE_RATIO, check_points_per_element=k)
+            coarse = build_model(scenario, refine=refine / COARSE_RATIO, check_points_per_element=k,
+                                 references=getattr(model, "start", None))
         except ModelError as exc:
             return SteadyErrorBar(None, None, solve_N, None, None, f"{head} not possible: {exc}",
                                   time.perf_counter() - t0)
