@@ -413,7 +413,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
                                bundle_tension_profile, check_bundle_supported)
     from .post.bundle import classify_cross_section
     from .solve.dynamic import Progress
-    from .solve.steady import solve_steady
+    from .solve.steady import SteadySettings, solve_steady
 
     if check_points_per_element is not None:
         raise ModelError("contact.check_points_per_element", "several cables take the scenario's check points; "
@@ -425,7 +425,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     t_cpu = time.process_time()
     progress = _budgeted(Progress(1.0, label=sc.name, enabled=not quiet), cpu_budget_s)
     try:
-        out = solve_steady(model, progress=progress)
+        out = solve_steady(model, progress=progress, settings=SteadySettings.from_solver(sc.solver))
     except _OverBudget:
         from .model.recorder import History
         from .solve.dynamic import SolveOutcome
