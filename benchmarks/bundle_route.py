@@ -1,21 +1,24 @@
-"""Whole-process wall time of a bundle run: three cables through a 100 m route with four bends, steady mode.
+"""Whole-process wall and CPU time of a bundle run: three cables through a 100 m route with four bends, steady mode.
 
     nice .venv/bin/python benchmarks/bundle_route.py [--count 3] [--arrangement triangular]
         [--length 100] [--repeat 1] [--out DIR]
 
-Writes the scenario (four 90° bends of 5 m radius, two left, one up, one right, joined by equal straights;
-cables of 30 mm diameter, 1.4 kg/m, in a 100 mm duct; μ 0.3, back tension 300 N) and times
-``exucable run SCENARIO --no-plots`` in a fresh process per repeat (scenario → build → solve → files),
-next to the same route with one cable (``cable.count = 1``) timed in the same run, and prints the
-ratio, the bundle's pull force, its weight correction factor beside the calculators' and its status.
-Target (issue "Three cables in one conduit"): ≤ 60 s whole process. The machine is shared: compare
-the rows of one run with each other.
+Writes the scenario (bends of 5 m radius: 90° left, 90° left, 30° up, 90° right, joined by equal
+straights; cables of 30 mm diameter, 1.4 kg/m, in a 100 mm duct, D/d 3.33; μ 0.3, back tension 300 N)
+and times ``exucable run SCENARIO --no-plots`` in a fresh process per repeat (scenario → build → solve
+→ files; CPU time of the child process), next to the same route with one cable (``cable.count = 1``)
+timed in the same run, and prints the ratio, the bundle's pull force, its weight correction factor
+beside the calculators' and its status. Mesh: the scenario's rule (printed); a bundle run states no
+error bar yet (the one-cable run's is the coarse-mesh Richardson estimate). Target (issue "Three
+cables in one conduit"): ≤ 60 s whole process. The machine is shared: compare the rows of one run
+with each other.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import resource
 import statistics
 import subprocess
 import sys
@@ -56,9 +59,9 @@ def main(argv=None) -> int:
     p.add_argument("--length", type=float, default=100.0, help="route length [m] (approximately)")
     p.add_argument("--repeat", type=int, default=1)
     p.add_argument("--out", default="out/bundle-benchmark")
-    p.add_argument("--quick", action="store_true", help="two cables on a 12 m route (a smoke run)")
+    p.add_argument("--quick", action="store_true", help="two cables on the shortest route, 1 m straights, 34 m (a smoke run)")
     args = p.parse_args(argv)
-    if args.quick:      # the smoke run: two cables on a short route
+    if args.quick:      # the smoke run: two cables on the shortest route (the straights' floor of 1 m)
         args.count, args.length, args.repeat = 2, 12.0, 1
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -69,26 +72,32 @@ def main(argv=None) -> int:
     for count, arrangement in ((1, "single"), (args.count, args.arrangement)):
         path = out / f"bundle_route_{count}.toml"
         atomic_write_text(path, SCENARIO.format(count=count, arrangement=arrangement, straight=f"{straight:.6g}"))
-        rows[count] = {"times": []}
+        rows[count] = {"times": [], "cpu": []}
     for _ in range(args.repeat):
         for count in rows:        # interleaved: one cable, then the bundle
             t0 = time.perf_counter()
+            c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             proc = subprocess.run([str(exe), "run", str(out / f"bundle_route_{count}.toml"), "--out",
                                    str(out / f"run_{count}"), "--no-plots", "--quiet"], capture_output=True, text=True)
             rows[count]["times"].append(time.perf_counter() - t0)
+            c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            rows[count]["cpu"].append(c1.ru_utime - c0.ru_utime + c1.ru_stime - c0.ru_stime)
             rows[count]["exit"] = proc.returncode
             rows[count]["summary"] = json.loads((out / f"run_{count}" / "summary.json").read_text())
     one, many = rows[1], rows[args.count]
     t1, tn = statistics.median(one["times"]), statistics.median(many["times"])
+    c1, cn = statistics.median(one["cpu"]), statistics.median(many["cpu"])
     s1, sn = one["summary"], many["summary"]
     b = sn["bundle"]
-    print(f"route {args.length:.0f} m (straights {straight:.4g} m, 4 bends), whole process, median of {args.repeat}:")
-    print(f"  1 cable : {t1:7.2f} s, status {s1['status']}, pull {s1['pull_force_N']:.6g} N, "
+    print(f"route {5 * straight + bends_m:.0f} m (straights {straight:.4g} m, 4 bends), whole process, "
+          f"median of {args.repeat}:")
+    print(f"  1 cable : {t1:7.2f} s wall, {c1:7.2f} s CPU, status {s1['status']}, pull {s1['pull_force_N']:.6g} N, "
           f"{s1['mesh']['elements']} elements, {s1['newton_iterations']} Newton iterations")
-    print(f"  {args.count} cables: {tn:7.2f} s, status {sn['status']}, pull {sn['pull_force_N']:.6g} N, "
-          f"{sn['mesh']['elements']} elements each, {sn['newton_iterations']} Newton iterations "
+    print(f"  {args.count} cables: {tn:7.2f} s wall, {cn:7.2f} s CPU, status {sn['status']}, pull {sn['pull_force_N']:.6g} N, "
+          f"{sn['mesh']['elements']} elements each ({sn['mesh']['element_length_m']:.3g} m, {sn['mesh']['check_points_per_element']} check points), {sn['newton_iterations']} Newton iterations "
           f"({sn['message']})")
-    print(f"  ratio bundle / one cable: {tn / t1:.2f}x; target ≤ 60 s: {'met' if tn <= 60.0 else 'NOT met'}")
+    print(f"  ratio bundle / one cable: {tn / t1:.2f}x wall, {cn / c1:.2f}x CPU; target ≤ 60 s whole process: "
+          f"{'met' if tn <= 60.0 else 'NOT met'} (wall), {'met' if cn <= 60.0 else 'NOT met'} (CPU)")
     print(f"  weight correction factor {b['weight_correction_factor']:.5g} (calculators' "
           f"{b['formula_weight_correction_factor']:.5g}); per straight: "
           + ", ".join(f"{st['weight_correction_factor']:.4g}" if st['weight_correction_factor'] is not None else "n/a"

@@ -6,23 +6,28 @@ that the straights between the vertical bends slope; the mesh and the check poin
 scenario's default rules (:func:`route_data`).
 
 Each length runs in its own process (so that its peak memory is its own): the process imports
-exucable, parses the scenario, builds the model (the start layout and both rope references
-included), solves steady, post-processes (tension profile, check-point loads, pressure, bends,
-trust), writes the result files and draws the three figures, each stage timed on its own. The
-parent times the whole child process (interpreter start to exit). Printed per length: elements,
-check points, Newton iterations, the wall time of each stage and its share of the whole, the CPU
-time of the whole process and of each stage (on a shared, loaded machine the CPU times are the ones
-to compare), the
-contact kernel's share of the solve, the solve's time per Newton iteration, peak memory (ru_maxrss)
-and the pulling force against the rope with clearance; then the exponent p of a least-squares fit
-whole-process wall (and CPU time) ∝ L^p, measured in this one run.
+exucable, parses the scenario, builds the models (the rule's coarse mesh for the error bar and the
+solved mesh, the start layout and both rope references included), solves steady, solves the error
+bar's coarse mesh, post-processes (tension profile, check-point loads, pressure, bends, trust),
+writes the result files and draws the three figures, each stage timed on its own (wall and CPU
+time). The parent times the whole child process (interpreter start to exit, wall and CPU). Printed
+per length: elements, check points, Newton iterations of the solve and of the error bar's, the CPU
+time of the whole process and of each stage with its share (on a shared, loaded machine the CPU
+times are the ones to compare), the rope references' part of the build, the solve's CPU time per
+Newton iteration, peak memory (ru_maxrss) and the pulling force against the rope with clearance;
+then the exponent p of a least-squares fit CPU time ∝ L^p (whole process, the solves, the rest),
+measured in this one run.
 
 ``--profile`` runs the longest route once more under cProfile (in this process, after a short
 warm-up) and prints Exudyn's own timers of its static solver per Newton iteration (system
 Jacobian, factorisation, residual) and the functions with the most own and cumulative time (the
 contact kernel, our coupling's and the pseudo-time spring's user functions, the build's parts).
 
-Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--clearance-spacing]``;
+``--newton-parts`` times each part of one Newton iteration of the longest route on its own (CPU
+time): the residual, the ODE2 Jacobian with and without the loads' Jacobian, our contact
+coupling's user functions within them, and one whole one-iteration static solve.
+
+Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing]``;
 ``--clearance-spacing`` solves the longest route's rope with clearance at a 2 cm node spacing and at
 the default rule's, with the pulling force's change and the CPU time of each.
 ``--quick`` is a smoke run (a 200 m and a 400 m route).
@@ -97,24 +102,75 @@ class _Clock:
         self._t = now
 
 
+class _Timed:
+    """Wall and CPU time [s] summed over the calls of the functions it wraps, per stage name,
+    and the outcomes of the steady solves (main solve first, then the error bar's coarse one)."""
+
+    def __init__(self):
+        self.wall, self.cpu, self.solves = {}, {}, []
+        self._inside = set()
+
+    def wrap(self, module, name: str, stage):
+        """Replace ``module.name`` by a timed copy; ``stage(call_number)`` names the stage of a call."""
+        f = getattr(module, name)
+        calls = [0]
+
+        def timed(*args, **kwargs):
+            key = stage(calls[0])
+            calls[0] += 1
+            if key in self._inside:     # a call within a timed call of the same stage: counted there
+                return f(*args, **kwargs)
+            self._inside.add(key)
+            w, c = time.perf_counter(), time.process_time()
+            try:
+                out = f(*args, **kwargs)
+            finally:
+                self._inside.discard(key)
+            self.wall[key] = self.wall.get(key, 0.0) + time.perf_counter() - w
+            self.cpu[key] = self.cpu.get(key, 0.0) + time.process_time() - c
+            if name == "solve_steady":
+                self.solves.append(out)
+            return out
+
+        setattr(module, name, timed)
+
+
 def one_case(length_m: float, figures: bool = True) -> dict:
-    """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints)."""
+    """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints).
+
+    Stages: import, parse, build (every model built, the rope references included), of it the
+    references (the centreline rope's solves and the rope with clearance), solve (the steady
+    solve), error bar (the second steady solve on the coarse mesh), post (the rest of
+    ``run_scenario``: tension profile, check-point loads, pressure, bends, trust), write (CSV and
+    JSON), figures; wall and CPU time of each."""
     clock = _Clock()
     from exucable.output.results import write_results
     from exucable.plots.results import plot_pressure, plot_pull_force, plot_tension_profile
     from exucable.run import run_scenario
     from exucable.scenario.specs import parse_scenario
+    import exucable.model.build as build
+    import exucable.quasistatic.clearance as clearance
+    import exucable.quasistatic.rope as rope
+    import exucable.solve.steady as steady
     clock.lap("import_s")
     sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
     clock.lap("parse_s")
+    # run_scenario and the error bar import these at call time: the timed copies are the ones called
+    timed = _Timed()
+    timed.wrap(build, "build_model", lambda i: "build_s")
+    timed.wrap(steady, "solve_steady", lambda i: "solve_s" if i == 0 else "error_bar_s")
+    for module, name in ((rope, "solve_rope"), (rope, "rope_pull_force_N"), (rope, "solve_rope_for_pull_force"),
+                         (clearance, "solve_rope_with_clearance")):
+        timed.wrap(module, name, lambda i: "references_s")
     res = run_scenario(sc, None, plots=False)
     clock.lap("run_s")
     s = res.summary
-    # run_scenario times its build and its solve; the rest of it is post-processing
-    t = {k: clock.wall[k] for k in ("import_s", "parse_s")}
-    t["build_s"] = s["build_time_s"]
-    t["solve_s"] = s["wall_time_s"]
-    t["post_s"] = clock.wall["run_s"] - s["build_time_s"] - s["wall_time_s"]
+    wall = {k: clock.wall[k] for k in ("import_s", "parse_s")}
+    cpu = {k: clock.cpu[k] for k in ("import_s", "parse_s")}
+    for k in ("build_s", "references_s", "solve_s", "error_bar_s"):
+        wall[k], cpu[k] = timed.wall.get(k, 0.0), timed.cpu.get(k, 0.0)
+    wall["post_s"] = clock.wall["run_s"] - wall["build_s"] - wall["solve_s"] - wall["error_bar_s"]
+    cpu["post_s"] = clock.cpu["run_s"] - cpu["build_s"] - cpu["solve_s"] - cpu["error_bar_s"]
 
     out = Path(tempfile.mkdtemp(prefix="exucable-long-routes-"))
     try:
@@ -129,16 +185,19 @@ def one_case(length_m: float, figures: bool = True) -> dict:
         clock.lap("figures_s")
     finally:
         shutil.rmtree(out, ignore_errors=True)
+    for k in ("write_s", "figures_s"):
+        wall[k], cpu[k] = clock.wall[k], clock.cpu[k]
+    bar = timed.solves[1] if len(timed.solves) > 1 else None
     return {"length_m": length_m, "status": s["status"], "message": s["message"],
-            "elements": s["scenario"]["cable"]["elements"],
-            "check_points": s["scenario"]["cable"]["elements"] * s["mesh"]["check_points_per_element"],
+            # the solved mesh's (steady mode refines the rule's; the error bar solves the rule's)
+            "elements": s["mesh"]["elements"],
+            "check_points": s["mesh"]["elements"] * s["mesh"]["check_points_per_element"],
             "newton_iterations": s["newton_iterations"], "steps": s["steps"],
+            "error_bar_newton_iterations": bar.newton_iterations if bar is not None else 0,
             "kernel_s": s["kernel_time_s"], "pull_force_N": s["pull_force_N"],
             "rope_clearance_pull_force_N": s["rope_clearance_pull_force_N"],
             "rope_pull_force_N": s["rope_pull_force_N"],
-            "write_s": clock.wall["write_s"], "figures_s": clock.wall["figures_s"],
-            "cpu_s": {k: v for k, v in clock.cpu.items() if k != "rest"},
-            "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **t}
+            "cpu_s": cpu, "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **wall}
 
 
 def in_child(length_m: float, figures: bool) -> dict:
@@ -155,24 +214,23 @@ def in_child(length_m: float, figures: bool) -> dict:
     return dict(json.loads(done.stdout.strip().splitlines()[-1]), process_s=wall, process_cpu_s=cpu)
 
 
-STAGES = ("import_s", "parse_s", "build_s", "solve_s", "post_s", "write_s", "figures_s")
+STAGES = ("import_s", "parse_s", "build_s", "solve_s", "error_bar_s", "post_s", "write_s", "figures_s")
 
 
 def report(r: dict) -> str:
-    whole = r["process_s"]
-    stages = "  ".join(f"{k[:-2]} {r[k]:6.2f} ({100 * r[k] / whole:3.0f} %)" for k in STAGES)
+    cpu, whole = r["cpu_s"], r["process_cpu_s"]
+    stages = "  ".join(f"{k[:-2].replace('_', ' ')} {cpu[k]:6.2f} ({100 * cpu[k] / whole:3.0f} %)" for k in STAGES)
     n = max(r["newton_iterations"], 1)
     F, Fc = r["pull_force_N"], r["rope_clearance_pull_force_N"]
     vs = f"{100 * (F / Fc - 1):+.2f} %" if F is not None and Fc else "-"
-    return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process {whole:6.2f} s  "
+    return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process CPU {whole:6.2f} s (wall {r['process_s']:6.2f} s)  "
             f"elements {r['elements']:5d}  check points {r['check_points']:7d}  Newton {r['newton_iterations']:4d} "
-            f"({r['steps']} pseudo-time steps)  peak RSS {r['peak_rss_MB']:5.0f} MB\n"
-            f"{'':9s}{stages}  (outside them: interpreter start and exit "
-            f"{whole - sum(r[k] for k in STAGES):5.2f})\n"
-            f"{'':9s}CPU time: whole process {r['process_cpu_s']:6.2f} s; "
-            + "  ".join(f"{k[:-2]} {v:6.2f}" for k, v in r["cpu_s"].items()) + "\n"
-            f"{'':9s}solve per Newton iteration {1e3 * r['solve_s'] / n:6.1f} ms, of which contact kernel "
-            f"{1e3 * r['kernel_s'] / n:6.1f} ms ({100 * r['kernel_s'] / max(r['solve_s'], 1e-12):3.0f} %);  "
+            f"({r['steps']} pseudo-time steps; error bar's coarse solve {r['error_bar_newton_iterations']})  "
+            f"peak RSS {r['peak_rss_MB']:5.0f} MB\n"
+            f"{'':9s}CPU per stage [s]: {stages}  (outside them: interpreter start and exit "
+            f"{whole - sum(cpu[k] for k in STAGES):5.2f}); of the build, the rope references {cpu['references_s']:6.2f}\n"
+            f"{'':9s}solve's CPU per Newton iteration {1e3 * cpu['solve_s'] / n:6.1f} ms (wall {1e3 * r['solve_s'] / n:6.1f} ms), "
+            f"of which contact kernel (wall) {1e3 * r['kernel_s'] / n:6.1f} ms;  "
             f"F {'-' if F is None else f'{F:.1f}'} N, vs rope with clearance {vs}"
             + (f"\n{'':9s}{r['message']}" if r["message"] else ""))
 
@@ -238,6 +296,66 @@ def profile(length_m: float, top: int = 25) -> None:
     print(buf.getvalue())
 
 
+def newton_parts(length_m: float, reps: int = 5) -> None:
+    """CPU time of each part of one Newton iteration of the steady solve on the solved mesh of the
+    route of ``length_m`` [m], each part called ``reps`` times on its own through Exudyn's solver
+    methods (after one warm-up residual): the residual (the ANCF elements inside Exudyn, our contact
+    coupling's user function with the kernel, the pseudo-time spring's), the ODE2 Jacobian (the
+    ANCF elements' by automatic differentiation inside Exudyn, the two user functions' sparse
+    blocks) with and without the loads' Jacobian, and one whole one-iteration static solve (adds
+    the sparse matrix's assembly, its LU factorisation and a second residual)."""
+    import types
+
+    import numpy as np
+    import exudyn as exu
+
+    import exucable.model.coupling as coupling
+    import exucable.solve.steady as steady
+    from exucable.model.build import build_model
+    from exucable.scenario.specs import parse_scenario
+
+    # the coupling's own timers then count this process's CPU time, not wall
+    coupling.time = types.SimpleNamespace(perf_counter=time.process_time)
+    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    first = build_model(sc)
+    model = build_model(sc, refine=2.0, check_points_per_element=first.mesh.check_points_per_element,
+                        references=first.start)
+    mbs = model.mbs
+    spring = steady.PseudoTimeSpring(model)
+    spring.rate = steady.initial_spring_rate(model)
+    n = mbs.systemData.ODE2Size()
+    print(f"one Newton iteration's parts, {length_m / 1000:g} km: {model.mesh.elements} elements x "
+          f"{model.mesh.check_points_per_element} check points, {n} coordinates; CPU time per call, "
+          f"mean of {reps}:")
+    q0 = np.array(mbs.systemData.GetODE2Coordinates())
+    rng = np.random.default_rng(0)
+
+    def moved():   # new coordinates each call, so that the coupling's reuse of a kernel pass does not hide it
+        mbs.systemData.SetODE2Coordinates(list(q0 + 1e-12 * rng.random(n)))
+
+    def timed(name, f, count=reps):
+        c = model.coupling
+        t, u, k = time.process_time(), c.user_time_s, c.kernel_time_s
+        for _ in range(count):
+            f()
+        dt, du, dk = [(x1 - x0) / count for x0, x1 in ((t, time.process_time()), (u, c.user_time_s), (k, c.kernel_time_s))]
+        print(f"  {name:58s} {1e3 * dt:8.2f} ms  (contact coupling's user functions {1e3 * du:7.2f}, of it the kernel "
+              f"{1e3 * dk:7.2f}; the rest {1e3 * (dt - du):7.2f})", flush=True)
+        return dt
+
+    solver = exu.MainSolverStatic()
+    settings = steady.static_settings()
+    solver.InitializeSolver(mbs, settings)
+    moved()
+    solver.ComputeODE2RHS(mbs)                  # warm-up: the kernel's first call loads it from numba's cache
+    timed("residual (ODE2 RHS) at new coordinates", lambda: (moved(), solver.ComputeODE2RHS(mbs)))
+    jac = timed("ODE2 Jacobian, no loads' Jacobian (the settings)", lambda: solver.ComputeJacobianODE2RHS(mbs, -1.0, 0.0, 0.0, 0))
+    timed("ODE2 Jacobian with the loads' Jacobian (Exudyn's default)", lambda: solver.ComputeJacobianODE2RHS(mbs, -1.0, 0.0, 0.0, 1))
+    one = steady.static_settings(tolerance=1.0, max_iterations=1)
+    whole = timed("one whole static solve of one Newton iteration", lambda: (moved(), exu.MainSolverStatic().SolveSystem(mbs, one)))
+    print(f"  the Jacobian is {100 * jac / whole:.0f} % of the whole iteration")
+
+
 def clearance_spacing(length_m: float, spacings_m=(0.02, None)) -> None:
     """The rope with clearance of the route of ``length_m`` [m] at node spacings ``spacings_m``
     (None: the default rule), with its pulling force and the CPU time of each solve."""
@@ -268,6 +386,8 @@ def main() -> None:
     ap.add_argument("--profile", action="store_true", help="also cProfile the longest route")
     ap.add_argument("--clearance-spacing", action="store_true",
                     help="also the longest route's rope with clearance at 2 cm and at the default node spacing")
+    ap.add_argument("--newton-parts", action="store_true",
+                    help="also the CPU time of each part of one Newton iteration on the longest route")
     ap.add_argument("--no-figures", action="store_true", help="skip the figures stage")
     ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -275,22 +395,26 @@ def main() -> None:
         print(json.dumps(one_case(float(args.case), figures=not args.no_figures)))
         return
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
-    walls = []
+    rows = []
     for L in lengths:
         r = in_child(L, figures=not args.no_figures)
         print(report(r), flush=True)
         if r["status"] != "failed":
-            walls.append((L, r["process_s"], r["solve_s"], r["process_s"] - r["solve_s"], r["process_cpu_s"]))
-    if len(walls) >= 2:
+            solves = r["cpu_s"]["solve_s"] + r["cpu_s"]["error_bar_s"]
+            rows.append((L, r["process_cpu_s"], solves, r["process_cpu_s"] - solves, r["process_s"]))
+    if len(rows) >= 2:
         import numpy as np
 
-        L, w, solve, rest, cpu = np.array(walls).T
+        L, cpu, solve, rest, w = np.array(rows).T
         fit = lambda y: np.polyfit(np.log(L), np.log(y), 1)[0]
-        print(f"whole process ∝ L^{fit(w):.2f}, solve ∝ L^{fit(solve):.2f}, everything but the solve ∝ "
-              f"L^{fit(rest):.2f}, whole process's CPU time ∝ L^{fit(cpu):.2f} over {', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
-        print(f"share of everything but the solve at {L[-1]:g} m: {100 * rest[-1] / w[-1]:.0f} %")
+        print(f"CPU time: whole process ∝ L^{fit(cpu):.2f}, the two steady solves ∝ L^{fit(solve):.2f}, everything "
+              f"but the solves ∝ L^{fit(rest):.2f}; whole process wall ∝ L^{fit(w):.2f}; over "
+              f"{', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
+        print(f"share of everything but the solve at {L[-1]:g} m (CPU time): {100 * rest[-1] / cpu[-1]:.0f} %")
     if args.clearance_spacing:
         clearance_spacing(lengths[-1])
+    if args.newton_parts:
+        newton_parts(lengths[-1])
     if args.profile:
         profile(lengths[-1])
 

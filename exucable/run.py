@@ -215,8 +215,10 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
             coarse = build_model(sc, refine=refine, check_points_per_element=points)
             points = coarse.mesh.check_points_per_element
         solve_refine = refine * STEADY_REFINE
+    # the coarse build's rope references are the scenario's, whatever the mesh: not solved twice
     model = build_model(sc, refine=solve_refine, check_points_per_element=points,
-                        start=first.layout if first is not None else None)
+                        start=first.layout if first is not None else None,
+                        references=coarse.start if coarse is not None else None)
     build_s = time.perf_counter() - t_start
     sp = sc.solver
     recorder = None
@@ -414,7 +416,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
                                bundle_tension_profile, check_bundle_supported)
     from .post.bundle import classify_cross_section
     from .solve.dynamic import Progress
-    from .solve.steady import solve_steady
+    from .solve.steady import SteadySettings, solve_steady
 
     if check_points_per_element is not None:
         raise ModelError("contact.check_points_per_element", "several cables take the scenario's check points; "
@@ -426,7 +428,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     t_cpu = time.process_time()
     progress = _budgeted(Progress(1.0, label=sc.name, enabled=not quiet), cpu_budget_s)
     try:
-        out = solve_steady(model, progress=progress)
+        out = solve_steady(model, progress=progress, settings=SteadySettings.from_solver(sc.solver))
     except _OverBudget:
         from .model.recorder import History
         from .solve.dynamic import SolveOutcome

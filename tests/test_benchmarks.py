@@ -47,6 +47,8 @@ SCRIPTS = {
     "studies/slow_pull.py": "force [N]",
     "studies/tension_profile.py": "| route | refine | elements | pull [N]",
     "studies/fit_engines.py": "mu_rope",
+    "benchmarks/pull_in_history.py": "CPU per point [s]",
+    "studies/bundle_bend_study.py": "p/formula",
 }
 
 # the slowest smoke runs, 10-35 s each on the shared 2-core machine (several processes each importing

@@ -191,3 +191,18 @@ back_tension = 150.0
         assert d["rope_pull_force_N"] == pytest.approx(CAPSTAN_N, rel=1e-9)
         assert abs(d["pull_force_N"] / CAPSTAN_N - 1) < 2e-3
     assert "engine steady (auto" in capsys.readouterr().out
+
+
+def test_the_error_bar_solves_and_states_the_scenarios_stop_residual(tmp_path):
+    """A scenario's ``solver.steady_residual`` is the stop rule of both steady solves: the coarse one
+    the error bar adds, and the solve term it states (stop residual × the rope's largest tension)."""
+    from exucable.run import run_scenario
+
+    d = _data(steady_residual=1e-9)
+    d["cable"]["elements"] = 24
+    res = run_scenario(parse_scenario(d, tmp_path), None, plots=False)
+    bar = res.summary["pull_force_uncertainty"]
+    assert res.summary["status"] == "ok"
+    assert "1e-09 x the rope's largest tension" in bar["method"]
+    # the solve term is 1e-9 × the rope's largest tension, here the capstan's exit tension (a few hundred N)
+    assert 0.0 < bar["solve_N"] < 1e-9 * 1000.0

@@ -88,3 +88,32 @@ def test_a_pull_starts_on_the_rope_with_clearance():
     # off the floor (z = −0.01 m there) and within 0.5 mm of the rope with clearance's height
     assert np.all(lay.position_m[span, 2] > -0.009)
     np.testing.assert_allclose(lay.position_m[span, 2], z_rope[span], atol=5e-4)
+
+
+def test_a_second_mesh_reuses_the_rope_references():
+    """The rope, the rope with clearance and the lead-out depend on the scenario, not on the mesh:
+    the solved mesh's layout takes them from the coarse one's (steady mode builds both) and is then
+    the same, bit for bit, as a layout that solved them again."""
+    from exucable.model.layout import initial_layout
+
+    data = {
+        "cable": {"radius": 0.009, "mass_per_length": W_KG_PER_M, "youngs_modulus": 5e8},
+        "conduit": {"inner_radius": 0.019, "path": [{"straight": 6.0}, {"bend": 30.0, "radius": 2.0, "turn": "up"},
+                                                    {"straight": 6.0}]},
+        "contact": {"friction": MU},
+        "pull": {"speed": 0.2, "back_tension": TB},
+        "gravity": {"g": G},
+        "solver": {"mode": "steady", "end_time": 1.0},
+    }
+    sc = parse_scenario(data, ".")
+    coarse = initial_layout(sc)
+    assert coarse.rope_clearance is not None
+    k = coarse.mesh.check_points_per_element
+    reused = initial_layout(sc, refine=2.0, check_points_per_element=k, references=coarse)
+    solved = initial_layout(sc, refine=2.0, check_points_per_element=k)
+    assert reused.rope is coarse.rope and reused.rope_clearance is coarse.rope_clearance
+    assert reused.lead_out_m == solved.lead_out_m
+    assert reused.mesh.elements == solved.mesh.elements > coarse.mesh.elements
+    np.testing.assert_array_equal(reused.cable.coordinates, solved.cable.coordinates)
+    np.testing.assert_array_equal(reused.rope.tension_N, solved.rope.tension_N)
+    np.testing.assert_array_equal(reused.rope_clearance.offset_m, solved.rope_clearance.offset_m)

@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from exucable.errors import LogError
-from exucable.fit.friction import RESAMPLERS, RopeFamily, fit_friction
+from exucable.fit.friction import FIT_ENGINES, RESAMPLERS, RopeFamily, fit_friction, fit_friction_steady, resolve_fit_engine
 from exucable.fit.log import read_pull_log
 from exucable.io import AtomicBatch, write_csv, write_json
 from exucable.plan.pull import load_plan_scenario
@@ -42,6 +42,10 @@ def add_arguments(p) -> None:
                    help="readings this many robust standard deviations off their running median are spikes (default 6)")
     p.add_argument("--direction", choices=("forward", "reverse"), default=None,
                    help="the pull's direction along the route (default: the scenario's pull.direction)")
+    p.add_argument("--engine", choices=FIT_ENGINES, default="auto",
+                   help="the pull-in history fitted: rope (instant; auto's choice) or steady (the multibody model's, "
+                        "a few histories of one steady solve per head position, seconds to minutes; the friction the "
+                        "multibody plan needs; not with --separate or several cables)")
     p.add_argument("--mu-max", type=float, default=1.0, help="largest friction coefficient looked at (default 1)")
     p.add_argument("--bootstrap", type=int, default=999, help="bootstrap resamples for the interval (default 999)")
     p.add_argument("--interval", choices=tuple(RESAMPLERS), default="block",
@@ -125,6 +129,12 @@ def _print_fit(fit, units: str) -> None:
         verdict = "explains the log" if one["explains"] else "does NOT explain the log"
         print(f"one coefficient {verdict}: halves (split at {_q(one['split_pulled_length_m'], 'length', units)}) "
               f"{one['first_half_friction']:.4f} and {one['second_half_friction']:.4f}, p = {one['p_value']:.3g}")
+    st = fit.steady
+    if st is not None and st.get("rope_friction") is not None:
+        a, b = st["rope_friction_interval"]
+        print(f"multibody histories at friction {', '.join(f'{m:.4g}' for m in st['mu_nodes'])} "
+              f"({st['history_points']} head positions each, {st['history_cpu_time_s']:.3g} s CPU); the rope fit "
+              f"of the same log: {st['rope_friction']:.4f} [{a:.4f}, {b:.4f}]")
     sb = fit.straights_and_bends
     if sb is not None:
         if "friction_straights_interval" in sb:
@@ -167,14 +177,29 @@ def main(args) -> int:
         direction = args.direction
     else:
         direction = scenario.pull.direction
+    engine, rule = resolve_fit_engine(args.engine, spec.count)
+    if engine == "steady" and args.separate:
+        raise LogError("--separate", "fits straights and bends apart on the rope only; use --engine rope with it")
     family = RopeFamily(scenario, spec, direction, args.mu_max)
     read_kwargs = _read_kwargs(args)
     out = Path(args.out) if args.out else Path(f"fit_{Path(args.log).stem}")
     title = f"{scenario.name} / {Path(args.log).name}"
+    print(f"engine: {engine} ({rule})", flush=True)
+    steady = {}
 
     def fit_once(log):
-        return fit_friction(scenario, log, family=family, bootstrap=args.bootstrap, seed=args.seed,
-                            method=args.interval, separate=args.separate)
+        kwargs = dict(bootstrap=args.bootstrap, seed=args.seed, method=args.interval)
+        if engine == "rope":
+            return fit_friction(scenario, log, family=family, separate=args.separate, **kwargs)
+        if "family" not in steady:
+            # the multibody histories are solved once, around the first log's rope fit, and reused
+            print("solving the multibody pull-in histories (one steady solve per head position)...", flush=True)
+            fit, steady["family"] = fit_friction_steady(scenario, log, rope_family=family, **kwargs)
+            steady["info"] = fit.steady
+            return fit
+        fit = fit_friction(scenario, log, family=steady["family"], **kwargs)
+        fit.steady = dict(steady["info"], rope_friction=None, rope_friction_interval=None)
+        return fit
 
     if not args.watch:
         log = read_pull_log(args.log, **read_kwargs)

@@ -87,7 +87,9 @@ def write_plan(out_dir, plan: dict, scenario, units: str, meta: dict | None = No
         written.append(path)
         if "pull_in" in d:
             path = out / f"pull_in_{name}.csv"
-            write_csv(path, ("pulled_length_m", "pull_force_N"), d["pull_in"])
+            columns = ("pulled_length_m", "pull_force_N") + (("rope_pull_force_N",) if "rope_pull_force_N" in d["pull_in"]
+                                                             else ())
+            write_csv(path, columns, d["pull_in"])
             written.append(path)
     rows = [dict(c, direction=n) for n in ("forward", "reverse") for c in plan["directions"][n]["checks"]]
     atomic_write_text(out / "checks.csv", _text_csv(CHECK_COLUMNS, rows))

@@ -35,7 +35,7 @@ from exucable.plan.pull import PlanSpec, plan_spec, pull_in_rope
 from exucable.quasistatic import engineering as eng
 from exucable.scenario.specs import Scenario
 
-__all__ = ["FrictionFit", "RopeFamily", "fit_friction", "SEPARABLE_CORRELATION", "SEPARABLE_HALF_WIDTH", "block_length", "GRID_STEP", "FINE_BELOW", "ONE_COEFFICIENT_P", "CONFIDENCE"]
+__all__ = ["FrictionFit", "RopeFamily", "SteadyFamily", "fit_friction_steady", "FIT_ENGINES", "resolve_fit_engine", "STEADY_NODE_FACTORS", "fit_friction", "SEPARABLE_CORRELATION", "SEPARABLE_HALF_WIDTH", "block_length", "GRID_STEP", "FINE_BELOW", "ONE_COEFFICIENT_P", "CONFIDENCE"]
 
 #: Step of the μ grid on which the rope is solved [-], a fifth of it below :data:`FINE_BELOW`; between, a
 #: cubic spline in μ (error of the interpolated history against a direct solve: tests/test_fit.py).
@@ -182,9 +182,113 @@ class RopeFamily:
         self.sidewall_pressure_factor = eng.sidewall_pressure_factor(
             spec.count, arrangement, eng.weight_correction_factor(spec.count, arrangement, D, d))
 
+    engine = "rope"
+
     def histories(self, x_m: np.ndarray) -> np.ndarray:
         """Head tension [N] at head positions ``x_m`` [m] (clipped to the route), one row per grid μ."""
         return np.asarray([r.tension_at(np.clip(x_m, 0.0, r.cable_length_m)) for r in self.ropes])
+
+    def max_tensions_N(self) -> list:
+        """The largest tension of the pull [N] at each grid μ."""
+        return [r.max_tension_N for r in self.ropes]
+
+
+class SteadyFamily(RopeFamily):
+    """The multibody model's pull-in histories on the μ grid, from a few steady histories.
+
+    The multibody history (:func:`exucable.solve.pull_in.steady_pull_in`) costs seconds to minutes per μ,
+    the rope's milliseconds. Their ratio T_mb(x; μ) / T_rope(x; μ) is smooth in μ and x (both grow by the
+    same capstan exponentials; the ratio carries what the rope misses: the stiffness at bends, free spans),
+    so the multibody history is solved at a few μ (``mu_nodes``) and its ratio to the rope interpolated:
+    in x linearly between the history's head positions (which include every piece end), in μ by the
+    polynomial through the nodes (quadratic for three), held at the end nodes' values outside them.
+    Then T(x; μ_k) = T_rope(x; μ_k) · ratio(x; μ_k) on the rope family's grid, and the fit proceeds as
+    with the rope (:func:`fit_friction`). How well the interpolation in μ holds:
+    ``tests/test_fit_steady.py`` (against a history solved directly between the nodes).
+
+    Parameters
+    ----------
+    scenario, spec, direction, mu_max
+        As :class:`RopeFamily`; one cable (``cable.count = 1``).
+    mu_nodes : sequence of float
+        The μ [-] at which the multibody history is solved (one to four; the fit should fall between
+        the outer ones: :attr:`mu_span`).
+    points : int
+        Uniform head positions of each history (:func:`exucable.solve.pull_in.pull_in_grid_m`).
+    solved : dict, optional
+        Histories solved before, by μ (:attr:`solved`), not solved again.
+    """
+
+    engine = "steady"
+
+    def __init__(self, scenario: Scenario, spec: PlanSpec | None = None, direction: str | None = None,
+                 mu_max: float = 1.0, *, mu_nodes, points: int | None = None, solved: dict | None = None):
+        from exucable.solve.pull_in import DEFAULT_POINTS, steady_pull_in  # builds Exudyn models
+
+        super().__init__(scenario, spec, direction, mu_max)
+        if self.spec.count != 1:
+            raise ScenarioError("cable.count", f"--engine steady simulates one cable, got {self.spec.count}; fit "
+                                               "several cables per duct with --engine rope")
+        mu = np.unique(np.asarray(mu_nodes, dtype=float))
+        if not (1 <= mu.size <= 4) or mu[0] <= 0.0 or mu[-1] > self.mu_max:
+            raise LogError("--engine", f"the multibody histories need 1 to 4 friction values in (0, {self.mu_max}], "
+                                       f"got {list(mu)}")
+        self.steady_mu = mu
+        self.steady = []
+        self._ratio = []
+        for m in mu:
+            h = (solved or {}).get(float(m))
+            if h is None:
+                sc = scenario.replace(**{"contact.friction": float(m), "pull.direction": self.direction})
+                h = steady_pull_in(sc, DEFAULT_POINTS if points is None else points)
+            ok = np.isfinite(h.pull_force_N)
+            if np.count_nonzero(ok) < 2:
+                raise LogError("--engine", f"the multibody pull-in history at friction {m:.4g} failed: "
+                                           f"{h.messages[-1]}; fit with --engine rope")
+            rope = pull_in_rope(scenario, self.spec, self.direction, friction=float(m))
+            x = h.pulled_length_m[ok]
+            T_rope = np.asarray(rope.tension_at(np.clip(x, 0.0, rope.cable_length_m)), dtype=float)
+            # where the rope carries nothing (no back tension, the head at the entrance) the two agree: 1
+            ratio = np.divide(h.pull_force_N[ok], T_rope, out=np.ones_like(T_rope), where=T_rope > 1e-9)
+            self.steady.append(h)
+            self._ratio.append((x, ratio))
+
+    @property
+    def solved(self) -> dict:
+        """The multibody histories by μ."""
+        return {float(m): h for m, h in zip(self.steady_mu, self.steady)}
+
+    @property
+    def mu_span(self) -> tuple[float, float]:
+        """The smallest and largest μ [-] with a multibody history: between them the ratio is interpolated."""
+        return float(self.steady_mu[0]), float(self.steady_mu[-1])
+
+    @property
+    def cpu_time_s(self) -> float:
+        """Process CPU time [s] of the multibody histories."""
+        return float(sum(h.cpu_time_s for h in self.steady))
+
+    def ratio(self, x_m: np.ndarray) -> np.ndarray:
+        """T_mb / T_rope [-] at head positions ``x_m`` [m], one row per grid μ."""
+        R = np.array([np.interp(x_m, x, r) for x, r in self._ratio])           # (J, n)
+        mu = np.clip(self.nodes, *self.mu_span)
+        # Lagrange basis of the nodes at every grid μ: (K, J)
+        nodes = self.steady_mu
+        w = np.ones((mu.size, nodes.size))
+        for j in range(nodes.size):
+            for m in range(nodes.size):
+                if m != j:
+                    w[:, j] *= (mu - nodes[m]) / (nodes[j] - nodes[m])
+        return w @ R
+
+    def histories(self, x_m: np.ndarray) -> np.ndarray:
+        x = np.clip(np.asarray(x_m, dtype=float), 0.0, self.route_length_m)
+        return super().histories(x) * self.ratio(x)
+
+    def max_tensions_N(self) -> list:
+        # the cable's largest tension is at its head: the history's largest value
+        x = np.linspace(0.0, self.route_length_m, 241)
+        return list(np.max(self.histories(x), axis=1))
 
 
 class _Histories:
@@ -249,6 +353,10 @@ class FrictionFit:
     log : dict
         The log's cleaning report (:attr:`exucable.fit.log.PullLog.report`) and rows beyond the route.
     warnings : list of str
+    steady : dict or None
+        With the multibody engine (:func:`fit_friction_steady`): the ``mu_nodes`` of its histories, the rope
+        fit of the same log (``rope_friction``, ``rope_friction_interval``), ``history_points`` and
+        ``history_cpu_time_s``.
     straights_and_bends : dict or None
         With ``separate``: ``friction_straights``, ``friction_bends`` with ``*_interval``, their
         ``correlation``, ``bends_minus_straights_interval``, ``separable`` (the log tells them apart: correlation
@@ -275,6 +383,7 @@ class FrictionFit:
     log: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     straights_and_bends: dict | None = None
+    steady: dict | None = None
 
     def to_json(self) -> dict:
         """The content of ``fit.json``."""
@@ -296,6 +405,8 @@ class FrictionFit:
         }
         if self.straights_and_bends is not None:
             out["straights_and_bends"] = self.straights_and_bends
+        if self.steady is not None:
+            out["steady"] = self.steady
         if self.partial:
             out["forecast_pull_force_N"] = self.expected["pull_force_N"]
             out["forecast_pull_force_interval_N"] = self.expected["pull_force_interval_N"]
@@ -414,6 +525,8 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
     if int(bootstrap) < 99:
         raise LogError("--bootstrap", f"needs at least 99 resamples for a 95 % interval, got {bootstrap}")
     family = family or RopeFamily(scenario, spec, direction, mu_max)
+    if separate and family.engine != "rope":
+        raise LogError("--separate", "fits straights and bends apart on the rope only; use --engine rope with it")
     spec, direction, mu_max, nodes = family.spec, family.direction, family.mu_max, family.nodes
     L = family.route_length_m
     if method not in RESAMPLERS:
@@ -434,7 +547,7 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
     partial = bool(not log.ended and x_last < L - max(1e-6 * L, 0.5 * (xr[1] - xr[0])))
     H, Hr = family.histories(x), family.histories(xr)
     f = family.sidewall_pressure_factor
-    tmax = [r.max_tension_N for r in family.ropes]
+    tmax = family.max_tensions_N()
     pmax = [r.max_sidewall_pressure_N_per_m * f for r in family.ropes]
     prof = [np.interp(xr, r.s_cable_m, r.sidewall_pressure_N_per_m * f) for r in family.ropes]
     model = _Histories(nodes, H)
@@ -484,6 +597,10 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
         warnings.append("too few rows in a half of the log to test whether one coefficient explains it")
     if lo <= 1e-12:
         warnings.append("the interval reaches μ = 0: the log cannot tell this friction from none")
+    span = getattr(family, "mu_span", None)
+    if span is not None and not (span[0] <= lo and hi <= span[1]):
+        warnings.append(f"the interval [{lo:.4g}, {hi:.4g}] reaches beyond the friction values with a multibody "
+                        f"history ({span[0]:.4g}-{span[1]:.4g}): there the model is extrapolated")
     separate_fit = None
     if separate:
         def r_series_of(model_values):
@@ -544,7 +661,72 @@ def fit_friction(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = No
 
     return FrictionFit(friction=mu_hat, friction_interval=(lo, hi), one_coefficient=one,
                        residual_std_N=float(np.std(resid)), resampling={"method": method, ("block_length_rows" if method == "block" else "ar_order"): b}, bootstrap_samples=int(bootstrap),
-                       engine="rope", direction=direction, partial=partial, pulled_length_m=x, pull_force_N=y,
+                       engine=family.engine, direction=direction, partial=partial, pulled_length_m=x, pull_force_N=y,
                        fitted_N=fitted, residual_N=resid, curve=curve, forecast=forecast, expected=expected,
                        log=dict(log.report, rows_outside_route=int(off_route.sum())), warnings=warnings,
                        straights_and_bends=separate_fit)
+
+
+#: The engines ``exucable fit`` fits against.
+FIT_ENGINES = ("auto", "rope", "steady")
+
+
+def resolve_fit_engine(engine: str, count: int = 1) -> tuple[str, str]:
+    """The engine ``"auto"`` stands for, and why: the rope. A fit is made on site and refitted at every
+    change of a growing log (``--watch``), where the rope's histories cost milliseconds and the multibody
+    ones seconds to minutes (three histories of one steady solve per head position); where the cable's
+    stiffness or free spans matter, the two fits differ (``studies/fit_engines.py``) and
+    ``--engine steady`` gives the friction the multibody model needs."""
+    if engine not in FIT_ENGINES:
+        raise LogError("--engine", f"must be one of {', '.join(FIT_ENGINES)}, got {engine!r}")
+    if engine == "steady" and count != 1:
+        raise ScenarioError("cable.count", f"--engine steady simulates one cable, got {count}; fit several cables "
+                                           "per duct with --engine rope")
+    if engine != "auto":
+        return engine, "given (--engine)"
+    return "rope", "auto: the rope, instant (--engine steady for the multibody model's history)"
+
+
+#: The multibody histories of :func:`fit_friction_steady` at these multiples of the rope's fitted μ [-].
+STEADY_NODE_FACTORS = (0.8, 1.0, 1.25)
+
+
+def fit_friction_steady(scenario: Scenario, log: PullLog, *, spec: PlanSpec | None = None,
+                        direction: str | None = None, mu_max: float = 1.0, rope_family: RopeFamily | None = None,
+                        points: int | None = None, **kwargs) -> tuple[FrictionFit, SteadyFamily]:
+    """Fit the friction coefficient against the multibody model's pull-in history.
+
+    The rope fit of the same log (:func:`fit_friction`) places the multibody histories: at
+    :data:`STEADY_NODE_FACTORS` times its μ (:class:`SteadyFamily`). Where the multibody fit's interval
+    reaches beyond those, a history is added at the interval's end (once each side), so that the fit's
+    interval lies between solved histories. ``kwargs``: as :func:`fit_friction` (not ``separate``).
+
+    Returns
+    -------
+    (FrictionFit, SteadyFamily)
+        The fit (``engine = "steady"``; ``rope_friction`` and ``rope_friction_interval`` in its
+        :attr:`FrictionFit.steady`) and the family, to refit a growing log (``--watch``) without solving again.
+    """
+    rope_family = rope_family or RopeFamily(scenario, spec, direction, mu_max)
+    rope = fit_friction(scenario, log, family=rope_family, **kwargs)
+    mu_max = rope_family.mu_max
+    nodes = sorted({min(mu_max, max(1e-3, f * rope.friction)) for f in STEADY_NODE_FACTORS})
+    family = SteadyFamily(scenario, rope_family.spec, rope_family.direction, mu_max, mu_nodes=nodes, points=points)
+    fit = fit_friction(scenario, log, family=family, **kwargs)
+    lo, hi = fit.friction_interval
+    extra = []
+    if lo < family.mu_span[0]:
+        extra.append(max(1e-3, lo - 0.05 * (hi - lo)))
+    if hi > family.mu_span[1]:
+        extra.append(min(mu_max, hi + 0.05 * (hi - lo)))
+    if extra:
+        # at most four histories (a cubic in μ): the new ends, and of the others those nearest the fit
+        kept = sorted(nodes, key=lambda m: abs(m - fit.friction))[:4 - len(extra)]
+        family = SteadyFamily(scenario, rope_family.spec, rope_family.direction, mu_max,
+                              mu_nodes=sorted(set(kept) | set(extra)), points=points, solved=family.solved)
+        fit = fit_friction(scenario, log, family=family, **kwargs)
+    fit.steady = {"mu_nodes": [float(m) for m in family.steady_mu], "rope_friction": rope.friction,
+                  "rope_friction_interval": list(rope.friction_interval),
+                  "history_points": int(family.steady[0].pulled_length_m.size),
+                  "history_cpu_time_s": family.cpu_time_s}
+    return fit, family

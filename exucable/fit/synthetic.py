@@ -1,4 +1,5 @@
-"""Synthetic tension logs from the rope with a known friction coefficient, with a recorder's faults.
+"""Synthetic tension logs from the rope (or a given history) with a known friction coefficient, with a
+recorder's faults.
 
 For checking the fit (``tests/test_fit.py``) and an installation's own logging chain: the head tension
 T(x; μ) of the pull-in history, sampled once per ``sample_interval_s`` at the pull speed, plus white noise,
@@ -23,7 +24,7 @@ def synthetic_log(scenario: Scenario, friction: float, *, seed: int = 0, speed_m
                   drift_N: float = 0.0, drift_time_s: float = 60.0, stops: int = 0, stop_s: float = 30.0,
                   spikes: int = 0, spike_N: float = 0.0, tare_N: float = 0.0, lead_in_s: float = 0.0,
                   friction_after: tuple[float, float] | None = None, bend_friction: float | None = None,
-                  spec: PlanSpec | None = None, direction: str | None = None) -> dict:
+                  spec: PlanSpec | None = None, direction: str | None = None, history=None) -> dict:
     """A synthetic log in SI: ``time_s``, ``pulled_length_m``, ``pull_force_N`` arrays.
 
     Parameters
@@ -54,6 +55,10 @@ def synthetic_log(scenario: Scenario, friction: float, *, seed: int = 0, speed_m
         (the friction changed in time: the log's slope steps there).
     spec : PlanSpec, optional
     direction : str, optional
+    history : (numpy.ndarray, numpy.ndarray), optional
+        Head positions [m] and head tensions [N] of another model's pull-in history at ``friction``
+        (the multibody one: :func:`exucable.solve.pull_in.steady_pull_in`), sampled linearly between
+        its points instead of the rope (not with ``friction_after`` or ``bend_friction``).
 
     Returns
     -------
@@ -68,6 +73,10 @@ def synthetic_log(scenario: Scenario, friction: float, *, seed: int = 0, speed_m
     end = L if until_m is None else min(float(until_m), L)
     x = np.arange(0.0, end + 1e-9, speed_m_per_s * sample_interval_s)
     T = np.asarray(rope.tension_at(x), dtype=float)
+    if history is not None:
+        if friction_after is not None or bend_friction is not None:
+            raise ValueError("history: not with friction_after or bend_friction (the rope's variations)")
+        T = np.interp(x, np.asarray(history[0], dtype=float), np.asarray(history[1], dtype=float))
     if friction_after is not None:
         x_c, mu2 = friction_after
         other = pull_in_rope(scenario, spec, direction, friction=mu2)

@@ -382,6 +382,20 @@ class Centreline:
             s += p.length_m
         return Centreline(pieces)
 
+    def truncated(self, length_m: float) -> "Centreline":
+        """The route's first ``length_m`` [m], ``0 < length_m <= L``: the pieces before it, and the
+        piece it ends in cut there (the same curve, a shorter arc)."""
+        x = float(length_m)
+        if not (0.0 < x <= self.length_m * (1.0 + _S_RTOL)):
+            raise ValueError(f"truncated: length must be in (0, {self.length_m:.9g}] m, got {length_m!r}")
+        if x >= self.length_m:
+            return self
+        k = self.piece_index(x)
+        pieces = list(self.pieces[:k])
+        if x > self.pieces[k].s_start_m:
+            pieces.append(replace(self.pieces[k], length_m=x - self.pieces[k].s_start_m))
+        return Centreline(pieces)
+
     def curved_ranges_m(self) -> list[tuple[float, float]]:
         """Arc-length intervals (start, end) [m] of the bends and helices, in order."""
         return [(p.s_start_m, p.s_end_m) for p in self.pieces if p.is_curved]

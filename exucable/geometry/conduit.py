@@ -128,6 +128,23 @@ class Conduit:
             "bends": sum(1 for p in c.pieces if p.is_curved),
         }
 
+    def truncated(self, length_m: float) -> "Conduit":
+        """The conduit's first ``length_m`` [m] (the cable's pull-in, head at ``length_m``): the same
+        segments up to there, the last one ending on the centreline at ``length_m``, so that the
+        wall the cable meets before its head is the whole conduit's."""
+        c = self.centreline.truncated(length_m)
+        if c is self.centreline:
+            return self
+        seg = self.segments
+        x = c.length_m
+        keep = int(np.searchsorted(seg.s_vertex_m, x, side="left"))       # vertices with s < x
+        # a vertex within a hair of x would leave a zero-length last segment: drop it
+        if keep > 1 and x - seg.s_vertex_m[keep - 1] <= 1e-9 * x:
+            keep -= 1
+        vertices = np.vstack([seg.vertices_m[:keep], c.point(x)[None, :]])
+        s = np.concatenate([seg.s_vertex_m[:keep], [x]])
+        return Conduit(self.inner_radius_m, c, Segments(vertices, s, seg.inner_radius_m))
+
     def reversed(self) -> "Conduit":
         """The same conduit entered from its other end (for pulling in the opposite direction).
 

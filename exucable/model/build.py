@@ -555,7 +555,8 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
 
 
 def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
-                check_points_per_element: int | None = None, start: InitialLayout | None = None) -> Model:
+                check_points_per_element: int | None = None, start: InitialLayout | None = None,
+                references: InitialLayout | None = None) -> Model:
     """Build and assemble the Exudyn system of ``scenario`` in a SystemContainer of its own.
 
     A thin wrapper of :func:`add_cable_in_conduit` with the scenario's rig and loads. The mesh is
@@ -563,9 +564,12 @@ def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
     scenario's override, with the element length divided by ``refine`` and the check points per
     element overridden by ``check_points_per_element`` (``exucable converge``). ``start`` replaces
     the start state (:func:`exucable.solve.start.steady_start`: the steady solve's state).
+    ``references``: another model's start of the same scenario, whose rope solutions are reused
+    (see :func:`exucable.model.layout.initial_layout`).
     """
     if start is None:
-        start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element)
+        start = initial_layout(scenario, with_contact, refine=refine, check_points_per_element=check_points_per_element,
+                               references=references)
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
     h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start)

@@ -1,8 +1,9 @@
 """Several cables pulled together through one conduit (``cable.count`` 2-4), in steady sliding.
 
 One ANCF cable per conductor, each with the scenario's cable data, laid along the conduit in the
-arrangement's cross-section (:func:`arrangement_offsets`) and pre-tensioned to the rope solution of
-one cable carrying its share. Each cable has its own wall contact (the cable-conduit kernel in its
+arrangement's cross-section (:func:`arrangement_offsets`) turned, station by station, toward the
+lateral load on a cable (:func:`load_turn_rad`: in a bend the tension presses the bundle onto the
+bend's inner wall), and pre-tensioned to the rope solution of one cable carrying its share. Each cable has its own wall contact (the cable-conduit kernel in its
 steady-sliding form) and one more coupling carries the contact between the cables
 (:class:`~exucable.contact.cable_pairs.CableContactKernel`).
 
@@ -37,9 +38,13 @@ from .generic import add_user_force_object
 from .layout import CableLayout, lay_cable, plan_cable_mesh, steady_lead_out_m
 from .rig import Drive, add_drive, add_end_force
 
-__all__ = ["BundleModel", "arrangement_offsets", "build_bundle_model", "check_bundle_supported", "bundle_arrangement",
-           "bundle_report", "bundle_tension_profile", "straight_weight_correction", "bundle_sections",
-           "bundle_cross_sections", "bundle_tension_along_conduit"]
+__all__ = ["BundleModel", "arrangement_offsets", "load_turn_rad", "build_bundle_model", "check_bundle_supported",
+           "bundle_arrangement", "bundle_report", "bundle_tension_profile", "straight_weight_correction",
+           "bundle_sections", "bundle_cross_sections", "bundle_tension_along_conduit"]
+
+
+#: Gap left at the start between the cables and to the wall, in cable radii [-] (see build_bundle_model).
+START_GAP = 0.05
 
 
 def bundle_arrangement(scenario) -> str:
@@ -133,6 +138,39 @@ def _cross_section_frame(centreline, s_m):
     up /= norm[:, None]
     horizontal = np.cross(t, up)
     return horizontal, up
+
+
+def load_turn_rad(centreline, s_m, tension_N, weight_per_length_N_per_m: float, blend_length_m: float) -> np.ndarray:
+    """Angle φ(s) [rad] by which the arrangement is turned in the cross-section at arc lengths ``s_m``
+    (a uniform grid) so that its "down" points along one cable's lateral load per length
+    p = T κ n - w (e_z - (e_z·t) t) (the rope equation's sidewall load, as for one cable's start):
+    φ = 0 under gravity alone, ±π/2 in a horizontal bend without gravity, measured from "down"
+    toward the horizontal axis of :func:`_cross_section_frame`.
+
+    Unloaded stations take their loaded neighbours' angle (interpolated; 0 where nothing is
+    loaded); the angle is unwrapped along s and smoothed with a Gaussian of width
+    ``blend_length_m``, so the bundle rolls round the duct into a bend rather than jumping.
+    """
+    s = np.asarray(s_m, dtype=float)
+    t = np.atleast_2d(centreline.tangent(s))
+    kn = np.atleast_2d(centreline.curvature_vector(s))
+    ez = np.array([0.0, 0.0, 1.0])
+    load = np.asarray(tension_N, dtype=float)[:, None] * kn - weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
+    eh, ev = _cross_section_frame(centreline, s)
+    ph, pv = np.einsum("ij,ij->i", load, eh), np.einsum("ij,ij->i", load, ev)
+    size = np.hypot(ph, pv)
+    loaded = size > 1e-9 * max(float(size.max()), 1e-300)
+    if not loaded.any():
+        return np.zeros_like(s)
+    phi = np.unwrap(np.arctan2(ph[loaded], -pv[loaded]))
+    phi = np.interp(s, s[loaded], phi)
+    ds = s[1] - s[0] if len(s) > 1 else 1.0
+    sigma = blend_length_m / ds
+    if sigma > 0.5:
+        half = int(np.ceil(4 * sigma))
+        k = np.exp(-0.5 * (np.arange(-half, half + 1) / sigma) ** 2)
+        phi = np.convolve(np.pad(phi, half, mode="edge"), k / k.sum(), mode="valid")
+    return phi
 
 
 @dataclass
@@ -399,11 +437,33 @@ def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
     def tension_fn(s):
         return np.interp(s, rope.s_conduit_m, rope.tension_N)
 
+    # the arrangement turned, station by station, to the lateral load the share rope puts on a cable
+    # (its rigid-circle rest under that load): in a bend the tension presses the bundle to the
+    # bend's inner wall, and a start left resting on the bottom there is far from any equilibrium
+    s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * n_el + 1))
+    # Rolled over a few elements (a faster roll the cubic elements cannot follow: measured 1 mm into
+    # the wall and 2 mm into each other at 1 m elements and a 0.5 m roll)
+    T_ref = max(float(np.max(rope.tension_N)), 1e-6)
+    blend = max(L_cable / n_el, math.sqrt(c.bending_stiffness_N_m2 / T_ref))
+    turn = load_turn_rad(centre, s_grid, np.interp(s_grid, rope.s_conduit_m, rope.tension_N), w, blend)
+    # laid as circles START_GAP·r larger: the cables start that far off the wall and apart, so what
+    # the fit and the roll leave over is a gap the first steps close, not an overlap they must undo
+    try:
+        laid = arrangement_offsets(n, arrangement, sc.conduit.inner_radius_m, (1.0 + START_GAP) * c.radius_m)
+    except ModelError:
+        laid = offsets
+
+    # ...except in the last element before the exit and beyond: the eye holds the leading ends where
+    # they are laid, and there they are the rigid circles (a gap held open at the eye is not the pull's)
+    L_e = L_cable / n_el
     layouts = []
-    for h, v in offsets:
-        def offset_fn(s, h=h, v=v):
+    for (h0, v0), (h1, v1) in zip(offsets, laid):
+        def offset_fn(s, h0=h0, v0=v0, h1=h1, v1=v1):
             eh, ev = _cross_section_frame(centre, s)
-            return h * eh + v * ev
+            f = np.clip((centre.length_m - np.asarray(s, dtype=float)) / L_e, 0.0, 1.0)[:, None]
+            h, v = h0 + f * (h1 - h0), v0 + f * (v1 - v0)
+            phi = np.interp(s, s_grid, turn)[:, None]
+            return (h * np.cos(phi) - v * np.sin(phi)) * eh + (h * np.sin(phi) + v * np.cos(phi)) * ev
         layouts.append(lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, tension_fn,
                                  offset_fn, lead_out_m=lead_out))
     Le = layouts[0].element_length_m

@@ -431,6 +431,8 @@ def steady_lead_out_m(centreline, bending_stiffness_N_m2: float, exit_tension_N:
     """
     if bending_stiffness_N_m2 <= 0.0 or exit_tension_N <= 0.0:
         return 0.0
+    if not any(piece.is_curved for piece in centreline.pieces):
+        return 0.0      # no bend, no boundary layer to leave (a straight route, or a pull-in's first metres)
     straight = 0.0
     for piece in reversed(centreline.pieces):
         if piece.is_curved:
@@ -472,7 +474,8 @@ def plan_cable_mesh(scenario, conduit, rope, refine: float = 1.0, check_points_p
 
 
 def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
-                   check_points_per_element: int | None = None) -> InitialLayout:
+                   check_points_per_element: int | None = None,
+                   references: InitialLayout | None = None) -> InitialLayout:
     """The start state of ``scenario``'s cable, without Exudyn.
 
     Pre-stretched to the rope solution's tension, on its bearing wall, sliding at the pull speed
@@ -488,6 +491,10 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         Divides the mesh rule's element length (``exucable converge``).
     check_points_per_element : int, optional
         Overrides ``contact.check_points_per_element``.
+    references : InitialLayout, optional
+        A layout of the same scenario with the same ``with_contact`` (another mesh): its rope, rope
+        with clearance and lead-out are taken instead of solved again. They depend on the scenario
+        alone, not on the mesh, and on a long route they cost more than the rest of the build.
 
     Returns
     -------
@@ -519,8 +526,8 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
             raise ModelError(key, exc.message) from None
 
     full = None          # the rope of the whole cable inside, where the lead-out rule needed it
-    lead_out = 0.0
-    if sc.solver.pretension and (sc.solver.mode == "steady" or (sc.solver.start_from == "steady" and sc.pull.force_N is None)):
+    lead_out = 0.0 if references is None else references.lead_out_m
+    if references is None and sc.solver.pretension and (sc.solver.mode == "steady" or (sc.solver.start_from == "steady" and sc.pull.force_N is None)):
         if sc.solver.steady_lead_out_m is not None:
             lead_out = float(sc.solver.steady_lead_out_m)
         else:
@@ -537,7 +544,10 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
             raise ModelError("solver.steady_lead_out", f"{lead_out:.4g} m laid out past the exit leaves none of the "
                              f"{L_cable:.4g} m cable in the conduit; give less than the cable's length")
     # the reference of the cable as laid: less inside by the lead-out
-    rope = full if full is not None and lead_out == 0.0 else rope_for(L_cable - lead_out)
+    if references is not None:
+        rope = references.rope
+    else:
+        rope = full if full is not None and lead_out == 0.0 else rope_for(L_cable - lead_out)
     clearance = conduit.inner_radius_m - c.radius_m
     mesh = plan_cable_mesh(sc, conduit, rope, refine, check_points_per_element)
     n_el = mesh.elements
@@ -549,7 +559,12 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         # half an element so the nodes can follow it
         T_ref = max(float(np.max(rope.tension_N)), 1e-6)
         blend = max(0.5 * L_e, np.sqrt(c.bending_stiffness_N_m2 / T_ref))
-        free = _clearance_rope_start(sc, centre, w, clearance, L_cable - lead_out) if with_contact else None
+        if not with_contact:
+            free = None
+        elif references is not None:
+            free = references.rope_clearance
+        else:
+            free = _clearance_rope_start(sc, centre, w, clearance, L_cable - lead_out)
         path = {}
         if free is not None:
             # Start on the path of the rope with clearance: with gravity the cable leaves the wall in

@@ -249,7 +249,23 @@ def _pull_in_history(curve: Centreline, rope, n: int = 201) -> dict:
     L = curve.length_m
     grid = np.unique(np.concatenate([np.linspace(0.0, L, n), [p.s_end_m for p in curve.pieces]]))
     grid = np.clip(grid, 0.0, rope.cable_length_m)
-    return {"pulled_length_m": grid.tolist(), "pull_force_N": np.asarray(rope.tension_at(grid)).tolist()}
+    return {"engine": "rope", "pulled_length_m": grid.tolist(),
+            "pull_force_N": np.asarray(rope.tension_at(grid)).tolist()}
+
+
+def _steady_pull_in_history(scenario: Scenario, direction: str, rope) -> dict:
+    """The multibody pull-in history (:func:`exucable.solve.pull_in.steady_pull_in`: one steady solve per
+    head position, each from the last state), the rope's head tension at the same places beside
+    (``rope_pull_force_N``). Failed points are left out of the table and counted (``failed_points``)."""
+    from exucable.solve.pull_in import DEFAULT_POINTS, steady_pull_in  # builds Exudyn models
+
+    sc = dataclasses.replace(scenario, pull=dataclasses.replace(scenario.pull, direction=direction))
+    h = steady_pull_in(sc, DEFAULT_POINTS)
+    ok = np.isfinite(h.pull_force_N)
+    x = h.pulled_length_m[ok]
+    return {"engine": "steady", "pulled_length_m": x.tolist(), "pull_force_N": h.pull_force_N[ok].tolist(),
+            "rope_pull_force_N": np.asarray(rope.tension_at(np.clip(x, 0.0, rope.cable_length_m))).tolist(),
+            "failed_points": int(h.failed), "cpu_time_s": h.cpu_time_s}
 
 
 #: The rope solver's argument names (its errors' keys) → the scenario keys a plan gives them from.
@@ -630,6 +646,8 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
         entry["passed"] = all(c["passed"] for c in entry["checks"])
         if spec.feed_from_reel:
             entry["pull_in"] = _pull_in_history(curve, rope)
+            if engine == "steady":
+                entry["pull_in"] = _steady_pull_in_history(scenario, name, rope)
         directions[name] = entry
 
     ok = [n for n in directions if directions[n]["passed"]]

@@ -455,7 +455,15 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
                   ". Sections in pull order, numbered and named in route order.</p>",
                   f"<div id='sections-{name}'>" + _table(header, rows, left=(1, 3), table_id=f"sections-table-{name}")
                   + "</div>" + loads + "</div>"]
-    if "pull_in" in plan["directions"]["forward"]:
+    if plan["directions"]["forward"].get("pull_in", {}).get("engine") == "steady":
+        failed = sum(plan["directions"][n]["pull_in"]["failed_points"] for n in ("forward", "reverse"))
+        parts += ["<h2 id='pull-in'>Pull-in history</h2><p>Tension at the rig while the cable's head advances from "
+                  "the entrance (multibody model, pulling line taken frictionless): one steady state per head "
+                  "position, the cable filling the route up to its head, each solved from the last; the rope's "
+                  "tension at the same head positions beside"
+                  f"{'' if not failed else f'; {failed} head positions whose solve failed are left out'}. Tables: "
+                  "<code>pull_in_forward.csv</code>, <code>pull_in_reverse.csv</code>.</p>"]
+    elif "pull_in" in plan["directions"]["forward"]:
         # The quasi-static rope integrates from the tail: with the head at x the rig pulls T(x) of the full
         # pull, so the history is the tension curve above read as "force at the rig vs pulled length".
         parts += ["<h2 id='pull-in'>Pull-in history</h2><p>Tension at the rig while the cable's head advances from "

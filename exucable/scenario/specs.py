@@ -1063,6 +1063,40 @@ class Scenario:
             object.__setattr__(self, "_conduit", cached)
         return cached
 
+    def pulled_in(self, length_m: float, elements: int) -> "Scenario":
+        """The pull with the cable's head ``length_m`` [m] into the conduit: the conduit as the pull
+        meets it (reversed for ``pull.direction = "reverse"``) cut at the head
+        (:meth:`exucable.geometry.Conduit.truncated`), pulled forward, the cable filling it on
+        ``elements`` elements. A step of the multibody pull-in history (:mod:`exucable.solve.pull_in`): a
+        scenario to build a model from, not to write back (its ``[conduit]`` table still names the whole route).
+
+        Raises
+        ------
+        ScenarioError
+            ``cable.length`` shorter than the route (the pull-in's cable is the length pulled in), or ``length_m``
+            outside the route.
+        """
+        conduit = self.build_conduit()
+        if self.cable.length_m is not None and self.cable.length_m < conduit.centreline.length_m * (1.0 - 1e-9):
+            raise ScenarioError("cable.length", "a pull-in history fills the conduit up to the head; leave "
+                                                "cable.length out (the route's length)")
+        if self.pull.direction == "reverse":
+            conduit = conduit.reversed()
+        L = conduit.centreline.length_m
+        if not (0.0 < float(length_m) <= L * (1.0 + 1e-9)):
+            raise ScenarioError("pull_in", f"the head's pulled length must be in (0, {L:.6g}] m, got {length_m!r}")
+        out = copy.copy(self)
+        cable = copy.copy(self.cable)
+        object.__setattr__(cable, "elements", int(elements))
+        object.__setattr__(cable, "element_length_m", None)
+        object.__setattr__(cable, "length_m", None)
+        object.__setattr__(cable, "_derived", frozenset())
+        object.__setattr__(out, "cable", cable)
+        object.__setattr__(out, "pull", dataclasses.replace(self.pull, direction="forward"))
+        # the built conduit is this scenario's own cut: build_conduit() returns it (its cache)
+        object.__setattr__(out, "_conduit", conduit.truncated(min(float(length_m), L)))
+        return out
+
     @property
     def cable_length_m(self) -> float:
         """Cable length [m]: ``cable.length`` or the conduit's centreline length."""

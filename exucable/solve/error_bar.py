@@ -111,14 +111,16 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
 
     t0 = time.perf_counter()
     T_max = model.rope.max_tension_N if getattr(model, "rope", None) is not None else abs(value_N)
-    stop = SteadySettings().steady_residual   # the coarse solve's (the default) stop residual [-]
+    settings = SteadySettings.from_solver(scenario.solver)   # the solved model's stop rule, so both stop alike
+    stop = settings.steady_residual   # the coarse solve's stop residual [-]
     solve_N = stop * T_max
     n = model.mesh.elements
     k = model.mesh.check_points_per_element
     head = f"second steady solve on a mesh {COARSE_RATIO:g}x coarser"
     if coarse is None:
         try:
-            coarse = build_model(scenario, refine=refine / COARSE_RATIO, check_points_per_element=k)
+            coarse = build_model(scenario, refine=refine / COARSE_RATIO, check_points_per_element=k,
+                                 references=getattr(model, "start", None))
         except ModelError as exc:
             return SteadyErrorBar(None, None, solve_N, None, None, f"{head} not possible: {exc}",
                                   time.perf_counter() - t0)
@@ -126,7 +128,7 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
     if m >= n:
         return SteadyErrorBar(None, None, solve_N, None, m, f"{head} not possible: {n} elements cannot be coarsened",
                               time.perf_counter() - t0)
-    out = solve_steady(coarse)
+    out = solve_steady(coarse, settings=settings)
     if out.status == "failed":
         return SteadyErrorBar(None, None, solve_N, None, m, f"{head} failed ({out.message})", time.perf_counter() - t0)
     pull, trail, _ = steady_forces(coarse)
