@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
 from pathlib import Path
@@ -15,6 +16,7 @@ import numpy as np
 from .errors import ModelError
 from .output.versions import versions
 from .output.export import conduit_s
+from .output.figure_process import Figures
 from .output.outdir import owned_out_dir
 from .output.results import RunResult, write_results
 from .output.summary import RunSummary
@@ -185,9 +187,10 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     _refuse_snapshot_times_in_steady_mode(sc)
     if out_dir is None:
         return solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
-    with owned_out_dir(out_dir) as out:
+    # the figures' helper process is forked before the solve, to import matplotlib beside it
+    with owned_out_dir(out_dir) as out, (Figures() if plots else contextlib.nullcontext(False)) as figures:
         result = solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
-        write_results(out, result, plots=plots)
+        write_results(out, result, plots=figures)
     return result
 
 

@@ -22,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = {
     "benchmarks/bundle_route.py": "ratio bundle / one cable",
     "benchmarks/contact_kernel.py": "ms/eval",
+    "benchmarks/figure_cost.py": "| mode | figures | wall, median [s]",
     "benchmarks/fixed_cost.py": "| command | wall, median [s]",
     "benchmarks/industry_suite.py": "pull force [N]",
     "benchmarks/long_routes.py": "everything but the solve",
@@ -33,6 +34,7 @@ SCRIPTS = {
     "benchmarks/steady_iterations.py": "exact steps",
     "benchmarks/steady_scale.py": "ms/element",
     "benchmarks/sweep_scaling.py": "cases/min",
+    "benchmarks/sweep_throughput.py": "cases/min/core",
     "studies/beam_conduit_study.py": "| case | EJ [N m²] | model: stiff vs its EJ → 0 limit",
     "studies/bending_stiffness_study.py": "| case | gravity | c [mm] | EJ [N m²] | √(EJ/T_in)/R",
     "studies/contact_flips.py": "| t [s] | touching | contact in/out",
@@ -52,6 +54,7 @@ SCRIPTS = {
 # the slowest smoke runs, 10-35 s each on the shared 2-core machine (several processes each importing
 # Exudyn and numba, or an industry route of hundreds of elements): run with -m slow
 SLOW = {"benchmarks/naive_baseline.py", "benchmarks/run_examples.py", "benchmarks/sweep_scaling.py",
+        "benchmarks/sweep_throughput.py",
         "benchmarks/industry_suite.py", "studies/industry_dynamic.py",
         # minutes even in their smoke runs: two cables through four bends; multibody steady runs both ways
         "benchmarks/bundle_route.py", "studies/fit_engines.py"}

@@ -2,7 +2,8 @@
 
 Every file is written atomically (a temporary file in the same directory, then ``os.replace``),
 so a crash or a kill never leaves a half-written file, and ``summary.json`` is written after the
-data files: its presence marks complete results. The figures (optional) follow it.
+data files: its presence marks complete results. The figures (optional) are drawn while the data files
+are written (by a helper process, :mod:`exucable.output.figure_process`) or after them.
 
 Files
 -----
@@ -31,13 +32,12 @@ from pathlib import Path
 # The writers live in io.py (one atomic writer); re-exported here, where callers have found them.
 from ..errors import OutputError
 from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, csv_text, read_csv, write_csv, write_json
-from ..plots.bundle import plot_cross_sections
-from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
+from .figure_process import Figures, draw_figures
 from ..post.pressure import BEND_COLUMNS, PRESSURE_COLUMNS
 from .summary import RunSummary
 
 __all__ = ["RunResult", "atomic_write_text", "atomic_write_bytes", "write_csv", "read_csv", "write_results",
-           "read_summary", "result_file_names", "DATA_FILES", "FIGURE_FILES", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
+           "read_summary", "result_file_names", "draw_figures", "DATA_FILES", "FIGURE_FILES", "HISTORY_COLUMNS", "PROFILE_COLUMNS", "CONTACT_COLUMNS", "ROPE_COLUMNS"]
 
 HISTORY_COLUMNS = ("time_s", "pull_force_N", "trailing_tension_N", "max_tension_N", "max_penetration_m",
                    "max_axis_offset_m", "max_axis_offset_s_conduit_m")
@@ -82,17 +82,30 @@ def result_file_names() -> tuple[str, ...]:
     return (SUMMARY_FILE, *DATA_FILES, *SNAPSHOT_FILES, *FIGURE_FILES)
 
 
-def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
+def write_results(out_dir, result: RunResult, plots: bool | Figures = True) -> list[Path]:
     """Write ``result`` into ``out_dir`` (created if needed): the CSV files, then ``summary.json``,
-    then (unless ``plots`` is false) the figures. Returns the paths.
+    and (unless ``plots`` is false) the figures. Returns the paths.
+
+    ``plots`` may be a :class:`~exucable.output.figure_process.Figures` started before the solve: its
+    helper process then draws the figures while the data files are written here. True draws them
+    here, after the data files.
 
     The directory's ``summary.json`` vouches only for files of its own run: an earlier run's
     ``summary.json`` is removed first, then every result file of that run (:func:`result_file_names`;
-    other files are left alone), and the new one is written last, listing the data files under
-    ``files`` (name → bytes). A write that fails (a full disk) therefore leaves no summary, and the
-    error says so. Raises :class:`~exucable.errors.OutputError` on a failed write.
+    other files are left alone), and the new one is written last among the data files, listing them
+    under ``files`` (name → bytes). A write that fails (a full disk) therefore leaves no summary, and
+    the error says so. Raises :class:`~exucable.errors.OutputError` on a failed write.
     """
     out = Path(out_dir)
+    data_error = []
+    written = []
+
+    def write_data() -> None:
+        try:
+            written.extend(_write_data(out, result))
+        except OSError as exc:
+            data_error.append(exc)
+
     try:
         out.mkdir(parents=True, exist_ok=True)
         for name in result_file_names():
@@ -100,18 +113,24 @@ def write_results(out_dir, result: RunResult, plots: bool = True) -> list[Path]:
                 (out / name).unlink()
             except FileNotFoundError:
                 pass
-        written = _write_data(out, result)
     except OSError as exc:
-        raise OutputError(out, f"writing the results failed ({_reason(exc)}); no {SUMMARY_FILE} was left "
-                               "to vouch for an incomplete set: free space or choose another directory and "
+        data_error.append(exc)
+    figures = []
+    if plots and not data_error:
+        try:
+            figures = (plots if isinstance(plots, Figures) else Figures(helper=False)).write(
+                out, result, while_drawing=write_data)
+        except OSError as exc:
+            if not data_error:
+                raise OutputError(out, f"the results and {SUMMARY_FILE} are written, but a figure is not "
+                                       f"({_reason(exc)})") from None
+    elif not data_error:
+        write_data()
+    if data_error:
+        raise OutputError(out, f"writing the results failed ({_reason(data_error[0])}); no {SUMMARY_FILE} was "
+                               "left to vouch for an incomplete set: free space or choose another directory and "
                                "run again") from None
-    if not plots:
-        return written
-    try:
-        return written + _write_figures(out, result)
-    except OSError as exc:
-        raise OutputError(out, f"the results and {SUMMARY_FILE} are written, but a figure is not "
-                               f"({_reason(exc)})") from None
+    return written + figures
 
 
 def _reason(exc: OSError) -> str:
@@ -154,25 +173,6 @@ def _write_data(out: Path, result: RunResult) -> list[Path]:
         else:
             summary["files"] = dict(contents)
         written.append(write_json(out / SUMMARY_FILE, dict(result.summary), batch=batch))
-    return written
-
-
-def _write_figures(out: Path, result: RunResult) -> list[Path]:
-    """The figures, after the numbers: they cost about half a second of matplotlib, and a failure
-    to draw must not hold back (or lose) a result already computed."""
-    plot_pull_force(out / "pull_force.png", result)
-    written = [out / "pull_force.png"]
-    if result.tension_profile is not None:
-        plot_tension_profile(out / "tension_profile.png", result)
-        written.append(out / "tension_profile.png")
-    if result.pressure_profile is not None:
-        plot_pressure(out / "pressure.png", result)
-        written.append(out / "pressure.png")
-    if result.cross_sections:
-        x = result.cross_sections
-        plot_cross_sections(out / "cross_sections.png", x["panels"], x["inner_radius_m"], x["cable_radius_m"],
-                            title=result.summary.get("name", ""))
-        written.append(out / "cross_sections.png")
     return written
 
 

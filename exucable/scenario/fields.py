@@ -324,6 +324,10 @@ FIELDS: tuple[Field, ...] = (
            "every coordinate) is below this times the rope solution's largest tension; at 1e-6 Example 4's pulling "
            "force is 1e-9 from a 1000× tighter solve's (reference/README.md, \"Speed\"); a cross-check of the "
            "equilibrium itself wants it tighter"),
+    F("solver.steady_time_limit", "steady_time_limit_s", "float", "s", 60.0, gt=0.0, ours=True,
+      rule="> 0; steady mode: CPU seconds one static solve may take before it stops as failed, naming the load "
+           "scale and residual it reached, the strain at the head and what to change (CPU time, not wall: the same "
+           "on a loaded machine)", le=1.0e6, why="keeps the run's time finite"),
     F("solver.steady_lead_out", "steady_lead_out_m", "float", "m", None, ge=0.0, ours=True,
       default_doc="the rule in `solver.mode`",
       rule="≥ 0; steady mode and `solver.start_from = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "

@@ -655,6 +655,8 @@ class SolverSpec(_Spec):
     steady_lead_out_m : float or None
         Steady mode: cable laid out past the conduit's exit at the start [m] (None: the rule of
         :func:`exucable.model.layout.steady_lead_out_m`, 10 bending lengths past the last bend).
+    steady_time_limit_s : float
+        Steady mode: CPU time one static solve may take before it stops as failed [s].
     """
 
     _SECTION: ClassVar[str] = "solver"
@@ -676,6 +678,7 @@ class SolverSpec(_Spec):
     mode: str = _default("solver.mode")
     steady_lead_out_m: float | None = _default("solver.steady_lead_out")
     steady_residual: float = _default("solver.steady_residual")
+    steady_time_limit_s: float = _default("solver.steady_time_limit")
     start_from: str = _default("solver.start_from")
 
     @property

@@ -56,6 +56,7 @@ import exudyn as exu
 from ..errors import SolverError
 from .dynamic import History, Progress, SolveOutcome, quiet_sparse
 from ..post.tension import TensionStations, profile_stations_m
+from .steady_advice import TIME_LIMIT_KEY, failure_advice
 
 __all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
 
@@ -66,7 +67,8 @@ class SteadySettings:
 
     Frozen: a variant is ``dataclasses.replace(SteadySettings(), rate_fall=16.0)``, never a
     changed module constant, so that one solve's rules cannot leak into another's. Only
-    ``steady_residual`` is a scenario key (``[solver] steady_residual``, :meth:`from_solver`); the
+    ``steady_residual`` and ``time_limit_s`` are scenario keys (``[solver] steady_residual``,
+    ``steady_time_limit``; :meth:`from_solver`); the
     others are the solver's tuning, measured on the paper's examples and the industry scenarios
     (``benchmarks/steady_iterations.py --set NAME=VALUE`` compares a change across them).
 
@@ -131,6 +133,9 @@ class SteadySettings:
     min_continuation_step : float
         Smallest increment of the load scale λ [-] in the load continuation before the solve is
         declared failed.
+    time_limit_s : float
+        CPU time [s] the solve may take before it stops as failed (``[solver] steady_time_limit``).
+        CPU, not wall: a loaded machine must not turn a converging solve into a failed one.
     """
 
     steady_residual: float = 1e-6
@@ -148,6 +153,7 @@ class SteadySettings:
     max_one_iteration_steps: int = 80
     max_one_iteration_stall: int = 20
     min_continuation_step: float = 1.0 / 16.0
+    time_limit_s: float = 60.0
 
     def __post_init__(self):
         for f in fields(self):
@@ -162,8 +168,8 @@ class SteadySettings:
     @classmethod
     def from_solver(cls, solver) -> "SteadySettings":
         """The settings of a scenario's ``[solver]`` table (:class:`exucable.scenario.specs.SolverSpec`):
-        its ``steady_residual``, the defaults otherwise."""
-        return cls(steady_residual=float(solver.steady_residual))
+        its ``steady_residual`` and ``steady_time_limit_s``, the defaults otherwise."""
+        return cls(steady_residual=float(solver.steady_residual), time_limit_s=float(solver.steady_time_limit_s))
 
 
 def initial_spring_rate(model) -> float:
@@ -352,11 +358,6 @@ def _outside_points(model) -> int:
     return int(np.count_nonzero(model.kernel.point_segments(q.reshape(-1)) < 0))
 
 
-#: What to change when the steady solve stalls (scenario keys), appended to its message.
-STALL_FIX = ('fix: a coarser mesh (larger `cable.element_length`, or fewer `contact.check_points_per_element`) '
-             'or the dynamic run (`solver.mode = "dynamic"` with a `solver.end_time`)')
-
-
 class _FailedSteps:
     """The failed pseudo-time steps at one load scale, for the message of a solve that stalls there."""
 
@@ -440,6 +441,24 @@ class SteadySolver:
                                                       absolute_tolerance_N=1e-3 * self.tolerance_N)
         self._last_solver = None
         self._solved = False
+        self._cpu_start = time.process_time()
+        self.timed_out = False           # stopped at settings.time_limit_s
+        self._trace_lam, self._trace = 0.0, []   # the load scale of the last accepted steps, their residuals [N]
+
+    def out_of_time(self) -> bool:
+        """Whether the solve has used up its CPU time (:attr:`SteadySettings.time_limit_s`)."""
+        self.timed_out = self.timed_out or time.process_time() - self._cpu_start > self.settings.time_limit_s
+        return self.timed_out
+
+    def advice(self, lam: float) -> str:
+        """Where the solve got to and what to change (:func:`failure_advice`): the residual is the
+        smallest at the last load scale tried; it counts as still converging unless five accepted
+        steps there failed to halve it (fewer steps tell nothing yet)."""
+        r = self._trace
+        falling = len(r) < 6 or r[-1] <= 0.5 * r[-6]
+        return failure_advice(self.model, load_scale=lam, residual_N=min(r) if r else float("nan"),
+                              tolerance_N=self.tolerance_N, timed_out=self.timed_out, still_converging=falling,
+                              time_limit_s=self.settings.time_limit_s)
 
     def one_solve(self, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
         """One static solve with the exact, inexact or given settings: converged?, message, and
@@ -470,6 +489,9 @@ class SteadySolver:
     def record(self, lam: float, residual: float) -> None:
         """One history row (and the progress bar) for an accepted pseudo-time step."""
         self.accepted += 1
+        if lam != self._trace_lam:
+            self._trace_lam, self._trace = lam, []
+        self._trace.append(residual)
         pull, trail, tmax = steady_forces(self.model, self.stations)
         self.history.time_s.append(float(self.accepted))
         self.history.pull_force_N.append(pull)
@@ -504,6 +526,8 @@ class SteadySolver:
         previous, after_reject, message = np.inf, False, ""
         best, stalled = np.inf, 0
         for _ in range(s.max_one_iteration_steps):
+            if self.out_of_time():
+                return False, f"stopped at `{TIME_LIMIT_KEY}`"
             if stalled >= s.max_one_iteration_stall:
                 return False, (f"one-iteration pseudo-time steps: the residual did not halve in "
                                f"{s.max_one_iteration_stall} steps (smallest {best:.3g} N)")
@@ -542,6 +566,8 @@ class SteadySolver:
         stuck = _FailedSteps()
         exact = s.inexact_newton_tolerance <= s.newton_tolerance   # only the stopping step need be exact
         for _ in range(s.max_pseudo_steps_total):
+            if self.out_of_time():
+                return False, f"stopped at `{TIME_LIMIT_KEY}`"
             if stalled >= s.max_pseudo_steps:
                 return False, (f"no equilibrium at load scale {lam:.3g}: the residual did not halve in "
                                f"{s.max_pseudo_steps} pseudo-time steps (smallest {best:.3g} N, stop at "
@@ -582,6 +608,9 @@ class SteadySolver:
         failure: status ("ok" or "failed") and message."""
         self.store.saved = self.start
         lam, step, stages = 0.0, 0.5, 0
+        if self.timed_out:
+            return "failed", (f"no steady state found: stopped at `{TIME_LIMIT_KEY}` = {self.settings.time_limit_s:g} s "
+                              f"CPU (at full load: {first_message}); {self.advice(lam)}")
         while lam < 1.0:
             target = min(1.0, lam + step)
             before = self.store.saved
@@ -593,9 +622,9 @@ class SteadySolver:
             else:
                 self.store.saved = before
                 step *= 0.5
-                if step < self.settings.min_continuation_step:
+                if step < self.settings.min_continuation_step or self.timed_out:
                     return "failed", (f"no steady state found: continuation stalled at load scale {lam:.4g} "
-                                      f"(at full load: {first_message}; last: {msg}); {STALL_FIX}")
+                                      f"(at full load: {first_message}; last: {msg}); {self.advice(lam)}")
         return "ok", (f"continuation in the load scale, {stages} stages, {self.accepted} pseudo-time steps "
                       f"(at full load from the start: {first_message})")
 
@@ -615,7 +644,7 @@ class SteadySolver:
         status, message = "ok", ""
         outside_at_start = _outside_points(model)
         ok, first_message = self.relax_one_iteration(1.0)
-        if not ok:
+        if not ok and not self.timed_out:
             self.store.saved = self.start
             ok, first_message = self.relax(1.0)
         if ok:

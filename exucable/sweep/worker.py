@@ -79,12 +79,13 @@ def execute_case(task: dict, workdir, runner=None) -> dict:
     dict
         The record written to ``case.json``: ``case``, ``index``, ``params``, ``status``,
         ``message``, the outputs of :data:`~exucable.sweep.store.RECORD_OUTPUTS`, ``wall_time_s``
-        (the whole case, [s]), ``solver_wall_time_s`` [s], the scenario and where it ran.
+        (the whole case, [s]), ``cpu_time_s`` (this process's CPU time over the case, user + system
+        [s]), ``solver_wall_time_s`` [s], the scenario and where it ran.
     """
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     record = _base_record(task)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         with _PROCESS_LOCK:
             data = task.get("portable_scenario") or task["scenario"]
@@ -101,6 +102,7 @@ def execute_case(task: dict, workdir, runner=None) -> dict:
         record["message"] = f"{type(exc).__name__}: {exc}"
         atomic_write_text(workdir / "error.txt", traceback.format_exc())
     record["wall_time_s"] = time.perf_counter() - t0
+    record["cpu_time_s"] = time.process_time() - c0
     # what the case finished with, so a later run can tell a damaged case from a finished one
     record["files"] = {p.relative_to(workdir).as_posix(): p.stat().st_size for p in sorted(workdir.rglob("*"))
                        if p.is_file() and p.name != CASE_JSON and not p.name.startswith(".")}

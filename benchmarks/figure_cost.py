@@ -1,0 +1,117 @@
+"""What a run's figures cost: ``exucable run`` with and without them, and where their time goes.
+
+Part 1, whole processes: the fast Example 2 (``scenarios/fast/paper_ex2_bend90.toml``, dynamic mode,
+the short run of the issue) and, with ``--steady``, the same in steady mode, run as ``exucable run
+-q`` with ``--no-plots`` and with its figures, interleaved ``--repeat`` times after one warm-up run;
+medians of wall time and of CPU time (user + system of the process and its children, less disturbed
+by other jobs on a shared machine than wall time). The target is figures within +0.3 s of
+``--no-plots``.
+
+Part 2, in this process (skipped by ``--quick``): the parts of the figures' cost, in CPU seconds: the
+import of matplotlib's Figure and Agg canvas, then each figure drawn and written (first call, then
+the median of ``--repeat`` warm calls), from one solved result.
+
+    nice .venv/bin/python benchmarks/figure_cost.py               # ~1 min
+    nice .venv/bin/python benchmarks/figure_cost.py --repeat 9 --steady
+    nice .venv/bin/python benchmarks/figure_cost.py --quick       # one repeat, no breakdown
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIO = ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml"
+TARGET_S = 0.3
+
+
+def timed(cmd) -> tuple[float, float]:
+    """Whole-process wall time and CPU time (user + system, children included) [s] of ``cmd``."""
+    c0, t0 = os.times(), time.perf_counter()
+    out = subprocess.run(cmd, capture_output=True, text=True)
+    dt, c1 = time.perf_counter() - t0, os.times()
+    if out.returncode != 0:
+        raise RuntimeError(f"{' '.join(map(str, cmd))} exited {out.returncode}:\n{out.stderr[-2000:]}")
+    return dt, (c1.children_user - c0.children_user) + (c1.children_system - c0.children_system)
+
+
+def whole_process(repeat: int, modes: list[str]) -> None:
+    exe = Path(sys.executable).with_name("exucable")
+    with tempfile.TemporaryDirectory() as tmp:
+        cases = {}
+        for mode in modes:
+            base = [str(exe), "run", str(SCENARIO), "-q", "--mode", mode]
+            cases[(mode, "--no-plots")] = base + ["-o", f"{tmp}/{mode}-a", "--no-plots"]
+            cases[(mode, "figures")] = base + ["-o", f"{tmp}/{mode}-b"]
+        for cmd in cases.values() if repeat > 1 else ():   # warm the disk, numba's and matplotlib's font caches
+            timed(cmd)
+        load0 = os.getloadavg()[0]
+        times = {k: [] for k in cases}
+        for _ in range(repeat):
+            for k, cmd in cases.items():
+                times[k].append(timed(cmd))
+        print(f"# exucable run with and without figures: {SCENARIO.relative_to(ROOT)}, load average "
+              f"{load0:.1f} -> {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores, median of {repeat} interleaved runs\n")
+        print("| mode | figures | wall, median [s] | CPU, median [s] | figures' cost, wall / CPU [s] | all runs, wall [s] |")
+        print("|---|---|---|---|---|---|")
+        for mode in modes:
+            base_w = statistics.median(w for w, _ in times[(mode, "--no-plots")])
+            base_c = statistics.median(c for _, c in times[(mode, "--no-plots")])
+            for what in ("--no-plots", "figures"):
+                v = times[(mode, what)]
+                w, c = statistics.median(x for x, _ in v), statistics.median(x for _, x in v)
+                cost = "" if what == "--no-plots" else f"{w - base_w:+.2f} / {c - base_c:+.2f}"
+                print(f"| {mode} | {what} | {w:.2f} | {c:.2f} | {cost} | {', '.join(f'{x:.2f}' for x, _ in v)} |")
+        print(f"\ntarget: figures within +{TARGET_S} s of --no-plots")
+
+
+def breakdown(repeat: int) -> None:
+    """CPU seconds of matplotlib's import and of each figure, in this process."""
+    from exucable.run import run_scenario
+    result = run_scenario(SCENARIO, None, plots=False)
+    c0 = time.process_time()
+    import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
+    c_import = time.process_time() - c0
+    from exucable.plots import results as plots
+    figures = {"pull_force.png": plots.plot_pull_force, "tension_profile.png": plots.plot_tension_profile,
+               "pressure.png": plots.plot_pressure}
+    print("\n| part | CPU, first call [s] | CPU, warm median [s] |\n|---|---|---|")
+    print(f"| import matplotlib.figure + backend_agg | {c_import:.3f} | |")
+    with tempfile.TemporaryDirectory() as tmp:
+        total_first = total_warm = 0.0
+        for name, draw in figures.items():
+            cpu = []
+            for _ in range(repeat + 1):
+                c0 = time.process_time()
+                draw(Path(tmp) / name, result)
+                cpu.append(time.process_time() - c0)
+            warm = statistics.median(cpu[1:])
+            total_first, total_warm = total_first + cpu[0], total_warm + warm
+            print(f"| {name} | {cpu[0]:.3f} | {warm:.3f} |")
+        print(f"| all three figures | {total_first:.3f} | {total_warm:.3f} |")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5, help="interleaved rounds (default 5)")
+    ap.add_argument("--steady", action="store_true", help="also in steady mode")
+    ap.add_argument("--quick", action="store_true", help="smoke run: one round, no breakdown")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.repeat = 1
+    whole_process(args.repeat, ["dynamic", "steady"] if args.steady else ["dynamic"])
+    if not args.quick:
+        breakdown(args.repeat)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

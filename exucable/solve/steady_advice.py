@@ -1,0 +1,68 @@
+"""Why a steady solve that did not converge stopped, and what to change that would help.
+
+A steady solve that fails names where it got to (the load scale λ reached, the residual against its
+stop) and the strain the rope reference puts at the head (its largest tension over the cable's EA;
+above a few per cent, check the modulus), and advises by cause: a solve that ran out of time while
+still converging (or before anything converged) needs more time; one that stalled, a coarser mesh or
+the dynamic run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["head_strain", "failure_advice", "LARGE_STRAIN", "TIME_LIMIT_KEY"]
+
+#: Axial strain at the head [-] above which the message asks to check the modulus: cables are not
+#: pulled that hard in practice (manufacturers' pulling limits keep the conductors' strain well under 1 %).
+LARGE_STRAIN = 0.02
+
+#: The scenario key of the steady solve's time limit.
+TIME_LIMIT_KEY = "solver.steady_time_limit"
+
+_MESH_FIX = ('a coarser mesh (larger `cable.element_length`, or fewer `contact.check_points_per_element`) '
+             'or the dynamic run (`solver.mode = "dynamic"` with a `solver.end_time`)')
+
+
+def head_strain(model) -> tuple[float, float, float]:
+    """The rope reference's largest tension [N], the cable's axial stiffness EA [N] and their ratio,
+    the axial strain at the head [-] (NaN without a rope reference)."""
+    EA = float(model.scenario.cable.axial_stiffness_N)
+    if model.rope is None or EA <= 0.0:
+        return float("nan"), EA, float("nan")
+    T = float(np.max(np.abs(model.rope.tension_N)))
+    return T, EA, T / EA
+
+
+def failure_advice(model, *, load_scale: float, residual_N: float, tolerance_N: float, timed_out: bool,
+                   still_converging: bool, time_limit_s: float | None) -> str:
+    """The cause of a failed steady solve and what to change, in one sentence for its message.
+
+    Parameters
+    ----------
+    model : Model
+        The steady model (its scenario and rope reference).
+    load_scale : float
+        The load scale λ [-] of the last equilibrium reached (1: the full loads).
+    residual_N, tolerance_N : float
+        The smallest equilibrium residual reached at the next load scale and the stop [N].
+    timed_out : bool
+        Whether the solve stopped at its time limit (``time_limit_s`` CPU seconds).
+    still_converging : bool
+        Whether the residual was still falling when it stopped.
+    """
+    T, EA, strain = head_strain(model)
+    reached = (f"residual {residual_N:.3g} N" if np.isfinite(residual_N) else "no pseudo-time step accepted")
+    where = (f"load scale reached {load_scale:.3g} of 1, {reached} (stop at {tolerance_N:.3g} N), "
+             f"strain at the head {100 * strain:.3g} % (the rope's {T:.4g} N over EA {EA:.4g} N)")
+    if np.isfinite(strain) and strain > LARGE_STRAIN:
+        # reported, not blamed: soft cables at 4.7 % and 7.3 % strain at the head converge
+        # (a 1 km route with ten 30° bends, a 100 m one with two); a strain like this is more often
+        # a wrong modulus than a real pull
+        where += (f"; a strain above {100 * LARGE_STRAIN:g} % is beyond cables' pulling limits: check "
+                  "`cable.youngs_modulus`")
+    if timed_out and (still_converging or not np.isfinite(residual_N)):
+        why = "the residual was still falling" if still_converging else "nothing had converged yet"
+        return (f"{where}: {why} when the time limit of {time_limit_s:g} s CPU ran out; "
+                f"fix: a larger `{TIME_LIMIT_KEY}`, or {_MESH_FIX}")
+    return f"{where}; fix: {_MESH_FIX}"

@@ -1,0 +1,115 @@
+"""The figures' helper process (exucable.output.figure_process): the same files as drawn here, a
+fallback when it fails, and the rule for when it is used. Hand-made results: no solve."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from exucable.errors import OutputError
+from exucable.output.figure_process import Figures
+from exucable.output.results import FIGURE_FILES, RunResult, write_results
+
+ROOT = Path(__file__).resolve().parents[1]
+needs_fork = pytest.mark.skipif(not hasattr(os, "fork"), reason="the helper is forked")
+
+
+def _result() -> RunResult:
+    """A small result with every figure's data (the writer is under test, not the physics)."""
+    t = np.linspace(0.0, 0.4, 41)
+    x = np.linspace(0.0, 2.8, 81)
+    s = np.linspace(0.0, 2.8, 600)
+    pressure = np.where((s > 1.0) & (s < 1.8), 350.0, 0.0)
+    summary = {"name": "hand-made", "mode": "dynamic", "status": "steady", "steady": True, "steady_from_s": 0.2,
+               "pull_force_N": 205.5, "pull_force_uncertainty_N": 0.1, "rope_pull_force_N": 205.37,
+               "rope_clearance_pull_force_N": 205.37, "pressure_window_m": 0.25}
+    from exucable.post.pressure import BEND_COLUMNS
+    bend = {c: 1.0 for c in BEND_COLUMNS}
+    bend |= {"s_conduit_start_m": 1.0, "s_conduit_end_m": 1.785, "entry_point_load_N": 6.0,
+            "exit_point_load_N": 15.3, "entry_s_conduit_m": 1.0, "exit_s_conduit_m": 1.785}
+    return RunResult(summary=summary,
+                     history={"time_s": t, "pull_force_N": 205.0 + t, "trailing_tension_N": np.full_like(t, 150.0),
+                              "max_tension_N": 205.0 + t},
+                     tension_profile={"x_m": x, "tension_N": 150.0 + 20.0 * x},
+                     contact_profile={"s_conduit_m": s, "normal_force_per_length_N_per_m": pressure,
+                                      "penetration_m": np.zeros_like(s)},
+                     rope_profile={"s_conduit_m": x, "tension_N": 150.0 + 19.0 * x,
+                                   "sidewall_pressure_N_per_m": np.zeros_like(x)},
+                     extras={"x_m": x}, bends=[bend],
+                     pressure_profile={"s_conduit_m": s, "windowed_pressure_N_per_m": pressure,
+                                       "rope_windowed_pressure_N_per_m": 0.95 * pressure})
+
+
+@needs_fork
+def test_the_helpers_figures_are_those_drawn_here(tmp_path):
+    """Byte for byte: the helper is a fork with the same matplotlib and settings."""
+    with Figures(helper=True) as figures:
+        assert figures.helper_running
+        helper = write_results(tmp_path / "helper", _result(), plots=figures)
+    here = write_results(tmp_path / "here", _result(), plots=True)
+    assert [p.name for p in helper] == [p.name for p in here]
+    for name in set(FIGURE_FILES) & {p.name for p in here}:
+        assert (tmp_path / "helper" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
+    assert not figures.helper_running and figures.helper_reason == ""
+
+
+@needs_fork
+def test_a_dead_helper_costs_no_figure(tmp_path):
+    """Killed before the results arrive: the figures are drawn here, and the reason is kept."""
+    with Figures(helper=True) as figures:
+        figures._proc.kill()
+        figures._proc.join()
+        paths = write_results(tmp_path, _result(), plots=figures)
+    drawn = {"pull_force.png", "tension_profile.png", "pressure.png"}      # one cable: no cross sections
+    assert {p.name for p in paths} >= drawn
+    assert all((tmp_path / n).stat().st_size > 1000 for n in drawn)
+    assert "helper" in figures.helper_reason
+
+
+@needs_fork
+def test_a_helper_that_cannot_write_reports_the_files_error(tmp_path, monkeypatch):
+    """An OSError of the helper's write (a full disk) is raised here as the usual OutputError, after
+    the data files and summary.json are in place."""
+    def full(path, data):
+        raise OSError(28, "No space left on device", str(path))
+
+    monkeypatch.setattr("exucable.io.atomic_write_bytes", full)   # the fork inherits the patch
+    with Figures(helper=True) as figures:
+        with pytest.raises(OutputError, match="summary.json are written, but a figure is not.*No space left"):
+            write_results(tmp_path, _result(), plots=figures)
+    assert (tmp_path / "summary.json").exists()
+
+
+def test_a_helper_that_stays_unused_is_stopped():
+    with Figures(helper=hasattr(os, "fork")) as figures:
+        proc = figures._proc
+    assert not figures.helper_running
+    assert proc is None or not proc.is_alive()
+
+
+def test_the_helper_is_forked_only_from_a_fresh_process():
+    """In a fresh process it is (exucable imported, neither Exudyn nor matplotlib yet); with matplotlib
+    or Exudyn loaded, or another thread running, the figures are drawn here, and the reason says why."""
+    script = textwrap.dedent("""
+        import threading, time
+        import exucable.run
+        from exucable.output.figure_process import helper_allowed
+        print(helper_allowed()[0])
+        t = threading.Thread(target=time.sleep, args=(0.5,)); t.start()
+        print(helper_allowed()); t.join()
+        import matplotlib.figure
+        print(helper_allowed())
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert p.returncode == 0, p.stderr
+    first, thread, mpl = p.stdout.strip().splitlines()
+    assert first == str(hasattr(os, "fork"))
+    assert "thread" in thread and "False" in thread
+    assert "matplotlib is loaded" in mpl

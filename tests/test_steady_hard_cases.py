@@ -1,0 +1,80 @@
+"""Hard steady cases end clearly and soon: the cause of a failed steady solve (load scale reached,
+residual, strain at the head) and advice that can help (exucable.solve.steady_advice), and the time
+limit `solver.steady_time_limit`. Coarse models only."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from exucable.run import run_scenario
+from exucable.scenario.specs import load_scenario
+from exucable.solve.steady_advice import LARGE_STRAIN, TIME_LIMIT_KEY, failure_advice, head_strain
+
+ROOT = Path(__file__).resolve().parents[1]
+TINY = ROOT / "tests" / "data" / "sweep" / "tiny_bend.toml"
+
+
+def _model(E_Pa: float, radius_m: float, rope_max_N: float | None):
+    """What failure_advice reads of a model: the cable's EA and the rope reference's tensions."""
+    area = math.pi * radius_m ** 2
+    cable = SimpleNamespace(axial_stiffness_N=E_Pa * area)
+    rope = None if rope_max_N is None else SimpleNamespace(tension_N=np.array([100.0, rope_max_N]))
+    return SimpleNamespace(scenario=SimpleNamespace(cable=cable), rope=rope)
+
+
+def test_head_strain_is_the_ropes_largest_tension_over_EA():
+    # E 3e8 Pa over a 15 mm radius: EA = 3e8·π·0.015² = 212 058 N; 17 kN at the head is 8.0 %
+    T, EA, strain = head_strain(_model(3.0e8, 0.015, 17_000.0))
+    assert EA == pytest.approx(212_057.5, rel=1e-6)
+    assert T == 17_000.0 and strain == pytest.approx(0.0802, abs=1e-4)
+    assert math.isnan(head_strain(_model(3.0e8, 0.015, None))[2])
+
+
+def test_a_large_strain_at_the_head_is_reported_with_the_modulus_to_check():
+    text = failure_advice(_model(3.0e8, 0.015, 17_000.0), load_scale=0.0, residual_N=120.0, tolerance_N=0.017,
+                          timed_out=False, still_converging=False, time_limit_s=60.0)
+    assert "load scale reached 0 of 1" in text and "residual 120 N (stop at 0.017 N)" in text
+    assert "strain at the head 8.02 %" in text and "check `cable.youngs_modulus`" in text
+    small = failure_advice(_model(3.0e8, 0.015, 2_000.0), load_scale=0.0, residual_N=120.0, tolerance_N=0.017,
+                           timed_out=False, still_converging=False, time_limit_s=60.0)
+    assert "youngs_modulus" not in small
+
+
+def test_a_solve_out_of_time_while_converging_is_told_to_allow_more():
+    stiff = _model(3.0e8, 0.015, 2_000.0)            # 0.94 % at the head: not the cause
+    assert head_strain(stiff)[2] < LARGE_STRAIN
+    text = failure_advice(stiff, load_scale=1.0, residual_N=0.5, tolerance_N=0.002, timed_out=True,
+                          still_converging=True, time_limit_s=60.0)
+    assert "time limit of 60 s CPU" in text and TIME_LIMIT_KEY in text
+    stalled = failure_advice(stiff, load_scale=0.5, residual_N=0.5, tolerance_N=0.002, timed_out=False,
+                             still_converging=False, time_limit_s=60.0)
+    assert TIME_LIMIT_KEY not in stalled and "cable.element_length" in stalled
+
+
+def test_the_time_limit_stops_a_steady_solve_soon_with_the_cause(tmp_path):
+    """A limit far below what the solve needs: status failed, the message names the key, the load
+    scale and residual reached and the strain at the head; nothing already computed is lost (the
+    result files are written)."""
+    sc = load_scenario(TINY).replace(**{"solver.mode": "steady", "solver.steady_time_limit": 1e-3})
+    c0 = time.process_time()
+    res = run_scenario(sc, tmp_path, plots=False)
+    assert time.process_time() - c0 < 30.0
+    s = res.summary
+    assert s["status"] == "failed"
+    assert TIME_LIMIT_KEY in s["message"] and "load scale reached" in s["message"]
+    assert "strain at the head" in s["message"] and "(stop at" in s["message"]
+    assert "a larger `solver.steady_time_limit`" in s["message"]      # nothing converged: more time can help
+    assert (tmp_path / "summary.json").exists()
+
+
+def test_the_default_time_limit_leaves_a_normal_case_alone():
+    sc = load_scenario(TINY).replace(**{"solver.mode": "steady"})
+    assert sc.solver.steady_time_limit_s == 60.0
+    res = run_scenario(sc, None, plots=False)
+    assert res.summary["status"] == "ok", res.summary["message"]
