@@ -572,7 +572,8 @@ def straight_weight_correction(model: BundleModel, s_from_m: float, s_to_m: floa
     ΣΔT = n w (sin θ + w_c μ cos θ) Δs, so w_c = (ΣΔT/n - w sin θ Δs)/(μ w cos θ Δs): the bundle's
     friction over what the same cables would have alone. Measured between two stations inside
     the straight, away from the cables' ends and the bends' bending boundary layers; each cable's
-    station is its material point laid there at the start (the steady state moves it by its strain).
+    station is its material point laid there at the start (the steady state moves it by its strain),
+    its tension from the equilibrium of its loads (:meth:`BundleModel.tension_N`).
     """
     sc = model.scenario
     g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
@@ -584,12 +585,9 @@ def straight_weight_correction(model: BundleModel, s_from_m: float, s_to_m: floa
     ds = s_to_m - s_from_m
     if not (mu * w * cos_t * ds > 0.0):
         return None
-    Le = model.layout.element_length_m
-    rise = 0.0
-    for lay, q in zip(model.layout.cables, model.cable_coordinates()):
-        x = np.interp([s_from_m, s_to_m], lay.node_s_m, lay.node_x_m)
-        T = tension_at(q, Le, model.axial_stiffness_N, x)
-        rise += float(T[1] - T[0])
+    at = _bundle_tension_at(model)
+    T = at([s_from_m, s_to_m])
+    rise = float(T[1] - T[0])
     n = model.n_cables
     return (rise / n - w * t[2] * ds) / (mu * w * cos_t * ds)
 
