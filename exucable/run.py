@@ -444,6 +444,10 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     h = out.history.arrays()
     report = bundle_report(model)
     cables = bundle_tension_profile(model)
+    if out.status != "failed" and len(h["time_s"]):
+        # the result's row is the converged state's: its largest tension is the profile's (from the
+        # cables' loads' equilibrium); the steps before it, not in equilibrium, keep EA·ε's
+        h["max_tension_N"][-1] = report["max_tension_N"]
     total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
     flags = []
     panels = None

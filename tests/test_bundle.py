@@ -43,7 +43,9 @@ def test_straight_duct_gives_the_rigid_circle_weight_correction(arrangement, rat
     """Three cables, frictionless between them: the tension rise along the straight's middle half
     over the cables' alone is the calculators' factor within 0.2 %. What separates them is the Hertz
     compliance (penetrations ~5 µm against 15 mm radii move the contact angles by ~1e-3 relative,
-    the factor by a fraction of that) and the tension's evaluation on a coarse mesh; measured -0.03 to -0.10 %"""
+    the factor by a fraction of that) and the check points' discrete contact on a coarse mesh;
+    measured -0.01 to +0.08 % with the cables' tensions from their loads' equilibrium (-0.04 to
+    -0.11 % read off EA·ε)"""
     sc = straight_duct(3, arrangement, ratio)
     model = build_bundle_model(sc)
     out = solve_steady(model)

@@ -409,6 +409,31 @@ class CableContactKernel:
         out["jac_u"] = ju[:m].copy() if jacobian else np.zeros((0, 9, 9))
         return out
 
+    def point_forces_N(self, q) -> tuple[np.ndarray, np.ndarray]:
+        """Each cable's contact load from the other cables, check point by check point.
+
+        The force of a contact on its point P and, as reaction, on the two check points B0, B1 of the
+        other cable's polyline (shares 1 - t, t) is summed per check point, so that
+        Σ_k S(ξ_k)ᵀ F_k is :meth:`evaluate`'s generalized force exactly: the loads a cable's
+        equilibrium (:func:`exucable.post.tension.equilibrium_tension`) needs from the others.
+
+        Returns
+        -------
+        x_m : ndarray (n_points,)
+            The check points' material coordinates from each cable's trailing end [m] (the same on
+            every cable).
+        force_N : ndarray (n_cables, n_points, 3)
+            The force on each cable's check points [N].
+        """
+        c = self.contacts(q)
+        f = np.zeros((self.n_cables * self.n_points, 3))
+        np.add.at(f, c["index"].reshape(-1), c["force"].reshape(-1, 3))
+        x_nodes = np.concatenate([[0.0], np.cumsum(self.element_length_m)])
+        p = np.arange(self.n_points)
+        e = p // self.n_k
+        x = x_nodes[e] + cable_check_points(self.n_k)[p % self.n_k] * self.element_length_m[e]
+        return x, f.reshape(self.n_cables, self.n_points, 3)
+
     def evaluate(self, q, jacobian: bool = True) -> CableContactResult:
         """Generalized contact force on all cables and (optionally) its exact Jacobian ∂Q/∂q."""
         from scipy import sparse

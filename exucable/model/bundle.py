@@ -326,6 +326,7 @@ class BundleModel:
     mesh: object
     lead_out_m: float
     exit_tangent: np.ndarray
+    entry_tangent: np.ndarray | None = None
     lead_drive: Drive | None = None
     trail_drive: Drive | None = None
     applied_pull_force_N: float | None = None
@@ -376,6 +377,47 @@ class BundleModel:
         """Each cable's pull at the eye [N]: its leading end's reaction along the exit tangent
         (the static solver's multipliers carry the opposite sign of the dynamic one's)."""
         return np.array([-d.force_N(self.mbs) for d in self.lead_drives])
+
+    def cable_loads(self) -> list:
+        """Each cable's external loads at the current (static) state, :class:`~exucable.post.tension.CableLoads`:
+        the wall's contact forces at its check points, the other cables' (the pair kernel's forces
+        on its check points, :meth:`~exucable.contact.cable_pairs.CableContactKernel.point_forces_N`),
+        its weight, the back tension's share T_b/n at the trailing end and its leading end's
+        reaction in the eye (all three components: the eye holds the end on the exit line)."""
+        from ..post.tension import CableLoads, check_point_forces_N
+        from .rig import drive_force_vector_N
+
+        Le = self.layout.element_length_m
+        x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
+        qs = self.cable_coordinates()
+        x_between, f_between = self.between.point_forces_N(np.concatenate([q.reshape(-1) for q in qs]))
+        sc = self.scenario
+        g = (sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0) * self.load_scale.gravity
+        rho_a = self.properties.mass_per_length_kg_per_m
+        t_entry = self.exit_tangent if self.entry_tangent is None else self.entry_tangent
+        trailing = -(self.back_tension_N / self.n_cables) * self.load_scale.end_force * np.asarray(t_entry, dtype=float)
+        out = []
+        for i, (q, wall, drive) in enumerate(zip(qs, self.walls, self.lead_drives)):
+            pts = wall.points(q.reshape(-1), np.zeros(q.size))
+            f_wall = check_point_forces_N(pts.normal, pts.normal_force_N, pts.friction_force_N, pts.velocity_m_per_s)
+            out.append(CableLoads(
+                point_x_m=np.concatenate([x_nodes[pts.element] + pts.xi * Le[pts.element], x_between]),
+                point_force_N=np.concatenate([f_wall, f_between[i]]), node_force_N=np.zeros((len(q), 3)),
+                line_load_N_per_m=rho_a * np.array([0.0, 0.0, -g]), mass_per_length_kg_per_m=rho_a,
+                acceleration=None, trailing_force_N=trailing.copy(),
+                leading_force_N=drive_force_vector_N(self.mbs, drive, static=True)))
+        return out
+
+    def tension_N(self, x_m) -> np.ndarray:
+        """Each cable's tension [N] at material stations ``x_m`` [m] from the trailing ends, shape
+        (n_cables, m): from the equilibrium of its loads (:meth:`cable_loads`,
+        :func:`~exucable.post.tension.equilibrium_tension`; the paper's Eq. 24 without the ANCF
+        element's strain error next to concentrated contact loads)."""
+        from ..post.tension import equilibrium_tension
+
+        Le = self.layout.element_length_m
+        return np.stack([equilibrium_tension(q, Le, loads, x_m)
+                         for q, loads in zip(self.cable_coordinates(), self.cable_loads())])
 
     def steady_forces(self, stations=None) -> tuple[float, float, float]:
         """Pulling force (the eye's), trailing tension (the bundle's) and largest cable tension [N]."""
@@ -519,7 +561,7 @@ def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
         cables=cables, layout=layout, properties=props, walls=walls, between=between, wall_couplings=couplings,
         between_coupling=between_coupling, lead_drives=drives, rope=rope, rope_alone=rope_alone,
         back_tension_N=sc.pull.back_tension_N, load_scale=load_scale, mesh=mesh, lead_out_m=lead_out,
-        exit_tangent=t_exit)
+        exit_tangent=t_exit, entry_tangent=t_entry)
 
 
 def straight_weight_correction(model: BundleModel, s_from_m: float, s_to_m: float) -> float | None:
@@ -530,7 +572,8 @@ def straight_weight_correction(model: BundleModel, s_from_m: float, s_to_m: floa
     ΣΔT = n w (sin θ + w_c μ cos θ) Δs, so w_c = (ΣΔT/n - w sin θ Δs)/(μ w cos θ Δs): the bundle's
     friction over what the same cables would have alone. Measured between two stations inside
     the straight, away from the cables' ends and the bends' bending boundary layers; each cable's
-    station is its material point laid there at the start (the steady state moves it by its strain).
+    station is its material point laid there at the start (the steady state moves it by its strain),
+    its tension from the equilibrium of its loads (:meth:`BundleModel.tension_N`).
     """
     sc = model.scenario
     g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
@@ -542,12 +585,9 @@ def straight_weight_correction(model: BundleModel, s_from_m: float, s_to_m: floa
     ds = s_to_m - s_from_m
     if not (mu * w * cos_t * ds > 0.0):
         return None
-    Le = model.layout.element_length_m
-    rise = 0.0
-    for lay, q in zip(model.layout.cables, model.cable_coordinates()):
-        x = np.interp([s_from_m, s_to_m], lay.node_s_m, lay.node_x_m)
-        T = tension_at(q, Le, model.axial_stiffness_N, x)
-        rise += float(T[1] - T[0])
+    at = _bundle_tension_at(model)
+    T = at([s_from_m, s_to_m])
+    rise = float(T[1] - T[0])
     n = model.n_cables
     return (rise / n - w * t[2] * ds) / (mu * w * cos_t * ds)
 
@@ -573,7 +613,6 @@ def bundle_report(model: BundleModel) -> dict:
     alone = model.rope_alone.pull_force_N - Tb / n
     D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
     Le = model.layout.element_length_m
-    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
     qs = model.cable_coordinates()
     q_all = np.concatenate([q.reshape(-1) for q in qs])
     between = model.between.contacts(q_all)
@@ -583,10 +622,12 @@ def bundle_report(model: BundleModel) -> dict:
     from_others = np.zeros(n)
     for col in range(3):
         np.add.at(from_others, owner[:, col], push[:, col])
+    from ..post.tension import profile_stations_m
+
+    tensions = model.tension_N(profile_stations_m(Le))
     cables = []
-    for i, (q, k) in enumerate(zip(qs, model.walls)):
+    for i, (q, k, T) in enumerate(zip(qs, model.walls, tensions)):
         pts = k.points(q.reshape(-1), np.zeros(q.size))
-        T = tension_at(q, Le, model.axial_stiffness_N, x_nodes)
         cables.append({
             "cable": i + 1,
             "pull_share_N": float(shares[i]),
@@ -631,14 +672,14 @@ def bundle_report(model: BundleModel) -> dict:
 
 
 def bundle_tension_profile(model: BundleModel, points_per_element: int = 4) -> dict:
-    """``x_m`` (material coordinate from the trailing ends) and each cable's ``cable_<k>_tension_N`` [N]."""
+    """``x_m`` (material coordinate from the trailing ends) and each cable's ``cable_<k>_tension_N`` [N],
+    from the equilibrium of its loads (:meth:`BundleModel.tension_N`)."""
     from ..post.tension import profile_stations_m
 
-    Le = model.layout.element_length_m
-    x = profile_stations_m(Le, points_per_element)
+    x = profile_stations_m(model.layout.element_length_m, points_per_element)
     out = {"x_m": x}
-    for i, q in enumerate(model.cable_coordinates()):
-        out[f"cable_{i + 1}_tension_N"] = tension_at(q, Le, model.axial_stiffness_N, x)
+    for i, T in enumerate(model.tension_N(x)):
+        out[f"cable_{i + 1}_tension_N"] = T
     return out
 
 
@@ -651,14 +692,18 @@ def _extent_m(model) -> tuple[float, float]:
 
 def _bundle_tension_at(model):
     """s along the pull-oriented centreline [m] → the cables' tensions summed there [N] (each
-    cable's material point laid at s, as :func:`straight_weight_correction`)."""
+    cable's material point laid at s, as :func:`straight_weight_correction`; each tension from the
+    equilibrium of the cable's loads, :meth:`BundleModel.tension_N`)."""
+    from ..post.tension import equilibrium_tension
+
     Le = model.layout.element_length_m
     qs = model.cable_coordinates()
+    loads = model.cable_loads()
 
     def at(s_m):
         s = np.atleast_1d(np.asarray(s_m, dtype=float))
-        return sum(tension_at(q, Le, model.axial_stiffness_N, np.interp(s, lay.node_s_m, lay.node_x_m))
-                   for lay, q in zip(model.layout.cables, qs))
+        return sum(equilibrium_tension(q, Le, load, np.interp(s, lay.node_s_m, lay.node_x_m))
+                   for lay, q, load in zip(model.layout.cables, qs, loads))
     return at
 
 

@@ -408,6 +408,39 @@ def _finite_or_none(x):
     return x if math.isfinite(x) else None
 
 
+def _simulated_sections(rope_entry: dict, s_c, T_c, length_m: float, name: str, bends: list, bend_extra):
+    """The rope's section rows with the simulated tensions: ``T_c`` [N] at ``s_c`` [m] along the
+    scenario's conduit, read at each section's ends (pull-oriented) and its largest inside; each
+    bend's row takes its simulated windowed SWBP from ``bends`` (along the scenario's conduit) plus
+    ``bend_extra(bend)``'s keys. Returns the sorted (s_c, T_c), the rows and the pull-oriented →
+    conduit map."""
+    order = np.argsort(s_c)
+    s_c, T_c = np.asarray(s_c, dtype=float)[order], np.asarray(T_c, dtype=float)[order]
+    to_conduit = (lambda s: s) if name == "forward" else (lambda s: length_m - s)
+
+    def tension(s_pull):
+        return float(np.interp(to_conduit(s_pull), s_c, T_c))
+
+    bends = iter(bends if name == "forward" else bends[::-1])
+    rows, running = [], tension(0.0)
+    for r in rope_entry["sections"]:
+        a, b = r["s_start_m"], r["s_start_m"] + r["length_m"]
+        lo, hi = sorted((to_conduit(a), to_conduit(b)))
+        inside = T_c[(s_c >= lo) & (s_c <= hi)]
+        t_in, t_out = tension(a), tension(b)
+        running = max(running, t_in, t_out, float(np.max(inside)) if inside.size else t_out)
+        row = dict(r, tension_in_N=t_in, tension_out_N=t_out, max_tension_so_far_N=running,
+                   rope_tension_in_N=r["tension_in_N"], rope_tension_out_N=r["tension_out_N"],
+                   rope_sidewall_pressure_N_per_m=r["sidewall_pressure_N_per_m"])
+        if r["sidewall_pressure_N_per_m"] is not None:
+            bend = next(bends)
+            row.update(sidewall_pressure_N_per_m=float(bend["peak_pressure_N_per_m"]),
+                       mean_sidewall_pressure_N_per_m=_finite_or_none(bend["mean_pressure_N_per_m"]),
+                       **bend_extra(bend))
+        rows.append(row)
+    return s_c, T_c, rows, to_conduit
+
+
 def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry: dict, progress: bool) -> dict:
     """One direction's plan entry from the multibody model, the rope's values kept beside.
 
@@ -428,37 +461,14 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     bundle = summary.get("bundle")
     if bundle is not None:
         return _bundle_direction(result, name, rope_entry)
-    s_c, T_c = cable_tension_along_conduit(result.model)
-    order = np.argsort(s_c)
-    s_c, T_c = np.asarray(s_c, dtype=float)[order], np.asarray(T_c, dtype=float)[order]
     L = scenario.build_conduit().centreline.length_m
-    to_conduit = (lambda s: s) if name == "forward" else (lambda s: L - s)
-
-    def tension(s_pull):
-        return float(np.interp(to_conduit(s_pull), s_c, T_c))
-
-    bends = iter(summary["bends"] if name == "forward" else summary["bends"][::-1])
-    rows = []
-    running = tension(0.0)
-    for r in rope_entry["sections"]:
-        a, b = r["s_start_m"], r["s_start_m"] + r["length_m"]
-        lo, hi = sorted((to_conduit(a), to_conduit(b)))
-        inside = T_c[(s_c >= lo) & (s_c <= hi)]
-        t_in, t_out = tension(a), tension(b)
-        running = max(running, t_in, t_out, float(np.max(inside)) if inside.size else t_out)
-        row = dict(r, tension_in_N=t_in, tension_out_N=t_out, max_tension_so_far_N=running,
-                   rope_tension_in_N=r["tension_in_N"], rope_tension_out_N=r["tension_out_N"],
-                   rope_sidewall_pressure_N_per_m=r["sidewall_pressure_N_per_m"])
-        if r["sidewall_pressure_N_per_m"] is not None:
-            bend = next(bends)
-            row.update(sidewall_pressure_N_per_m=float(bend["peak_pressure_N_per_m"]),
-                       mean_sidewall_pressure_N_per_m=_finite_or_none(bend["mean_pressure_N_per_m"]),
-                       rope_windowed_sidewall_pressure_N_per_m=float(bend["rope_peak_pressure_N_per_m"]),
-                       entry_point_load_N=float(bend["entry_point_load_N"]),
-                       entry_s_conduit_m=float(bend["entry_s_conduit_m"]),
-                       exit_point_load_N=float(bend["exit_point_load_N"]),
-                       exit_s_conduit_m=float(bend["exit_s_conduit_m"]))
-        rows.append(row)
+    s_c, T_c, rows, to_conduit = _simulated_sections(
+        rope_entry, *cable_tension_along_conduit(result.model), L, name, summary["bends"],
+        lambda bend: dict(rope_windowed_sidewall_pressure_N_per_m=float(bend["rope_peak_pressure_N_per_m"]),
+                          entry_point_load_N=float(bend["entry_point_load_N"]),
+                          entry_s_conduit_m=float(bend["entry_s_conduit_m"]),
+                          exit_point_load_N=float(bend["exit_point_load_N"]),
+                          exit_s_conduit_m=float(bend["exit_s_conduit_m"])))
     s_pull = np.clip(np.array([to_conduit(s) for s in s_c]), 0.0, L)
     back = np.argsort(s_pull)
     pressures = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
@@ -493,7 +503,8 @@ def _bundle_direction(result, name: str, rope_entry: dict) -> dict:
     """One direction's plan entry from a simulated bundle (``cable.count`` > 1, steady mode), the
     calculators' values (the rope with the weight correction factor) kept beside.
 
-    Section tensions are the bundle's (the cables' summed, :func:`exucable.model.bundle.bundle_tension_along_conduit`);
+    Section tensions are the bundle's (the cables' summed, each from its loads' equilibrium,
+    :func:`exucable.model.bundle.bundle_tension_along_conduit`);
     a bend's SWBP is the most loaded cable's peak windowed pressure, with the calculators' formula on
     the simulated exit tension beside it (``formula_sidewall_pressure_N_per_m``). A failed solve
     keeps the calculators' sections and says so in ``status`` and ``message``.
@@ -518,33 +529,11 @@ def _bundle_direction(result, name: str, rope_entry: dict) -> dict:
         common["bundle"] = {k: (v if k in ("count", "arrangement", "formula_weight_correction_factor") else None)
                             for k, v in common["bundle"].items()}
         return dict(rope_entry, pull_force_N=float("nan"), **common)
-    s_c, T_c = bundle_tension_along_conduit(result.model)
-    order = np.argsort(s_c)
-    s_c, T_c = s_c[order], T_c[order]
     L = result.model.scenario.build_conduit().centreline.length_m
-    to_conduit = (lambda s: s) if name == "forward" else (lambda s: L - s)
-
-    def tension(s_pull):
-        return float(np.interp(to_conduit(s_pull), s_c, T_c))
-
-    bends = iter(bundle["bends"] if name == "forward" else bundle["bends"][::-1])
-    rows, running = [], tension(0.0)
-    for r in rope_entry["sections"]:
-        a, b = r["s_start_m"], r["s_start_m"] + r["length_m"]
-        lo, hi = sorted((to_conduit(a), to_conduit(b)))
-        inside = T_c[(s_c >= lo) & (s_c <= hi)]
-        t_in, t_out = tension(a), tension(b)
-        running = max(running, t_in, t_out, float(np.max(inside)) if inside.size else t_out)
-        row = dict(r, tension_in_N=t_in, tension_out_N=t_out, max_tension_so_far_N=running,
-                   rope_tension_in_N=r["tension_in_N"], rope_tension_out_N=r["tension_out_N"],
-                   rope_sidewall_pressure_N_per_m=r["sidewall_pressure_N_per_m"])
-        if r["sidewall_pressure_N_per_m"] is not None:
-            bend = next(bends)
-            row.update(sidewall_pressure_N_per_m=float(bend["peak_pressure_N_per_m"]),
-                       mean_sidewall_pressure_N_per_m=_finite_or_none(bend["mean_pressure_N_per_m"]),
-                       formula_sidewall_pressure_N_per_m=float(bend["formula_pressure_N_per_m"]),
-                       most_loaded_cable=int(bend["most_loaded_cable"]))
-        rows.append(row)
+    s_c, T_c, rows, to_conduit = _simulated_sections(
+        rope_entry, *bundle_tension_along_conduit(result.model), L, name, bundle["bends"],
+        lambda bend: dict(formula_sidewall_pressure_N_per_m=float(bend["formula_pressure_N_per_m"]),
+                          most_loaded_cable=int(bend["most_loaded_cable"])))
     pressures = [r["sidewall_pressure_N_per_m"] for r in rows if r["sidewall_pressure_N_per_m"] is not None]
     order = np.argsort([to_conduit(s) for s in s_c])
     return {
