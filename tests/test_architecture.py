@@ -1,7 +1,7 @@
 """The house rules, checked: one folder per stage of the data flow with imports pointing down the
 stages (lazy imports count too), no import cycles, at most a handful of top-level modules, only
 ``model/`` and ``solve/`` import Exudyn, no module changes matplotlib's backend, no absolute paths
-of a development machine in the repository."""
+of a development machine in the repository, the contact modules share only public names."""
 
 from __future__ import annotations
 
@@ -156,6 +156,21 @@ def test_imports_point_down_the_stages():
             if a != b and rank[b] >= rank[a]:
                 upward.append(f"{name} -> {target}")
     assert upward == [], "imports that point up or sideways across the stages"
+
+
+def test_contact_modules_share_only_public_names():
+    # the compiled kernels share their parts through contact/kernel_parts.py's public names, so
+    # that a module's underscored names stay its own
+    modules = _modules()
+    found = []
+    for name, path in modules.items():
+        if not name.startswith("exucable.contact."):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.level:
+                found += [f"{name}: {node.module}.{a.name}" for a in node.names
+                          if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not found, f"private names imported across contact modules: {found}"
 
 
 def test_a_handful_of_top_level_modules():

@@ -347,7 +347,7 @@ def test_segment_sectors_are_the_segments_angular_sides():
     """The compiled bend refinement skips the angle test for a point strictly inside its segment's
     sector: the table holds (cos, sin) of each segment's end angles, and zero sides (no point is
     ever inside) for a segment spanning π/2 or more."""
-    from exucable.contact.fast import segment_sectors
+    from exucable.contact.kernel_parts import segment_sectors
 
     phi = np.array([[0.0, 0.1], [0.1, 0.2], [0.0, 2.0], [0.0, 0.0]])
     table = segment_sectors(phi)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from exucable.contact import ContactKernel, ContactLaw, assemble_blocks_dense
-from exucable.contact.fast import _PAIRS
+from exucable.contact.kernel_parts import PAIRS
 from exucable.contact.steady import SteadySlidingKernel, bernstein, block_coefficients, hermite_unit_derivative
 from exucable.contact.checkpoints import hermite_unit
 from exucable.geometry import Bend, Conduit, Straight, centreline_from_path
@@ -88,7 +88,7 @@ def test_block_coefficients_reproduce_the_shape_products():
     exactly up to round-off: 1e-14 against products of order 1)."""
     xi = np.random.default_rng(1).uniform(0.0, 1.0, 50)
     nh, dnh = hermite_unit(xi), hermite_unit_derivative(xi)
-    direct = np.stack([nh[:, a] * nh[:, b] for a, b in _PAIRS]
+    direct = np.stack([nh[:, a] * nh[:, b] for a, b in PAIRS]
                       + [nh[:, a] * dnh[:, b] for a in range(4) for b in range(4)], axis=1)
     assert np.abs(bernstein(xi) @ block_coefficients().T - direct).max() < 1e-14
     assert np.allclose(bernstein(xi).sum(axis=1), 1.0, rtol=0, atol=1e-15)

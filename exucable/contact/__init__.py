@@ -3,7 +3,10 @@ regularised Coulomb friction, generalized forces and their exact Jacobians.
 
 :class:`ContactKernel` (:mod:`.kernel`) is the facade; one switch, its ``backend``, sends every call
 (profiles included) to the numpy reference (:mod:`.numpy_kernel`, the tested definition) or the numba
-fast path (:mod:`.fast`, the default; its per-point profiles in :mod:`.profiles`). Nothing here imports Exudyn; the model layer wraps :class:`ContactKernel` in Exudyn user functions.
+fast path (:mod:`.fast`, the default; its per-point profiles in :mod:`.profiles`). The compiled
+dynamic kernel and the steady-sliding one (:mod:`.steady`) are built from the same parts
+(:mod:`.kernel_parts`). Nothing here imports Exudyn; the model layer wraps :class:`ContactKernel` in
+Exudyn user functions.
 """
 
 from .checkpoints import check_points

@@ -1,12 +1,13 @@
 """How the compiled contact kernels are made, cached and loaded, and what happens when they cannot be.
 
 The kernels (:mod:`.fast`, the broad phase :mod:`.broadphase`, the steady-mode kernel :mod:`.steady`,
-the trust gauge's nearest-sample search :mod:`.nearest`) are decorated with :func:`njit` from here,
-not numba's: it records the function and its numba options and imports nothing until the first call
-(``import exucable`` stays light). A call goes to numba's JIT dispatcher, created on first use with
-``cache=True``: the first call in a fresh environment compiles (tens of seconds for :mod:`.fast`; 
-``exucable compile`` does it up front, and :func:`kernels_to_compile` lets a command say so before a
-run), later processes load the machine code from disk (a tenth of a second, plus numba's own start-up).
+the parts those two share, :mod:`.kernel_parts`, the trust gauge's nearest-sample search
+:mod:`.nearest`) are decorated with :func:`njit` from here, not numba's: it records the function
+and its numba options and imports nothing until the first call (``import exucable`` stays light).
+A call goes to numba's JIT dispatcher, created on first use with ``cache=True``: the first call in a
+fresh environment compiles (tens of seconds for :mod:`.fast`; ``exucable compile`` does it up front,
+and :func:`kernels_to_compile` lets a command say so before a run), later processes load the machine
+code from disk (a tenth of a second, plus numba's own start-up).
 Numba would load a kernel's machine code even after a helper it inlined from another file changed;
 :func:`forget_stale_machine_code` compiles it again then.
 
@@ -101,9 +102,9 @@ def forget_stale_machine_code(dispatcher, name: str) -> bool:
     """Empty ``dispatcher``'s on-disk cache if the kernel sources changed since it was written.
 
     Numba keys a cached function on its own source file's time stamp and its own bytecode only:
-    machine code that inlined a function from another file (the steady kernel inlines
-    :mod:`.fast`'s closest-point and contact-law helpers) is loaded unchanged after that other file
-    changes, i.e. the old code runs. A marker file beside the cache holds the hash of all this
+    machine code that inlined a function from another file (both contact kernels
+    inline :mod:`.kernel_parts`' closest-point and contact-law helpers) is loaded unchanged after that
+    other file changes, i.e. the old code runs. A marker file beside the cache holds the hash of all this
     package's sources (:func:`sources_key`);
     a different or missing marker flushes the cache index, so the kernel is compiled again.
     Returns whether it flushed. A cache it cannot write is left alone (numba then compiles in memory).

@@ -20,12 +20,12 @@ import math
 
 import numpy as np
 
-from .broadphase import _jit
+from .jitcache import njit
 
 __all__ = ["NearestSample"]
 
 
-@_jit
+@njit(nogil=True)
 def _nearest(points, samples, block_start, block_centre, block_radius, out):
     n_blocks = block_centre.size
     centre_distance = np.empty(n_blocks)

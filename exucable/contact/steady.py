@@ -44,33 +44,33 @@ from .jitcache import njit
 from .checkpoints import hermite_unit
 from .kernel import ContactKernel
 from .numpy_kernel import ReferenceKernel
-from .fast import (
-    _JIT,
-    _PAIRS,
-    _J0,
-    _PX,
-    _PY,
-    _PZ,
-    _BEST,
-    _RX,
-    _RY,
-    _RZ,
-    _AX,
-    _AY,
-    _AZ,
-    _BEYOND,
-    _VX,
-    _VY,
-    _VZ,
-    _add_generalized_force,
-    _exponent_mode,
-    _friction,
-    _nearest_segments,
-    _normal_force,
-    _normals,
-    _point_jacobians,
-    _positions,
-    _refine_smooth,
+from .kernel_parts import (
+    JIT_OPTIONS,
+    PAIRS,
+    J0,
+    PX,
+    PY,
+    PZ,
+    BEST,
+    RX,
+    RY,
+    RZ,
+    AX,
+    AY,
+    AZ,
+    BEYOND,
+    VX,
+    VY,
+    VZ,
+    add_generalized_force,
+    exponent_mode_of,
+    friction,
+    nearest_segments,
+    normal_force,
+    normals,
+    point_jacobians,
+    positions,
+    refine_smooth,
 )
 from .smooth import NEWTON_ITERATIONS
 
@@ -185,7 +185,7 @@ def bernstein(xi, degree: int = BLOCK_DEGREE) -> np.ndarray:
 
 def block_coefficients() -> np.ndarray:
     """Bernstein coefficients (degree 6) of the ten products N_a N_b (rows in the order of
-    ``fast._PAIRS``) and the sixteen N_a N'_b (row 10 + 4a + b), shape (26, 7) [-].
+    :data:`.kernel_parts.PAIRS`) and the sixteen N_a N'_b (row 10 + 4a + b), shape (26, 7) [-].
 
     Both are polynomials of degree ≤ 6 in ξ (N cubic, N' quadratic), so they are interpolated
     exactly (to round-off, ~1e-16) at seven Chebyshev nodes, where the Bernstein collocation
@@ -194,11 +194,11 @@ def block_coefficients() -> np.ndarray:
     nodes = 0.5 - 0.5 * np.cos(np.pi * (2 * np.arange(BLOCK_DEGREE + 1) + 1) / (2 * BLOCK_DEGREE + 2))
     nh = hermite_unit(nodes)
     dnh = hermite_unit_derivative(nodes)
-    products = [nh[:, a] * nh[:, b] for a, b in _PAIRS] + [nh[:, a] * dnh[:, b] for a in range(4) for b in range(4)]
+    products = [nh[:, a] * nh[:, b] for a, b in PAIRS] + [nh[:, a] * dnh[:, b] for a in range(4) for b in range(4)]
     return np.ascontiguousarray(np.linalg.solve(bernstein(nodes), np.stack(products, axis=1)).T)
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _jacobian_moments(tab, basis, mom):
     """mom[m, c] = Σ_k B_m(ξ_k) J_c(k) for the 18 columns of ∂F/∂P and ∂F/∂v (B: Bernstein,
     degree 6). Three columns per pass: each basis value loaded once serves three sums (the loop
@@ -206,9 +206,9 @@ def _jacobian_moments(tab, basis, mom):
     n_k = basis.shape[1]
     b0, b1, b2, b3, b4, b5, b6 = basis[0], basis[1], basis[2], basis[3], basis[4], basis[5], basis[6]
     for col in range(0, 18, 3):
-        ja = tab[_J0 + col]
-        jb = tab[_J0 + col + 1]
-        jc = tab[_J0 + col + 2]
+        ja = tab[J0 + col]
+        jb = tab[J0 + col + 1]
+        jc = tab[J0 + col + 2]
         a0 = a1 = a2 = a3 = a4 = a5 = a6 = 0.0
         c0 = c1 = c2 = c3 = c4 = c5 = c6 = 0.0
         d0 = d1 = d2 = d3 = d4 = d5 = d6 = 0.0
@@ -228,20 +228,20 @@ def _jacobian_moments(tab, basis, mom):
         _store_moments(mom, col + 2, d0, d1, d2, d3, d4, d5, d6)
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _add_products(v, x, y, z, sx, sy, sz):
     """(sx + v x, sy + v y, sz + v z): one basis value into three running sums."""
     return sx + v * x, sy + v * y, sz + v * z
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _store_moments(mom, col, s0, s1, s2, s3, s4, s5, s6):
     """The seven moments of column ``col``."""
     mom[0, col], mom[1, col], mom[2, col], mom[3, col] = s0, s1, s2, s3
     mom[4, col], mom[5, col], mom[6, col] = s4, s5, s6
 
 
-@njit(inline="always", **_JIT)
+@njit(inline="always", **JIT_OPTIONS)
 def _steady_blocks(mom, coeff, pair_ab, le, speed, bq):
     """∂Q_e/∂q_e = Σ_k S_kᵀ (∂F/∂P)_k S_k + Σ_k S_kᵀ (∂F/∂v)_k V S'_k from the moments of
     :func:`_jacobian_moments`: Σ_k N_a N_b J = Σ_m c_abm mom_m (``coeff``: :func:`block_coefficients`)."""
@@ -274,7 +274,7 @@ def _steady_blocks(mom, coeff, pair_ab, le, speed, bq):
                     bq[3 * a + i, 3 * b + j] += scale * v
 
 
-@njit(**_JIT)
+@njit(**JIT_OPTIONS)
 def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, basis, pair_ab, coeff,
                    omega, seg, off, cand, gap, stiffness, damping, exponent, exponent_mode, mu_k,
                    dmu, inv_vs2, eps2, inv_href, jacobian, force, jq, scratch, tab, sel, acc,
@@ -296,35 +296,35 @@ def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, basis, pair
             continue
         le = length[e]
         b = 6 * e
-        _positions(q, b, le, n1, n2, n3, n4, tab[_PX], tab[_PY], tab[_PZ])
-        _nearest_segments(tab[_PX], tab[_PY], tab[_PZ], seg, cand, c0, c1, tab[_BEST], sel,
-                          tab[_RX], tab[_RY], tab[_RZ], tab[_AX], tab[_AY], tab[_AZ],
-                          open_first, open_last, tab[_BEYOND])
+        positions(q, b, le, n1, n2, n3, n4, tab[PX], tab[PY], tab[PZ])
+        nearest_segments(tab[PX], tab[PY], tab[PZ], seg, cand, c0, c1, tab[BEST], sel,
+                          tab[RX], tab[RY], tab[RZ], tab[AX], tab[AY], tab[AZ],
+                          open_first, open_last, tab[BEYOND])
         if smooth:
-            _refine_smooth(tab[_PX], tab[_PY], tab[_PZ], seg, sel, tab[_BEST], tab[_RX], tab[_RY],
-                           tab[_RZ], tab[_AX], tab[_AY], tab[_AZ], seg_piece, pieces, seg_phi,
+            refine_smooth(tab[PX], tab[PY], tab[PZ], seg, sel, tab[BEST], tab[RX], tab[RY],
+                           tab[RZ], tab[AX], tab[AY], tab[AZ], seg_piece, pieces, seg_phi,
                            n_newton)
-        n_touch, max_d2 = _normals(tab, n_k, gap, max_d2)
+        n_touch, max_d2 = normals(tab, n_k, gap, max_d2)
         if n_touch == 0:
             continue
         n_contact += n_touch
-        # v = V ∂r/∂x: _positions with the derivative table gives L ∂r/∂x
-        _positions(q, b, le, d1, d2, d3, d4, tab[_VX], tab[_VY], tab[_VZ])
+        # v = V ∂r/∂x: positions with the derivative table gives L ∂r/∂x
+        positions(q, b, le, d1, d2, d3, d4, tab[VX], tab[VY], tab[VZ])
         vs = speed / le
-        vx = tab[_VX]
-        vy = tab[_VY]
-        vz = tab[_VZ]
+        vx = tab[VX]
+        vy = tab[VY]
+        vz = tab[VZ]
         for k in range(n_k):
             vx[k] *= vs
             vy[k] *= vs
             vz[k] *= vs
-        _normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
+        normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
                       exponent_mode, inv_onset)
-        _friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
-        _add_generalized_force(tab, n1, n2, n3, n4, le, b, force)
+        friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
+        add_generalized_force(tab, n1, n2, n3, n4, le, b, force)
         if not jacobian:
             continue
-        _point_jacobians(tab, n_k, stiffness, damping)
+        point_jacobians(tab, n_k, stiffness, damping)
         _jacobian_moments(tab, basis, acc)
         _steady_blocks(acc, coeff, pair_ab, le, speed, jq[e])
     max_pen = np.sqrt(max_d2) - gap if max_d2 >= 0.0 else -np.inf
@@ -369,9 +369,9 @@ class _SteadyFast:
         n1, n2, n3, n4 = f._n
         d1, d2, d3, d4 = self._d
         n_contact, max_pen = _steady_kernel(
-            q, f.length, n1, n2, n3, n4, d1, d2, d3, d4, self.speed, self.basis, _PAIRS, self.coeff,
+            q, f.length, n1, n2, n3, n4, d1, d2, d3, d4, self.speed, self.basis, PAIRS, self.coeff,
             f.omega, f.seg, off, cand, f.gap, float(law.stiffness), float(law.damping),
-            float(law.exponent), _exponent_mode(law.exponent), float(law.friction),
+            float(law.exponent), exponent_mode_of(law.exponent), float(law.friction),
             float(law.static_excess), 1.0 / law.stribeck_velocity_m_per_s**2,
             law.regularisation_velocity_m_per_s**2, f.inv_href, bool(jacobian), force, jq,
             self._unused_work, f._tab, f._sel, f._acc, self._unused_work, f.open_first, f.open_last,
