@@ -11,9 +11,9 @@ scatter), with elements of at most λ/3 and check points at most λ/8 apart. The
 `rope_difference_study.py` (`tight`: R 0.5 m, 15 mm clearance, 18 mm cable, μ 0.5, 100 N back
 tension; `hbend`, `upbend`, `downbend`); the model's exit is held on the rope's line where the
 rig holds the cable's head, the exit straight's length beyond the bend. With gravity the estimate
-also gets the gravity term of the linearised duct model (`exucable.quasistatic.duct_beam`): the stiff cable
+also gets the gravity term of the beam-in-conduit model (`exucable.quasistatic.beam`): the stiff cable
 crossing the floor's trough to a horizontal bend's inner wall, or held by its weight on a
-down-bend's floor, which the in-plane model lacks.
+down-bend's floor, which the in-plane stiff bend lacks.
 
     nice .venv/bin/python studies/bending_stiffness_study.py --json reference/bending_stiffness_study.json \\
         --figure reference/bending_stiffness.png                            # ~10 min on 2 loaded cores
@@ -21,7 +21,7 @@ down-bend's floor, which the in-plane model lacks.
     nice .venv/bin/python studies/bending_stiffness_study.py --quick    # smoke run: one row, tight, EJ 4
     nice .venv/bin/python studies/bending_stiffness_study.py --from-json reference/bending_stiffness_study.json
     nice .venv/bin/python studies/bending_stiffness_study.py --from-json reference/bending_stiffness_study.json \\
-        --gravity-terms --figure reference/bending_stiffness.png        # add the duct model's gravity terms
+        --gravity-terms --figure reference/bending_stiffness.png        # add the beam model's gravity terms
 
 Prints a Markdown table.
 """
@@ -91,23 +91,29 @@ def model_estimate(case: str, clearance_m: float, ej: float, tension_in_N: float
 
 
 def gravity_term(case: str, clearance_m: float, ej: float) -> float:
-    """What gravity changes in the stiff cable's pull against the rope with clearance [relative], by
-    the linearised duct model (`exucable.quasistatic.duct_beam.gravity_change_of_stiffness`: the beam crossing
-    the floor's trough to a horizontal bend's inner wall, or held on a down-bend's floor by its
-    weight; on an up-bend the free spans). Nodes λ/8 apart, 2.5–10 mm (converged to ≤ 0.002
-    percentage point: tested at 5 and 2.5 mm on the tight bend)."""
-    from exucable.quasistatic.duct_beam import gravity_change_of_stiffness
+    """What gravity changes in the stiff cable's pull against the flexible one [relative], by the
+    beam-in-conduit model (`exucable.quasistatic.beam.gravity_change_of_stiffness`: on a horizontal bend
+    the 3D chain crossing the floor's trough to the inner wall; on a vertical bend the planar chain
+    with its weight in the bend plane, held on a down-bend's floor, in free spans on an up-bend).
+    Nodes λ/8 apart, 5–10 mm (finer, the 3D chain's Newton stalls at λ = h on the floor's contact
+    kinks; the rows with λ < 4 cm, coarser than λ/8, have gravity terms of a few 0.001 percentage
+    point)."""
+    from exucable.quasistatic.beam import BeamConduitError, gravity_change_of_stiffness
     c = CASES[case]
     g = bend_geometry(case)
     w = c["mass_kg_per_m"] * G
     t_in = c["back_tension_N"] + c["friction"] * w * g["before_m"]
-    h = min(0.01, max(0.0025, math.sqrt(ej / t_in) / 8.0))
-    return gravity_change_of_stiffness(c["path"], clearance_m, c["friction"], w, c["back_tension_N"], ej, h)
+    h = min(0.01, max(0.005, math.sqrt(ej / t_in) / 8.0))
+    try:
+        return gravity_change_of_stiffness(c["path"], clearance_m, c["friction"], w, ej, c["back_tension_N"], h)
+    except BeamConduitError:
+        # the 3D chain's Newton can stall on the floor's contact kinks at a fine spacing: once at 2h
+        return gravity_change_of_stiffness(c["path"], clearance_m, c["friction"], w, ej, c["back_tension_N"], 2 * h)
 
 
 def add_gravity_terms(rows) -> None:
-    """Add the duct model's gravity term and the estimate with it to each gravity row (in place):
-    ``gravity_term_pct`` and ``duct_estimate_pct`` = the stiff bend (held exit) + that term."""
+    """Add the beam model's gravity term and the estimate with it to each gravity row (in place):
+    ``gravity_term_pct`` and ``gravity_estimate_pct`` = the stiff bend (held exit) + that term."""
     done = {}
     for r in rows:
         if not r["gravity"]:
@@ -120,7 +126,8 @@ def add_gravity_terms(rows) -> None:
         t_in = c["back_tension_N"] + c["friction"] * c["mass_kg_per_m"] * G * g["before_m"]
         stiff, _ = model_estimate(r["case"], r["clearance_m"], r["EJ_N_m2"], t_in, False, r["rope_clearance_N"])
         r["gravity_term_pct"] = done[key]
-        r["duct_estimate_pct"] = 100.0 * stiff + done[key]
+        r["gravity_estimate_pct"] = 100.0 * stiff + done[key]
+        r.pop("duct_estimate_pct", None)       # the retired linearised model's column
 
 
 def run_one(case: str, gravity: bool, clearance_m: float, ej: float, refine: float = 1.0) -> dict:
@@ -169,7 +176,7 @@ def run_one(case: str, gravity: bool, clearance_m: float, ej: float, refine: flo
 
 
 HEADER = ("| case | gravity | c [mm] | EJ [N m²] | √(EJ/T_in)/R | lift-off / 2c | mesh | exucable [N] | "
-          "rope with clearance [N] | exucable − it | model | model + duct gravity term | entry P [N] (model) | exit P [N] (model) | "
+          "rope with clearance [N] | exucable − it | model | model + beam gravity term | entry P [N] (model) | exit P [N] (model) | "
           "entry edge [mm] (model) | wall [s] |\n"
           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 
@@ -179,7 +186,7 @@ def print_row(r: dict) -> None:
     print(f"| {r['case']} | {'yes' if r['gravity'] else 'no'} | {r['clearance_m'] * 1e3:g} | {r['EJ_N_m2']:g} | "
           f"{r['lambda_in_over_R']:.3g} | {r['offset_over_2c']:.2f} | {r['elements']}×{r['check_points_per_element']} | "
           f"{r['pull_force_N']:.3f} | {r['rope_clearance_N']:.3f} | {r['vs_rope_clearance_pct']:+.3f} % | "
-          f"{r['model_pct']:+.3f} %{fit} | {_duct(r)} | "
+          f"{r['model_pct']:+.3f} %{fit} | {_with_gravity(r)} | "
           f"{r['entry_point_load_N']:.2f} ({r['model_entry_point_load_N']:.2f}) | "
           f"{r['exit_point_load_N']:.2f} ({r['model_exit_point_load_N']:.2f}) | "
           f"{1e3 * r['entry_edge_m']:.0f} ({1e3 * r['model_entry_edge_m']:.0f}) | {r['wall_s']:.0f} |", flush=True)
@@ -213,15 +220,15 @@ def mesh_table(rows) -> str:
     return "\n".join(out)
 
 
-def _duct(r: dict) -> str:
-    """The estimate with the duct model's gravity term, or "–" (no gravity: the stiff bend alone)."""
-    return f"{r['duct_estimate_pct']:+.3f} %" if "duct_estimate_pct" in r else "–"
+def _with_gravity(r: dict) -> str:
+    """The estimate with the beam model's gravity term, or "–" (no gravity: the stiff bend alone)."""
+    return f"{r['gravity_estimate_pct']:+.3f} %" if "gravity_estimate_pct" in r else "–"
 
 
 def readme_table(rows) -> str:
     """One line per case: both meshes' values side by side (reference/README.md)."""
     out = ["| case | gravity | c [mm] | EJ [N m²] | λ_in/R | lift-off/2c | meshes | exucable − rope with clearance | "
-           "estimate | estimate + duct gravity term | entry P [N] (model) | exit P [N] (model) | "
+           "estimate | estimate + beam gravity term | entry P [N] (model) | exit P [N] (model) | "
            "entry place [mm into the bend] (model) |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for rs in by_case(rows):
@@ -231,7 +238,7 @@ def readme_table(rows) -> str:
         est = f"{r0['model_pct']:+.3f} %" + ("" if r0["model_fits"] else " (invalid: lift-off > 2c)")
         out.append(f"| {k[0]} | {'yes' if k[1] else 'no'} | {k[2] * 1e3:g} | {k[3]:g} | {r0['lambda_in_over_R']:.3g} | "
                    f"{r0['offset_over_2c']:.2f} | {both(lambda r: str(r['elements']))} | "
-                   f"{both(lambda r: format(r['vs_rope_clearance_pct'], '+.3f'))} % | {est} | {_duct(r0)} | "
+                   f"{both(lambda r: format(r['vs_rope_clearance_pct'], '+.3f'))} % | {est} | {_with_gravity(r0)} | "
                    f"{both(lambda r: format(r['entry_point_load_N'], '.2f'))} ({r0['model_entry_point_load_N']:.2f}) | "
                    f"{both(lambda r: format(r['exit_point_load_N'], '.2f'))} ({r0['model_exit_point_load_N']:.2f}) | "
                    f"{both(lambda r: format(1e3 * r['entry_edge_m'], '.0f'))} ({1e3 * r0['model_entry_edge_m']:.0f}) |")
@@ -258,10 +265,10 @@ def plot(rows, path) -> None:
         valid = [r for r in sel if r["model_fits"]]       # the model's assumptions hold (lift-off ≤ 2c)
         axes[0].plot([r["lambda_in_over_R"] for r in valid], [r["model_pct"] for r in valid], color=colour, ls=":",
                      label=f"estimate, {label}")
-        duct = [r for r in valid if "duct_estimate_pct" in r]   # with the duct model's gravity term
-        if duct:
-            axes[0].plot([r["lambda_in_over_R"] for r in duct], [r["duct_estimate_pct"] for r in duct],
-                         color=colour, ls="--", label=f"estimate + duct gravity term, {label}")
+        grav = [r for r in valid if "gravity_estimate_pct" in r]   # with the beam model's gravity term
+        if grav:
+            axes[0].plot([r["lambda_in_over_R"] for r in grav], [r["gravity_estimate_pct"] for r in grav],
+                         color=colour, ls="--", label=f"estimate + beam gravity term, {label}")
         for key, fill in (("entry", True), ("exit", False)):
             axes[1].plot([r[f"model_{key}_point_load_N"] for r in sel], [r[f"{key}_point_load_N"] for r in sel],
                          marker=marker, color=colour, ls="none", mfc=colour if fill else "none",
@@ -297,7 +304,7 @@ def main(argv=None) -> int:
     p.add_argument("--from-json", help="print (and plot) the rows of this JSON file instead of running")
     p.add_argument("--figure", help="plot the rows to this PNG")
     p.add_argument("--gravity-terms", action="store_true",
-                   help="with --from-json: (re)compute the duct model's gravity term of every gravity row and "
+                   help="with --from-json: (re)compute the beam model's gravity term of every gravity row and "
                         "rewrite the JSON (no exucable runs)")
     p.add_argument("--mesh-report", action="store_true",
                    help="with --from-json: the mesh check of every case (pulling force and wall time per mesh)")

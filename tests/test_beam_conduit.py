@@ -8,6 +8,7 @@ elastica) the discretisation of the edge load costs a few % of the ~0.3 % effect
 
 import math
 
+import numpy as np
 import pytest
 
 from exucable.quasistatic.beam import BeamConduitError, solve_planar_beam, stiff_route_difference
@@ -73,3 +74,51 @@ def test_span_pressing_the_opposite_wall_costs_friction():
     single = stiff_bend(T, MU, math.pi / 2, R - C, 4.0)
     assert not single.fits(C)
     assert single.vs_rope + 0.01 < got["difference"] < 0.0
+
+
+def test_vertical_route_without_friction_lifts_the_weight():
+    """μ = 0 on an up- and a down-bend (the weight in the bend plane): the pull is T_b + w ΔH, ΔH the
+    rise of the cable's axis (steady sliding's energy balance: no work but the weight's; paper
+    Eq. 25 with μ = 0). Both ends lie on the floor, the head held there, so ΔH is the centreline's
+    R(1 − cos θ) + L sin θ plus c(1 − cos θ) from the floor's tilt. The chain lumps the weight per
+    centreline length, so on the bend's wall (at R ∓ c) it lifts w c (1 − cos θ) too much or too
+    little: 2e-5 of the pull at c = 1 mm, hence 5e-5."""
+    from exucable.quasistatic.beam import path_pieces
+    c, w, radius, theta, t_back = 0.001, 9.81, 2.0, math.pi / 3, 200.0
+    for turn, sign in (("up", 1.0), ("down", -1.0)):
+        pieces, vertical = path_pieces([{"straight": 1.0}, {"bend": 60.0, "radius": radius, "turn": turn},
+                                        {"straight": 1.0}])
+        assert vertical
+        sol = solve_planar_beam(pieces, c, 0.0, w, 2.0, t_back, 0.01, vertical=True, head_offset_m=-c)
+        rise = sign * (radius * (1.0 - math.cos(theta)) + math.sin(theta)) + c * (1.0 - math.cos(theta))
+        assert sol.pull_force_N == pytest.approx(t_back + w * rise, rel=5e-5)
+
+
+def test_up_bend_free_spans_match_their_closed_form():
+    """Up-bend with gravity: the cable crosses from the straights' floors to the bend's upper wall in
+    free spans; bending stiffness keeps more weight on the floor, ΔF = μ EJ/(ρ X₀) per span
+    (reference/README.md, "Gravity on vertical bends"; stiff_bend.free_span_stiffness_N), the entry's
+    grown by e^{μθ}. What gravity changes (gravity_change_of_stiffness) against that closed form:
+    first order in λ/X₀ ≈ 0.3 here, hence 15 %."""
+    from exucable.quasistatic.beam import gravity_change_of_stiffness, path_pieces
+    from exucable.quasistatic.stiff_bend import free_span_stiffness_N
+    path = [{"straight": 2.5}, {"bend": 60.0, "radius": 5.0, "turn": "up"}, {"straight": 2.0}]
+    mu, w, ej, c, t_back, theta, h = 0.3, 9.81, 25.0, 0.01, 200.0, math.pi / 3, 0.02
+    model = gravity_change_of_stiffness(path, c, mu, w, ej, t_back, h)
+    pieces, _ = path_pieces(path)
+    flex = solve_planar_beam(pieces, c, mu, w, t_back * h * h, t_back, h, vertical=True)
+    t_in = t_back + mu * w * 2.5
+    mid = 0.5 * (flex.station_m[1:] + flex.station_m[:-1])
+    t_out = float(np.interp(2.5 + 5.0 * theta, mid, flex.tension_N))
+    rho = 5.0 - c
+    closed = (free_span_stiffness_N(ej, mu, rho, c, w, t_in) * math.exp(mu * theta)
+              + free_span_stiffness_N(ej, mu, rho, c, w * math.cos(theta), t_out)) / flex.pull_force_N
+    assert model == pytest.approx(closed, rel=0.15)
+
+
+def test_mixed_route_and_vertical_3d_are_refused():
+    from exucable.quasistatic.beam import path_pieces
+    with pytest.raises(ValueError, match="horizontal route"):
+        path_pieces([{"bend": 90.0, "radius": 1.0, "turn": "left"}, {"bend": 30.0, "radius": 1.0, "turn": "up"}])
+    with pytest.raises(ValueError, match="three_d=False"):
+        solve_planar_beam(ROUTE, C, MU, 1.0, 0.1, T, 0.01, three_d=True, vertical=True)

@@ -24,6 +24,9 @@ elastica of curvature φ_i/h). Two variants:
 - *planar* (without gravity): node i moves along n only, walls at d = ±c; a weight, if given, acts
   as the trough's potential w (c − √(c² − d²)) and presses the floor with √(f² + w²) (kept for
   comparison: it overstates the gravity part, not bridging the floor).
+- *planar, vertical route* (``vertical``): the route lies in a vertical plane, so the weight w h is
+  a body force in the bend plane and the walls at ±c are the floor and the roof: the cable lies on
+  the straights' floor, crosses to an up-bend's roof in free spans, rests on a down-bend's floor.
 
 Coulomb friction μ |contact| acts against the sliding direction (the bisector of t_{i−1} and t_i;
 Eq. 19 of Yang et al. 2013). Two sub-problems alternate until the pulling force settles (as in
@@ -42,7 +45,8 @@ wall of each bend and the floor, is a good start).
 Limits (``tests/test_beam_conduit.py``): λ = h gives the capstan on a bend without gravity (1e-4)
 and, in 3D with gravity, the rope with clearance (:mod:`exucable.quasistatic.clearance`, 2e-4); small λ/ρ
 with the span inside the conduit gives :func:`exucable.quasistatic.stiff_bend.stiff_bend` (within 10 % of its
-−0.24 %). What it leaves out: torsion, the cable's extension, and dynamics; the prediction used is
+−0.24 %); μ = 0 on a vertical route gives T_b + w ΔH; an up-bend's free spans give
+:func:`exucable.quasistatic.stiff_bend.free_span_stiffness_N` (:func:`gravity_change_of_stiffness`). What it leaves out: torsion, the cable's extension, and dynamics; the prediction used is
 the *ratio* of the stiff cable's pull to the model's own λ = h limit.
 """
 
@@ -56,7 +60,8 @@ from scipy.linalg import solve_banded
 
 from .newton import armijo_step, banded_jacobian
 
-__all__ = ["PlanarBeamSolution", "solve_planar_beam", "stiff_route_difference", "route_pieces"]
+__all__ = ["PlanarBeamSolution", "solve_planar_beam", "stiff_route_difference", "route_pieces", "path_pieces",
+           "gravity_change_of_stiffness"]
 
 # Wall penalty per node = _PENALTY · T_ref / h: node loads of a bend end (~√(EJ T)/ρ) penetrate
 # ~1e-4 of the clearance.
@@ -140,14 +145,20 @@ class _Chain:
     residual_name = "lateral"
 
     def __init__(self, pieces, clearance_m, friction, weight_N_per_m, bending_stiffness_N_m2, back_tension_N,
-                 spacing_m, head_offset_m=None, trough_weight_N_per_m=None, tension_scale_N=None):
+                 spacing_m, head_offset_m=None, trough_weight_N_per_m=None, tension_scale_N=None, vertical=False):
         self.sig, self.C, self.e, self.n, self.kap = _centreline(pieces, spacing_m)
         self.N = self.sig.size
         self.h = float(np.diff(self.sig).mean())
         self.c, self.mu, self.w, self.EJ = clearance_m, friction, weight_N_per_m, bending_stiffness_N_m2
         self.Tb = back_tension_N
         self.Tref = tension_scale_N or back_tension_N
-        self.wt = weight_N_per_m if trough_weight_N_per_m is None else trough_weight_N_per_m
+        # a vertical route: the weight acts in the bend plane (world-up is the start's left normal,
+        # +y), through the walls at ±c; no trough across the plane and no floor load out of it
+        self.vertical = vertical
+        self.w_plane = weight_N_per_m if vertical else 0.0
+        self.w_out = 0.0 if vertical else weight_N_per_m
+        default_trough = 0.0 if vertical else weight_N_per_m
+        self.wt = default_trough if trough_weight_N_per_m is None else trough_weight_N_per_m
         self.head = head_offset_m
         self.K = _PENALTY * self.Tref / self.h
         self.hbar = np.full(self.N, self.h)
@@ -180,7 +191,8 @@ class _Chain:
 
     def energy(self, d, T, G):
         x, _, length, _, phi = self.geometry(d)
-        return float(T @ length + self.EJ / (2 * self.h) * phi @ phi + self.wall_energy(d) - np.sum(G * x))
+        return float(T @ length + self.EJ / (2 * self.h) * phi @ phi + self.wall_energy(d) - np.sum(G * x)
+                     + self.w_plane * float(self.hbar @ x[:, 1]))
 
     def forces(self, d, T):
         """Tension, bending and wall forces on the nodes (2D) [N], segment directions and lengths."""
@@ -197,6 +209,7 @@ class _Chain:
         bending[1:] -= dE_dbeta[:, None] * perp
         bending[:-1] += dE_dbeta[:, None] * perp
         wall = self.wall_force(d)[:, None] * self.n
+        wall[:, 1] -= self.w_plane * self.hbar      # the in-plane weight (vertical route), with the wall's force
         return tension, bending, wall, t
 
     def lateral_residual(self, d, T, G):
@@ -252,7 +265,7 @@ class _Chain:
     def march(self, d, T):
         """Tensions from the trailing end, and the frozen friction forces."""
         _, bending, wall, t = self.forces(d, T)
-        contact = np.hypot(self.wall_force(d), self.w * self.hbar)
+        contact = np.hypot(self.wall_force(d), self.w_out * self.hbar)
         new_T = np.empty_like(T)
         friction_force = np.zeros((self.N, 2))
         prev_T, prev_t = self.Tb, self.e[0]
@@ -263,7 +276,9 @@ class _Chain:
             new_T[i] = (prev_T * (prev_t @ tau) - (bending[i] + wall[i]) @ tau + self.mu * contact[i]) / (t[i] @ tau)
             prev_T, prev_t = new_T[i], t[i]
         friction_force[-1] = -self.mu * contact[-1] * t[-1]
-        return new_T, friction_force, prev_T + self.mu * contact[-1], contact
+        # the head node's own share of an in-plane weight (a vertical route) is lifted by the pull too
+        head_weight = self.w_plane * self.hbar[-1] * t[-1, 1]
+        return new_T, friction_force, prev_T + self.mu * contact[-1] + head_weight, contact
 
     def solve(self, d, soften=False, max_passes=200):
         T = np.full(self.N - 1, self.Tb)
@@ -287,7 +302,8 @@ class _Chain:
 def solve_planar_beam(pieces, clearance_m: float, friction: float, weight_N_per_m: float,
                       bending_stiffness_N_m2: float, back_tension_N: float, spacing_m: float,
                       head_offset_m: float | None = None, trough_weight_N_per_m: float | None = None,
-                      start_bending_stiffness_N_m2: float | None = None, three_d: bool = False) -> PlanarBeamSolution:
+                      start_bending_stiffness_N_m2: float | None = None, three_d: bool = False,
+                      vertical: bool = False) -> PlanarBeamSolution:
     """Steady pull of a beam through a planar route, by continuation in EJ.
 
     Parameters
@@ -300,7 +316,8 @@ def solve_planar_beam(pieces, clearance_m: float, friction: float, weight_N_per_
     friction : float
         μ.
     weight_N_per_m : float
-        w, the weight per length pressing the floor (a horizontal route) [N/m]; 0 without gravity.
+        w, the weight per length [N/m]: pressing the floor of a horizontal route, in the bend plane
+        of a ``vertical`` one; 0 without gravity.
     bending_stiffness_N_m2 : float
         EJ [N m²] (> 0).
     back_tension_N : float
@@ -318,6 +335,10 @@ def solve_planar_beam(pieces, clearance_m: float, friction: float, weight_N_per_
         Nodes move in their whole normal plane inside the round conduit, under their weight (free
         spans over the floor, the trough bridged by the stiffness); default: in the bend plane only,
         the weight as the trough's potential and floor friction.
+    vertical : bool
+        The route lies in a vertical plane, turning left = up (world-up is the start's left normal):
+        the weight acts in the bend plane on the planar chain (its walls at ±c are the conduit's
+        floor and roof; no trough). Not with ``three_d``.
 
     Returns
     -------
@@ -325,12 +346,18 @@ def solve_planar_beam(pieces, clearance_m: float, friction: float, weight_N_per_
     """
     if bending_stiffness_N_m2 <= 0.0 or back_tension_N <= 0.0 or clearance_m <= 0.0:
         raise ValueError("bending_stiffness_N_m2, back_tension_N and clearance_m must be > 0")
+    if vertical and three_d:
+        raise ValueError("vertical: the in-plane weight of a vertical route is for the planar chain; "
+                         "set three_d=False (the 3D chain's weight is out of the route's plane)")
     args = (pieces, clearance_m, friction, weight_N_per_m)
-    kw = dict(head_offset_m=head_offset_m, trough_weight_N_per_m=trough_weight_N_per_m, tension_scale_N=back_tension_N)
+    kw = dict(head_offset_m=head_offset_m, trough_weight_N_per_m=trough_weight_N_per_m, tension_scale_N=back_tension_N,
+              vertical=vertical)
     ej = start_bending_stiffness_N_m2 or min(bending_stiffness_N_m2, back_tension_N * spacing_m ** 2)
     cls = _Chain3D if three_d else _Chain
     chain = cls(*args, ej, back_tension_N, spacing_m, **kw)
     d = np.clip(chain.kap * 1e12, -clearance_m, clearance_m)   # the rope's: on each bend's inner wall
+    if vertical and weight_N_per_m > 0.0:                      # ... and on the straights' floor
+        d = np.where(chain.kap != 0.0, d, -clearance_m)
     if three_d:                                                # ... and on the floor
         d = np.stack([d, -np.sqrt(np.maximum(clearance_m ** 2 - d * d, 0.0))], 1)
     sol = chain.solve(d, soften=True)
@@ -360,6 +387,68 @@ def route_pieces(centreline) -> list[tuple[float, float]]:
         sign = 1.0 if np.cross(a, b)[2] >= 0.0 else -1.0
         out.append((float(p.length_m), sign / float(p.radius_of_curvature_m)))
     return out
+
+
+def path_pieces(path) -> tuple[list[tuple[float, float]], bool]:
+    """A planar path in the scenario's ``conduit.path`` form as pieces, and whether it is vertical.
+
+    Parameters
+    ----------
+    path : sequence of dict
+        ``{"straight": L [m]}`` or ``{"bend": angle [deg], "radius": R [m], "turn": "left" | "right" |
+        "up" | "down"}``: left/right turns only (a horizontal route) or up/down only (a vertical one).
+
+    Returns
+    -------
+    pieces : list of (float, float)
+        (length [m], signed curvature [1/m], > 0 turning left or up).
+    vertical : bool
+        The path turns up or down (:func:`solve_planar_beam`'s ``vertical``).
+    """
+    turns = {p.get("turn", "left") for p in path if "bend" in p}
+    if turns & {"left", "right"} and turns & {"up", "down"}:
+        raise ValueError("path: the planar beam takes a horizontal route (left/right turns) or a vertical one "
+                         "(up/down turns), not both; split the route or use exucable's 3D model")
+    sign = {"left": 1.0, "up": 1.0, "right": -1.0, "down": -1.0}
+    pieces = [(float(p["straight"]), 0.0) if "straight" in p
+              else (math.radians(p["bend"]) * p["radius"], sign[p.get("turn", "left")] / p["radius"]) for p in path]
+    return pieces, bool(turns & {"up", "down"})
+
+
+def gravity_change_of_stiffness(path, clearance_m: float, friction: float, weight_N_per_m: float,
+                                bending_stiffness_N_m2: float, back_tension_N: float, spacing_m: float) -> float:
+    """What gravity changes in the stiff cable's pull against the flexible one [relative].
+
+    ``(F_EJ/F_0)|_w − (F_EJ/F_0)|_{w=0}`` on the whole route in one window (F_0 the chain at λ = h,
+    F_EJ the stiff chain with its head held where F_0's head lies, as exucable's steady rig holds it):
+    the term to add to the in-plane stiff bend (:func:`exucable.quasistatic.stiff_bend.stiff_bend`) on a
+    route with gravity. A horizontal route with gravity uses the 3D chain (the cable crosses the
+    floor's trough), a vertical one the planar chain with the weight in its plane (free spans on an
+    up-bend, the cable held on a down-bend's floor). Four continuation solves.
+
+    Parameters
+    ----------
+    path : sequence of dict
+        The route (:func:`path_pieces`), pulled from its start to its end.
+    clearance_m, friction, weight_N_per_m, bending_stiffness_N_m2, back_tension_N, spacing_m : float
+        c [m], μ, w [N/m] (> 0), EJ [N m²], T at the trailing end [N], node spacing h [m] (resolve
+        λ = √(EJ/T) with several nodes).
+    """
+    if weight_N_per_m <= 0.0:
+        raise ValueError(f"weight_N_per_m must be > 0 (the gravity term), got {weight_N_per_m}")
+    pieces, vertical = path_pieces(path)
+    h = spacing_m
+    ratio = []
+    for w in (weight_N_per_m, 0.0):
+        # without gravity a faint trough fixes a free straight's place (stiff_route_difference's)
+        trough = None if w > 0.0 else 1e-5 * back_tension_N * max(abs(k) for _, k in pieces)
+        kw = dict(trough_weight_N_per_m=trough, three_d=w > 0.0 and not vertical, vertical=vertical and w > 0.0)
+        flex = solve_planar_beam(pieces, clearance_m, friction, w, min(bending_stiffness_N_m2, back_tension_N * h * h),
+                                 back_tension_N, h, **kw)
+        stiff = solve_planar_beam(pieces, clearance_m, friction, w, bending_stiffness_N_m2, back_tension_N, h,
+                                  head_offset_m=flex.offset_m[-1].copy(), **kw)
+        ratio.append(stiff.pull_force_N / flex.pull_force_N)
+    return ratio[0] - ratio[1]
 
 
 def stiff_route_difference(pieces, clearance_m, friction, weight_N_per_m, bending_stiffness_N_m2,

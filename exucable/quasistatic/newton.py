@@ -1,9 +1,9 @@
 """Damped Newton for the quasi-static models' shape problems: an energy-decreasing step size and a
 banded Jacobian by finite differences in colours. numpy and scipy only.
 
-Each model (:mod:`.clearance`, :mod:`.beam`, :mod:`.duct_beam`) finds its cable's offsets by minimising
-an energy whose gradient is a force residual; the steps differ (along the wall, through a symmetric
-band), the safeguard is the same: halve the step until the energy falls by the Armijo fraction of
+Each model (:mod:`.clearance`, :mod:`.beam`) finds its cable's offsets by minimising
+an energy whose gradient is a force residual; the steps differ (along the wall, through a band), the
+safeguard is the same: halve the step until the energy falls by the Armijo fraction of
 what the linear model promises (Nocedal & Wright, *Numerical Optimization*, 2nd ed., Alg. 3.1).
 """
 
