@@ -127,17 +127,9 @@ def _cross_section_frame(centreline, s_m):
     up = e_z without its tangential part (a vertical tangent takes e_x's instead)."""
     from .layout import extended_tangent
 
-    t = extended_tangent(centreline, np.asarray(s_m, dtype=float))
-    up = np.array([0.0, 0.0, 1.0])[None, :] - t[:, 2:3] * t
-    norm = np.linalg.norm(up, axis=1)
-    vertical = norm < 1e-6
-    if np.any(vertical):
-        alt = np.array([1.0, 0.0, 0.0])[None, :] - t[:, 0:1] * t
-        up[vertical] = alt[vertical]
-        norm = np.linalg.norm(up, axis=1)
-    up /= norm[:, None]
-    horizontal = np.cross(t, up)
-    return horizontal, up
+    from ..post.bundle import frame_across
+
+    return frame_across(extended_tangent(centreline, np.asarray(s_m, dtype=float)))
 
 
 def load_turn_rad(centreline, s_m, tension_N, weight_per_length_N_per_m: float, blend_length_m: float) -> np.ndarray:

@@ -41,7 +41,7 @@ import numpy as np
 
 from .pressure import windowed_load
 
-__all__ = ["ACROSS_DEG", "CONTACT_TOLERANCE", "cross_section_frame", "cable_points", "cross_section_offsets",
+__all__ = ["ACROSS_DEG", "CONTACT_TOLERANCE", "cross_section_frame", "frame_across", "cable_points", "cross_section_offsets",
            "classify_cross_section", "arrangement_sections", "bend_pressures"]
 
 #: Gap, as a fraction of the cable radius, below which two surfaces count as touching [-]. Contact
@@ -59,6 +59,12 @@ def cross_section_frame(centreline, s_m) -> tuple[np.ndarray, np.ndarray, np.nda
     """Tangent, horizontal and up unit vectors across the centreline at ``s_m``, each (m, 3)."""
     s = np.atleast_1d(np.asarray(s_m, dtype=float))
     t = np.asarray(centreline.tangent(s), dtype=float).reshape(-1, 3)
+    return (t, *frame_across(t))
+
+
+def frame_across(t) -> tuple[np.ndarray, np.ndarray]:
+    """Unit (horizontal, up) axes across unit tangents ``t`` (m, 3): up = e_z without its tangential
+    part (a vertical tangent takes e_x's instead), horizontal = t × up."""
     up = np.array([0.0, 0.0, 1.0])[None, :] - t[:, 2:3] * t
     norm = np.linalg.norm(up, axis=1)
     vertical = norm < 1e-6
@@ -67,7 +73,7 @@ def cross_section_frame(centreline, s_m) -> tuple[np.ndarray, np.ndarray, np.nda
         up[vertical] = alt[vertical]
         norm = np.linalg.norm(up, axis=1)
     up /= norm[:, None]
-    return t, np.cross(t, up), up
+    return np.cross(t, up), up
 
 
 def cable_points(coordinates, element_length_m, per_element: int = 32) -> np.ndarray:
