@@ -15,6 +15,7 @@ import math
 import numpy as np
 import pytest
 
+import exucable as xc
 from exucable.errors import ModelError
 from exucable.post.bundle import classify_cross_section, jam_band_warning
 from exucable.quasistatic.bundle_jam import (frictionless_keystone_psi_rad, keystone, keystone_friction_needed,
@@ -125,3 +126,79 @@ def test_jam_band_warning(ratio, friction, bends, warned):
     if warned:
         assert f"D/d = {ratio:.3g}" in text and "conduit.inner_radius" in text
     assert jam_band_warning(2, ratio, friction, bends) is None
+
+
+D_CABLE, RADIUS, STRAIGHT = 0.03, 2.0, 0.5
+
+
+def bend_scenario(ratio):
+    """The study's case (studies/bundle_jam_study.py): a horizontal 90° bend of 2 m radius, gravity,
+    wall μ 0.3, frictionless between the cables, 100 N per cable in, 16 elements."""
+    route = (xc.Route(inner_radius=ratio * D_CABLE / 2).straight(STRAIGHT).bend(90, radius=RADIUS, turn="left")
+             .straight(STRAIGHT))
+    return xc.Scenario(route=route,
+                       cable=xc.Cable(radius=D_CABLE / 2, density=2000.0, youngs_modulus=2e8, bending_stiffness=1.0,
+                                      count=3, arrangement="cradled", elements=16),
+                       contact=xc.Contact(friction=0.3, check_points_per_element=8),
+                       pull=xc.Pull(speed=0.1, back_tension=300.0), gravity=xc.Gravity(g=9.81),
+                       solver=xc.Solver(mode="steady", end_time=1.0, steady_lead_out=0.0))
+
+
+def test_a_cradle_in_the_jam_range_slides_cradled_and_says_it_could_wedge():
+    """D/d = 2.9, inside NFPA 70's 2.8-3.2: the steady bundle goes round the bend cradled, no cable
+    lifted off the wall between the others, so no jam flag and status ok, but with the keystone
+    band's warning. The middle cable's contact force per length over the bend's middle half is the
+    rigid cradle's 2x·p = 1.053 p within 10 % (p = T κ n − w e_z⊥ per cable, T the share rope's),
+    not the keystone's 1.60 p."""
+    res = xc.run(bend_scenario(2.9))
+    b = res.summary.bundle
+    assert res.status == "ok" and b["jam"] is False
+    bend = next(s for s in b["sections"] if s["kind"] == "bend")
+    assert bend["arrangement"] == "cradled" and not bend["jam"]
+    assert any("wedge side by side" in w for w in res.summary.warnings)
+    model = res.model
+    kernel = model.between
+    q_all = np.concatenate([q.reshape(-1) for q in model.cable_coordinates()])
+    c = kernel.contacts(q_all)
+    cable, point = c["index"][:, 0] // kernel.n_points, c["index"][:, 0] % kernel.n_points
+    line = (kernel.weight[point] * kernel.law.stiffness * c["penetration_m"] ** kernel.law.exponent
+            / (kernel.element_length_m[point // kernel.n_k] / kernel.n_k))
+    x_pts, _ = kernel.point_forces_N(q_all)
+    s = np.array([np.interp(x_pts[j], model.layout.cables[i].node_x_m, model.layout.cables[i].node_s_m)
+                  for i, j in zip(cable, point)])
+    a, e = STRAIGHT + 0.25 * RADIUS * math.pi / 2, STRAIGHT + 0.75 * RADIUS * math.pi / 2
+    mid = (s >= a) & (s <= e)
+    centre = model.conduit.centreline
+    T = np.interp(s[mid], model.rope.s_conduit_m, model.rope.tension_N)
+    w = model.scenario.cable.mass_per_length_kg_per_m * 9.81
+    p = np.hypot(T / RADIUS, w)          # a horizontal bend: T κ across, the weight down
+    assert centre.length_m > e
+    ratio = line[mid] / p
+    assert np.max(ratio) == pytest.approx(2.0 / (2.9 - 1.0), rel=0.10)
+
+
+def test_laid_as_the_keystone_the_steady_bundle_does_not_stay_wedged(monkeypatch):
+    """Started in the jam itself (a 2 m horizontal straight with gravity, D/d 3.05, the cables laid as
+    the keystone at its frictionless balance ψ = 76.5°, G = 6.3 w), the steady solve does not hold it
+    (it is unstable, and sliding friction gives no hold across the duct): the middle cable drops
+    between the outer ones, the straight reads cradled (7 of its 9 planes; the 2 by the eye, which
+    holds the leading ends as laid, triangular), no plane side by side, no jam, status ok, the
+    pull within 5 % of the calculators' cradle (measured +3.7 %: the eye holds the leading ends in
+    the keystone as laid) rather than the keystone's w_c = 2N/3w = 4.3."""
+    import exucable.model.bundle as bundle_model
+
+    def keystone_offsets(count, arrangement, inner_radius_m, cable_radius_m):
+        D, d = 2.0 * inner_radius_m, 2.0 * cable_radius_m
+        psi = frictionless_keystone_psi_rad(D, d)
+        return keystone(D, d, math.pi / 2 if psi is None else psi).positions_m[0]
+
+    monkeypatch.setattr(bundle_model, "arrangement_offsets", keystone_offsets)
+    ratio = 3.05
+    sc = bend_scenario(ratio).replace(**{"conduit.path": [{"straight": 2.0}]})
+    res = xc.run(sc)
+    b = res.summary.bundle
+    assert res.status == "ok" and b["jam"] is False
+    (straight,) = b["sections"]
+    assert straight["arrangement"] == "cradled" and "side_by_side" not in straight["arrangements_seen"]
+    formula = 3 * res.model.rope.pull_force_N
+    assert res.pull_force_N == pytest.approx(formula, rel=0.05)
