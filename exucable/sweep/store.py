@@ -3,7 +3,8 @@
 Layout of ``DIR``::
 
     DIR/sweep.json              the sweep: keys, mode, output, every case's hash and parameters
-    DIR/sweep.csv               one row per case (rewritten atomically after each finished case)
+    DIR/sweep.csv               one row per case (rewritten atomically every few seconds while
+                                running and when the sweep ends)
     DIR/sweep.png               output against the first varied key
     DIR/cases/<hash>/           one finished case: run_scenario's files + case.json
     DIR/cases/.<hash>.tmp-<pid> a case being run by process <pid> (never read; removed by a later
