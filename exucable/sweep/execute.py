@@ -43,7 +43,7 @@ from .store import (
     CASES_DIR,
     TABLE,
     SweepLock,
-    _extra_columns,
+    extra_columns,
     case_dir,
     is_finished,
     make_row,
@@ -149,7 +149,7 @@ def _run_sweep(sweep, out: Path, workers, client, retry_failed, quiet, plots, ru
     cases_dir = check_out_dir(out / CASES_DIR)
     keys = sweep.keys
     ids = sweep.case_ids()
-    extra = _extra_columns(sweep.output)
+    extra = extra_columns(sweep.output)
     columns = table_columns(keys, sweep.output)
 
     with SweepLock(out):
