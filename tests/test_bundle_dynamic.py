@@ -1,0 +1,117 @@
+"""Several cables in one conduit in the dynamic mode: the cable-cable kernel's dynamic form.
+
+The cable-cable kernel with the points' velocities from the nodal rates and the normal law's damping
+is checked against central differences of its own force (exact Jacobians ∂Q/∂q and ∂Q/∂q̇) and the
+compiled loop against the numpy definition. The dynamic bundle's steady pulling force is checked
+against the steady bundle solve (exucable/model/bundle.py, the same model without inertia) and its
+straight's weight correction against the rigid-circle formulas (triangular 1/√(1 - x²), cradled
+1 + (4/3)x², x = d/(D - d); exucable/quasistatic/engineering.py); tolerances from how steady the
+dynamic run got (its pulling force's uncertainty, exucable/post/trust.py). Coarse meshes (8 elements
+of 0.5 m on a 4 m straight, 16 round a bend).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import exucable as xc
+from exucable.contact import ContactLaw
+from exucable.contact.cable_pairs import CableContactKernel
+from exucable.errors import ModelError
+from exucable.post.tension import detect_steady_state
+from exucable.post.trust import pull_force_uncertainty
+from exucable.quasistatic import engineering as eng
+
+D_CABLE = 0.03          # cable diameter [m]
+MU = 0.3
+BACK = 30.0             # the bundle's back tension [N]
+
+
+def straight_duct(arrangement, ratio, mode, **solver):
+    """A 4 m horizontal duct of inner diameter ratio·d with three cables (as tests/test_bundle.py)."""
+    keys = dict(mode=mode, end_time=1.0, steady_lead_out=0.0)
+    keys.update(solver)
+    return xc.Scenario(route=xc.Route(inner_radius=ratio * D_CABLE / 2).straight(4.0),
+                       cable=xc.Cable(radius=D_CABLE / 2, density=2000.0, youngs_modulus=2e8, count=3,
+                                      arrangement=arrangement, elements=8),
+                       contact=xc.Contact(friction=MU, check_points_per_element=8),
+                       pull=xc.Pull(speed=0.1, back_tension=BACK), gravity=xc.Gravity(g=9.81),
+                       solver=xc.Solver(**keys))
+
+
+# -- the kernel's dynamic form
+
+R = 2.5e-3
+LAW = ContactLaw(stiffness=1e6, damping=50.0, exponent=1.5, friction=0.3, regularisation_velocity_m_per_s=1e-3,
+                 damping_onset_m=2e-4)
+
+
+def _trefoil(rng, n_el=2, Le=0.05):
+    """Three cables pressed together by 0.1 mm, perturbed, with random nodal rates."""
+    gap = 2 * R - 1e-4
+    q = []
+    for y, z in ((0.0, 0.0), (gap, 0.0), (gap / 2, gap * np.sqrt(3) / 2)):
+        c = np.zeros((n_el + 1, 6))
+        c[:, 0] = np.arange(n_el + 1) * Le + 1e-5 * rng.normal(size=n_el + 1)
+        c[:, 1], c[:, 2], c[:, 3] = y, z, 1.0
+        c[:, 1:3] += 1e-4 * rng.normal(size=(n_el + 1, 2))
+        c[:, 4:6] += 0.02 * rng.normal(size=(n_el + 1, 2))
+        q.append(c.reshape(-1))
+    q = np.concatenate(q)
+    q_t = 0.05 * rng.normal(size=q.size)
+    q_t[0::6] += 0.1                    # all sliding along x at about the pull speed
+    return q, q_t
+
+
+def test_dynamic_pair_jacobians_match_central_differences():
+    """∂Q/∂q and ∂Q/∂q̇ of the force with the points' velocities S q̇, friction and damping (with its
+    onset ramp) on: exact against central differences (truncation ~h²|Q'''|, round-off ~1e-16|Q|/h,
+    both below 1e-6 of the largest entry here). The compiled kernel; the numpy one is equal to it
+    (next test)."""
+    q, q_t = _trefoil(np.random.default_rng(3))
+    k = CableContactKernel(3, np.full(2, 0.05), R, LAW, 4, 1e-3, 0.1, backend="numba")
+    res = k.evaluate(q, q_t=q_t)
+    assert res.n_in_contact > 0 and res.jacobian_t is not None
+    for J, vary, h in ((res.jacobian.toarray(), "q", 1e-9), (res.jacobian_t.toarray(), "q_t", 1e-7)):
+        fd = np.empty_like(J)
+        for i in range(q.size):
+            d = np.zeros_like(q)
+            d[i] = h
+            plus = k.evaluate(q + d, False, q_t) if vary == "q" else k.evaluate(q, False, q_t + d)
+            minus = k.evaluate(q - d, False, q_t) if vary == "q" else k.evaluate(q, False, q_t - d)
+            fd[:, i] = (plus.generalized_force - minus.generalized_force) / (2 * h)
+        assert np.abs(J - fd).max() <= 1e-6 * np.abs(J).max(), vary
+
+
+def test_dynamic_pair_kernel_compiled_equals_numpy():
+    q, q_t = _trefoil(np.random.default_rng(4))
+    a = CableContactKernel(3, np.full(2, 0.05), R, LAW, 4, 1e-3, 0.1, backend="numpy").evaluate(q, q_t=q_t)
+    b = CableContactKernel(3, np.full(2, 0.05), R, LAW, 4, 1e-3, 0.1, backend="numba").evaluate(q, q_t=q_t)
+    assert a.n_in_contact == b.n_in_contact > 0
+    np.testing.assert_allclose(b.generalized_force, a.generalized_force, rtol=0,
+                               atol=1e-11 * np.abs(a.generalized_force).max())
+    for x, y in ((a.jacobian, b.jacobian), (a.jacobian_t, b.jacobian_t)):
+        assert abs(x - y).max() <= 1e-11 * abs(x).max()
+
+
+def test_damping_acts_on_the_approach_only_through_the_normal():
+    """Two parallel cables approaching at δ̇ along their common normal: the normal force is
+    w (K δ^e + C g δ̇) with g = δ/δ_d in the onset ramp; sliding along the axis adds nothing to it."""
+    n_el, Le, delta = 4, 0.1, 1e-4
+    a = np.zeros((n_el + 1, 6))
+    a[:, 0], a[:, 3] = np.arange(n_el + 1) * Le, 1.0
+    b = a.copy()
+    b[:, 1] = 2 * R - delta
+    q = np.concatenate([a.reshape(-1), b.reshape(-1)])
+    q_t = np.zeros_like(q)
+    q_t[0::6] = 0.1                                     # both sliding along x together
+    q_t[6 * (n_el + 1) + 1::6] = -0.02                  # cable 2 approaching cable 1 along -y
+    k = CableContactKernel(2, np.full(n_el, Le), R, LAW, 4, 1e-3, 0.1, backend="numba")
+    c = k.contacts(q, q_t=q_t)
+    w = Le / 4 / 1e-3
+    expected = w * (LAW.stiffness * delta ** 1.5 + LAW.damping * (delta / LAW.damping_onset_m) * 0.02)
+    np.testing.assert_allclose(c["force"][:, 1], -expected, rtol=1e-12)   # P on cable 1 pushed to -y
+    np.testing.assert_allclose(c["force"][:, 0], 0.0, atol=1e-12 * expected)
