@@ -218,3 +218,23 @@ def test_snapshots_are_refused_naming_the_key():
     with pytest.raises(ModelError) as err:
         xc.run(sc)
     assert "output.snapshots" in str(err.value)
+
+
+def test_command_line_prints_the_dynamic_bundle(tmp_path):
+    """`exucable run` on a scenario file with three cables in the dynamic mode (the bend without
+    gravity, started steady): exit 0, the time integration's line and the shares printed."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "three.toml"
+    path.write_text('name = "three"\n[cable]\nradius = 0.015\ndensity = 2000.0\nyoungs_modulus = 2e8\n'
+                    'bending_stiffness = 1.0\ncount = 3\narrangement = "cradled"\nelements = 16\n'
+                    '[conduit]\ninner_radius = 0.0495\npath = [{straight = 0.5}, {bend = 90.0, radius = 2.0, turn = "left"},'
+                    ' {straight = 0.5}]\n[contact]\nfriction = 0.3\ncheck_points_per_element = 8\n'
+                    '[pull]\nspeed = 0.1\nback_tension = 300.0\n'
+                    '[solver]\nmode = "dynamic"\nstart_from = "steady"\nend_time = 0.3\nsteady_lead_out = 0.0\n')
+    proc = subprocess.run([sys.executable, "-m", "exucable", "run", str(path), "--out", str(tmp_path / "out"),
+                           "--no-plots"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "3 cables cradled" in proc.stdout and "time integration to t = 0.3 s, steady from" in proc.stdout
+    assert proc.stdout.count("  cable ") == 3
