@@ -173,8 +173,8 @@ def start_tensions(centreline, share_rope, offsets_m, clearance_m: float, weight
     A cable of the arrangement that rests on the others only (``offsets_m`` inside the clearance
     ``clearance_m``: the triangle's top one) slides on them without friction (``contact.cable_friction``
     0, the default; with friction between the cables this is only a start) and touches no wall, so
-    only its weight along the route changes
-    its tension: T_free = T_b/n + w (z(s) - z(s_0)), at least 0. The cables on the wall carry the
+    only its weight along the route changes its tension: T_free = T_b/n + w (z(s) - z(s_0)), at
+    least 0 (z the centreline's height, s_0 the trailing end's place). The cables on the wall carry the
     rest of the bundle's rope, n·T_share(s) (``share_rope``: one cable's share with μ times the
     weight correction factor, back tension T_b/n), in equal parts. With every cable on the wall
     (cradled) each starts at T_share. Starting every cable at T_share instead left the top one of a
