@@ -506,9 +506,6 @@ def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
     mesh = plan_cable_mesh(sc, conduit, rope, refine)
     n_el = mesh.elements
 
-    def tension_fn(s):
-        return np.interp(s, rope.s_conduit_m, rope.tension_N)
-
     tension_fns = start_tensions(centre, rope, offsets, sc.conduit.inner_radius_m - c.radius_m, w, back)
 
     # the arrangement turned, station by station, to the lateral load the share rope puts on a cable
