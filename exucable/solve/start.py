@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["SteadyStart", "steady_start", "hermite_state", "nested_start", "NESTED_MAX_BENDING_LENGTHS"]
+__all__ = ["SteadyStart", "steady_start", "hermite_state", "nested_start", "resolves_bend_ends",
+           "NESTED_MAX_BENDING_LENGTHS"]
 
 #: The nested start is taken only where the coarse mesh's elements are at most this many bending
 #: lengths √(EJ/T) long [-]. Longer elements do not resolve the bend ends' boundary layer, and the
@@ -64,6 +65,12 @@ def hermite_state(q, node_x_m, x_m) -> np.ndarray:
     return np.hstack([r, d])
 
 
+def resolves_bend_ends(mesh) -> bool:
+    """Whether a coarse mesh plan (:class:`exucable.scenario.mesh.MeshPlan`) is fine enough for the
+    nested start: elements at most :data:`NESTED_MAX_BENDING_LENGTHS` bending lengths long."""
+    return mesh is None or mesh.element_length_m <= NESTED_MAX_BENDING_LENGTHS * mesh.bending_length_m
+
+
 def nested_start(fine, coarse) -> tuple[np.ndarray, np.ndarray] | None:
     """The start of ``fine``'s steady solve from ``coarse``'s solved state: the system's ODE2 and
     algebraic coordinates (:class:`exucable.solve.steady.SteadySolver`'s ``warm_start``).
@@ -77,8 +84,7 @@ def nested_start(fine, coarse) -> tuple[np.ndarray, np.ndarray] | None:
     the coarse elements are too long for the bends' boundary layers
     (:data:`NESTED_MAX_BENDING_LENGTHS`): the fine solve then starts from the rope.
     """
-    mesh = coarse.mesh
-    if mesh is not None and mesh.element_length_m > NESTED_MAX_BENDING_LENGTHS * mesh.bending_length_m:
+    if not resolves_bend_ends(coarse.mesh):
         return None
     lay_f, lay_c = fine.layout, coarse.layout
     X_f, X_c = lay_f.node_x_m, lay_c.node_x_m
