@@ -1,9 +1,9 @@
 """Starts of a solve taken from another solve's state.
 
 - The dynamic run's start from a steady solve (``solver.start_from = "steady"``,
-  :func:`steady_start`; several cables: :func:`bundle_steady_start`). Its own module: it builds and solves a steady-mode model
-  (:mod:`exucable.solve.steady`) for the dynamic run (:mod:`exucable.solve.dynamic`), which neither
-  of those should import.
+  :func:`steady_start`; several cables: :func:`bundle_steady_start`). Its own module: it builds and
+  solves a steady-mode model (:mod:`exucable.solve.steady`) for the dynamic run
+  (:mod:`exucable.solve.dynamic`), which neither of those should import.
 - The steady solve's start on a fine mesh from the coarse mesh's solved state (nested iteration,
   :func:`nested_start`): an ANCF cable element's centreline is a cubic Hermite curve of its material
   coordinate, so a fine mesh whose nodes lie on the coarse one's elements (each coarse element split
