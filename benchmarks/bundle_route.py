@@ -52,6 +52,11 @@ end_time = 1.0
 """
 
 
+def _num(value, fmt: str, unit: str = "") -> str:
+    """A summary number formatted, or "n/a" where the run gave none (a failed solve's None)."""
+    return "n/a" if value is None else f"{value:{fmt}}{unit}"
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--count", type=int, default=3)
@@ -88,21 +93,25 @@ def main(argv=None) -> int:
     t1, tn = statistics.median(one["times"]), statistics.median(many["times"])
     c1, cn = statistics.median(one["cpu"]), statistics.median(many["cpu"])
     s1, sn = one["summary"], many["summary"]
-    b = sn["bundle"]
+    b = sn.get("bundle") or {}
     print(f"route {5 * straight + bends_m:.0f} m (straights {straight:.4g} m, 4 bends), whole process, "
           f"median of {args.repeat}:")
-    print(f"  1 cable : {t1:7.2f} s wall, {c1:7.2f} s CPU, status {s1['status']}, pull {s1['pull_force_N']:.6g} N, "
+    print(f"  1 cable : {t1:7.2f} s wall, {c1:7.2f} s CPU, status {s1['status']}, pull {_num(s1['pull_force_N'], '.6g')} N, "
           f"{s1['mesh']['elements']} elements, {s1['newton_iterations']} Newton iterations")
-    print(f"  {args.count} cables: {tn:7.2f} s wall, {cn:7.2f} s CPU, status {sn['status']}, pull {sn['pull_force_N']:.6g} N, "
-          f"{sn['mesh']['elements']} elements each ({sn['mesh']['element_length_m']:.3g} m, {sn['mesh']['check_points_per_element']} check points), {sn['newton_iterations']} Newton iterations "
-          f"({sn['message']})")
+    print(f"  {args.count} cables: {tn:7.2f} s wall, {cn:7.2f} s CPU, status {sn['status']}, pull {_num(sn['pull_force_N'], '.6g')} N, "
+          f"{sn['mesh']['elements']} elements each ({sn['mesh']['element_length_m']:.3g} m, {sn['mesh']['check_points_per_element']} check points), {sn['newton_iterations']} Newton iterations"
+          + (f" ({sn['message']})" if sn["status"] == "ok" else ""))
     print(f"  ratio bundle / one cable: {tn / t1:.2f}x wall, {cn / c1:.2f}x CPU; target ≤ 60 s whole process: "
           f"{'met' if tn <= 60.0 else 'NOT met'} (wall), {'met' if cn <= 60.0 else 'NOT met'} (CPU)")
-    print(f"  weight correction factor {b['weight_correction_factor']:.5g} (calculators' "
-          f"{b['formula_weight_correction_factor']:.5g}); per straight: "
-          + ", ".join(f"{st['weight_correction_factor']:.4g}" if st['weight_correction_factor'] is not None else "n/a"
-                      for st in b["straights"]))
-    print("  pull shares: " + ", ".join(f"{100 * c['pull_share']:.1f} %" for c in b["cables"]))
+    if sn["status"] != "ok":     # a failed run's state is not the steady pull: no factor or shares from it
+        print(f"  the {args.count}-cable run is NOT a steady pull (no weight correction or pull shares): "
+              f"status {sn['status']}: {sn['message']}")
+        return 0
+    print(f"  weight correction factor {_num(b.get('weight_correction_factor'), '.5g')} (calculators' "
+          f"{_num(b.get('formula_weight_correction_factor'), '.5g')}); per straight: "
+          + ", ".join(_num(st.get("weight_correction_factor"), ".4g") for st in b.get("straights") or []))
+    print("  pull shares: " + ", ".join(_num(None if c.get("pull_share") is None else 100 * c["pull_share"], ".1f", " %")
+                                       for c in b.get("cables") or []))
     return 0
 
 

@@ -27,9 +27,13 @@ contact kernel, our coupling's and the pseudo-time spring's user functions, the 
 time): the residual, the ODE2 Jacobian with and without the loads' Jacobian, our contact
 coupling's user functions within them, and one whole one-iteration static solve.
 
-Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing]``;
+Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing] [--compare-cold]``;
 ``--clearance-spacing`` solves the longest route's rope with clearance at a 2 cm node spacing and at
 the default rule's, with the pulling force's change and the CPU time of each.
+``--compare-cold`` runs each length a second time with the solved mesh started from the rope start
+instead of the error bar's coarse solve (steady mode's nested start), in a process of its own right
+after, and prints the two side by side (Newton iterations, CPU of the solves and of the whole process,
+the pulling forces' difference).
 ``--quick`` is a smoke run (a 200 m and a 400 m route).
 """
 
@@ -104,19 +108,19 @@ class _Clock:
 
 class _Timed:
     """Wall and CPU time [s] summed over the calls of the functions it wraps, per stage name,
-    and the outcomes of the steady solves (main solve first, then the error bar's coarse one)."""
+    and the outcomes of the steady solves by stage."""
 
     def __init__(self):
-        self.wall, self.cpu, self.solves = {}, {}, []
+        self.wall, self.cpu, self.solves = {}, {}, {}
         self._inside = set()
 
     def wrap(self, module, name: str, stage):
-        """Replace ``module.name`` by a timed copy; ``stage(call_number)`` names the stage of a call."""
+        """Replace ``module.name`` by a timed copy; ``stage(call_number, kwargs)`` names the stage of a call."""
         f = getattr(module, name)
         calls = [0]
 
         def timed(*args, **kwargs):
-            key = stage(calls[0])
+            key = stage(calls[0], kwargs)
             calls[0] += 1
             if key in self._inside:     # a call within a timed call of the same stage: counted there
                 return f(*args, **kwargs)
@@ -129,20 +133,21 @@ class _Timed:
             self.wall[key] = self.wall.get(key, 0.0) + time.perf_counter() - w
             self.cpu[key] = self.cpu.get(key, 0.0) + time.process_time() - c
             if name == "solve_steady":
-                self.solves.append(out)
+                self.solves[key] = out
             return out
 
         setattr(module, name, timed)
 
 
-def one_case(length_m: float, figures: bool = True) -> dict:
+def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
     """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints).
 
     Stages: import, parse, build (every model built, the rope references included), of it the
     references (the centreline rope's solves and the rope with clearance), solve (the steady
     solve), error bar (the second steady solve on the coarse mesh), post (the rest of
     ``run_scenario``: tension profile, check-point loads, pressure, bends, trust), write (CSV and
-    JSON), figures; wall and CPU time of each."""
+    JSON), figures; wall and CPU time of each. ``cold``: the solved mesh from the rope start, not
+    from the error bar's coarse solve (``--compare-cold``)."""
     clock = _Clock()
     from exucable.output.results import write_results
     from exucable.plots.results import plot_pressure, plot_pull_force, plot_tension_profile
@@ -151,17 +156,21 @@ def one_case(length_m: float, figures: bool = True) -> dict:
     import exucable.model.build as build
     import exucable.quasistatic.clearance as clearance
     import exucable.quasistatic.rope as rope
+    import exucable.solve.start as start
     import exucable.solve.steady as steady
+    if cold:
+        start.nested_start = lambda fine, coarse: None     # run.py imports it at call time
     clock.lap("import_s")
     sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
     clock.lap("parse_s")
     # run_scenario and the error bar import these at call time: the timed copies are the ones called
     timed = _Timed()
-    timed.wrap(build, "build_model", lambda i: "build_s")
-    timed.wrap(steady, "solve_steady", lambda i: "solve_s" if i == 0 else "error_bar_s")
+    timed.wrap(build, "build_model", lambda i, kw: "build_s")
+    # run.py's main solve is the one with a progress bar; the error bar's coarse solve has none
+    timed.wrap(steady, "solve_steady", lambda i, kw: "solve_s" if "progress" in kw else "error_bar_s")
     for module, name in ((rope, "solve_rope"), (rope, "rope_pull_force_N"), (rope, "solve_rope_for_pull_force"),
                          (clearance, "solve_rope_with_clearance")):
-        timed.wrap(module, name, lambda i: "references_s")
+        timed.wrap(module, name, lambda i, kw: "references_s")
     res = run_scenario(sc, None, plots=False)
     clock.lap("run_s")
     s = res.summary
@@ -187,22 +196,24 @@ def one_case(length_m: float, figures: bool = True) -> dict:
         shutil.rmtree(out, ignore_errors=True)
     for k in ("write_s", "figures_s"):
         wall[k], cpu[k] = clock.wall[k], clock.cpu[k]
-    bar = timed.solves[1] if len(timed.solves) > 1 else None
+    bar = timed.solves.get("error_bar_s")
     return {"length_m": length_m, "status": s["status"], "message": s["message"],
             # the solved mesh's (steady mode refines the rule's; the error bar solves the rule's)
             "elements": s["mesh"]["elements"],
             "check_points": s["mesh"]["elements"] * s["mesh"]["check_points_per_element"],
             "newton_iterations": s["newton_iterations"], "steps": s["steps"],
             "error_bar_newton_iterations": bar.newton_iterations if bar is not None else 0,
+            "started_from": timed.solves["solve_s"].started_from if "solve_s" in timed.solves else "-",
             "kernel_s": s["kernel_time_s"], "pull_force_N": s["pull_force_N"],
             "rope_clearance_pull_force_N": s["rope_clearance_pull_force_N"],
             "rope_pull_force_N": s["rope_pull_force_N"],
             "cpu_s": cpu, "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **wall}
 
 
-def in_child(length_m: float, figures: bool) -> dict:
+def in_child(length_m: float, figures: bool, cold: bool = False) -> dict:
     """:func:`one_case` in a fresh process; adds the whole process's wall time ``process_s``."""
-    cmd = [sys.executable, __file__, "--case", f"{length_m:g}"] + ([] if figures else ["--no-figures"])
+    cmd = ([sys.executable, __file__, "--case", f"{length_m:g}"] + ([] if figures else ["--no-figures"])
+           + (["--cold"] if cold else []))
     t0 = time.perf_counter()
     cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     done = subprocess.run(cmd, capture_output=True, text=True, check=False)
@@ -225,7 +236,8 @@ def report(r: dict) -> str:
     vs = f"{100 * (F / Fc - 1):+.2f} %" if F is not None and Fc else "-"
     return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process CPU {whole:6.2f} s (wall {r['process_s']:6.2f} s)  "
             f"elements {r['elements']:5d}  check points {r['check_points']:7d}  Newton {r['newton_iterations']:4d} "
-            f"({r['steps']} pseudo-time steps; error bar's coarse solve {r['error_bar_newton_iterations']})  "
+            f"({r['steps']} pseudo-time steps, from the {r['started_from']}; error bar's coarse solve "
+            f"{r['error_bar_newton_iterations']})  "
             f"peak RSS {r['peak_rss_MB']:5.0f} MB\n"
             f"{'':9s}CPU per stage [s]: {stages}  (outside them: interpreter start and exit "
             f"{whole - sum(cpu[k] for k in STAGES):5.2f}); of the build, the rope references {cpu['references_s']:6.2f}\n"
@@ -233,6 +245,23 @@ def report(r: dict) -> str:
             f"of which contact kernel (wall) {1e3 * r['kernel_s'] / n:6.1f} ms;  "
             f"F {'-' if F is None else f'{F:.1f}'} N, vs rope with clearance {vs}"
             + (f"\n{'':9s}{r['message']}" if r["message"] else ""))
+
+
+def cold_table(pairs) -> str:
+    """Markdown table of ``--compare-cold``: each length's run with the solved mesh started from the
+    coarse solve (nested) and from the rope start (cold), in processes run one after the other."""
+    lines = ["| route | Newton, solve (nested / cold) / error bar | solve CPU [s] nested / cold | "
+             "solve + error bar CPU [s] nested / cold (ratio) | whole process CPU [s] nested / cold (ratio) | "
+             "F nested − cold [N] |", "|---|---|---|---|---|---|"]
+    for r, c in pairs:
+        both = lambda x: x["cpu_s"]["solve_s"] + x["cpu_s"]["error_bar_s"]
+        dF = (r["pull_force_N"] - c["pull_force_N"]) if r["pull_force_N"] is not None and c["pull_force_N"] is not None else float("nan")
+        lines.append(f"| {r['length_m'] / 1000:g} km | {r['newton_iterations']} / {c['newton_iterations']} / "
+                     f"{r['error_bar_newton_iterations']} | {r['cpu_s']['solve_s']:.2f} / {c['cpu_s']['solve_s']:.2f} | "
+                     f"{both(r):.2f} / {both(c):.2f} ({both(r) / both(c):.2f}) | "
+                     f"{r['process_cpu_s']:.2f} / {c['process_cpu_s']:.2f} ({r['process_cpu_s'] / c['process_cpu_s']:.2f}) | "
+                     f"{dF:+.2g} |")
+    return "\n".join(lines)
 
 
 def profile(length_m: float, top: int = 25) -> None:
@@ -389,16 +418,24 @@ def main() -> None:
     ap.add_argument("--newton-parts", action="store_true",
                     help="also the CPU time of each part of one Newton iteration on the longest route")
     ap.add_argument("--no-figures", action="store_true", help="skip the figures stage")
+    ap.add_argument("--compare-cold", action="store_true",
+                    help="also run each length with the solved mesh from the rope start (not from the error "
+                         "bar's coarse solve) in a process of its own, and print the two side by side")
+    ap.add_argument("--cold", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.case:
-        print(json.dumps(one_case(float(args.case), figures=not args.no_figures)))
+        print(json.dumps(one_case(float(args.case), figures=not args.no_figures, cold=args.cold)))
         return
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
-    rows = []
+    rows, pairs = [], []
     for L in lengths:
         r = in_child(L, figures=not args.no_figures)
         print(report(r), flush=True)
+        if args.compare_cold:
+            c = in_child(L, figures=not args.no_figures, cold=True)
+            print(report(c), flush=True)
+            pairs.append((r, c))
         if r["status"] != "failed":
             solves = r["cpu_s"]["solve_s"] + r["cpu_s"]["error_bar_s"]
             rows.append((L, r["process_cpu_s"], solves, r["process_cpu_s"] - solves, r["process_s"]))
@@ -411,6 +448,8 @@ def main() -> None:
               f"but the solves ∝ L^{fit(rest):.2f}; whole process wall ∝ L^{fit(w):.2f}; over "
               f"{', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
         print(f"share of everything but the solve at {L[-1]:g} m (CPU time): {100 * rest[-1] / cpu[-1]:.0f} %")
+    if pairs:
+        print(cold_table(pairs))
     if args.clearance_spacing:
         clearance_spacing(lengths[-1])
     if args.newton_parts:

@@ -225,9 +225,22 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     bar = None
     if sp.mode == "steady":
         from .output.snapshots import SnapshotRecorder
+        from .solve.start import nested_start, resolves_bend_ends
         from .solve.steady import SteadySettings, solve_steady
+        settings = SteadySettings.from_solver(sp)
+        coarse_out, warm = None, None
+        if error_bar and coarse is not None and resolves_bend_ends(coarse.mesh):
+            # nested iteration: the error bar's coarse solve first, from the rope start; the solved
+            # mesh then starts from its state, subdivided exactly (the rope start if that fails).
+            # Otherwise the solved mesh first: the coarse solve's kernel buffers are not held
+            # through the larger solve (10 km: +45 MB peak)
+            coarse_out = solve_steady(coarse, settings=settings)
+            if coarse.coupling is not None:
+                coarse.coupling.forget_evaluation()   # its last kernel pass: not needed, and large on long routes
+            if coarse_out.status != "failed":
+                warm = nested_start(model, coarse)
         out = solve_steady(model, progress=Progress(1.0, label=sc.name, enabled=not quiet),
-                           settings=SteadySettings.from_solver(sp))
+                           settings=settings, warm_start=warm)
         h = out.history.arrays()
         # the steady state is the result: written as the one snapshot, so that a cross-check
         # needs the files only
@@ -244,7 +257,8 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         if error_bar and out.status != "failed" and len(h["time_s"]):
             from .solve.error_bar import steady_error_bar
             quantity = steady_quantity(model)
-            bar = steady_error_bar(sc, model, float(h[quantity][-1]), quantity, coarse=coarse, refine=solve_refine)
+            bar = steady_error_bar(sc, model, float(h[quantity][-1]), quantity, coarse=coarse, refine=solve_refine,
+                                   coarse_outcome=coarse_out)
     else:
         progress = Progress(sp.end_time_s, label=sc.name, enabled=not quiet)
         snapshot_times = sc.output.times_s(sp.end_time_s)

@@ -28,6 +28,7 @@ SCRIPTS = {
     "benchmarks/long_routes.py": "everything but the solve",
     "benchmarks/naive_baseline.py": "| | whole process [s] | simulation [s]",
     "benchmarks/newton_cost.py": "| case | check points | steps | Newton its",
+    "benchmarks/newton_floor.py": "| part (CPU per call, median) | before [ms] | after [ms]",
     "benchmarks/newton_trace.py": "| accepted steps | rejected attempts",
     "benchmarks/run_examples.py": "| example | status | wall [s]",
     "benchmarks/steady_error_bar.py": "| case | elements (coarse) | F [N] | u [N] (u/F)",
@@ -50,6 +51,7 @@ SCRIPTS = {
     "benchmarks/pull_in_history.py": "CPU per point [s]",
     "studies/bundle_bend_study.py": "p/formula",
     "studies/bundle_jam_study.py": "F/formula",
+    "studies/bundle_physics_study.py": "| place | arrangement | D/d | μ_c |",
 }
 
 # the slowest smoke runs, 10-35 s each on the shared 2-core machine (several processes each importing

@@ -116,3 +116,46 @@ def test_one_kernel_pass_per_newton_iteration():
     assert cb.kernel_evaluations == cb.force_calls + cb.onset_evaluations
     # the held damping onset is read off the converged state's own pass: one pass more, at t = 0
     assert ca.onset_evaluations == cb.onset_evaluations == 1
+
+
+def _reference_triplets(coupling, res, f_q, f_v):
+    """The contact Jacobian's triplets by the plain formula: -(f_q ∂Q/∂q + f_v ∂Q/∂q̇) per element
+    block, summed with scipy where blocks share a node, zeros dropped, sorted by (row, column)."""
+    import scipy.sparse as sp
+    from exucable.contact import block_sparsity
+
+    blocks = -(f_q * res.jac_q_blocks + f_v * res.jac_qt_blocks)
+    rows, cols = block_sparsity(res.jac_q_blocks.shape[0])
+    m = sp.coo_matrix((blocks.reshape(-1), (rows, cols)), shape=(coupling.n, coupling.n)).tocsr()
+    m.sum_duplicates()
+    m.eliminate_zeros()
+    m = m.tocoo()
+    order = np.lexsort((m.col, m.row))
+    return np.column_stack([m.row[order], m.col[order], m.data[order]]).astype(float)
+
+
+@pytest.mark.parametrize("mode", ["dynamic", "steady"])
+def test_contact_jacobian_triplets_are_the_plain_formula_bit_for_bit(mode):
+    """The triplets handed to Exudyn (summed in place, zeros dropped by a record gather, the
+    q̇-term skipped when it is zero) equal the plain formula's to the last bit, at Newton's
+    factors of both solvers (f_v = 0 in a static solve; an f_q that is no power of two)."""
+    sc = make_scenario(conduit={"inner_radius": 0.0035, "path": [{"straight": 1.0},
+                                                                 {"bend": 90.0, "radius": 0.5, "turn": "up"}]},
+                       cable=dict(radius=0.0025, density=1000.0, youngs_modulus=1.0e9, elements=8),
+                       contact={"friction": 0.2, "check_points_per_element": 10},
+                       pull={"speed": 0.1, "back_tension": 50.0}, gravity={"g": G},
+                       solver={"mode": mode, "end_time": 0.03, "step": 0.01})
+    model = build_model(sc)
+    c = model.coupling
+    q, v = model.coordinates()
+    rng = np.random.default_rng(1)
+    # a state pressed into the wall along part of the cable (some blocks zero, some not)
+    qa = q.reshape(-1) + 2e-4 * rng.standard_normal(c.n)
+    va = v.reshape(-1) + 1e-6 * rng.standard_normal(c.n)
+    res = c.kernel.evaluate(qa, va, jacobian=True, held_onset=c.held_onset)
+    assert res.n_in_contact > 0
+    free = (res.jac_q_blocks == 0.0).all(axis=(1, 2))
+    assert free.any() and not free.all()      # some zeros to drop, some values to keep
+    for f_q, f_v in [(1.0, 0.0), (0.7, 0.0), (1.0, 37.3), (0.3, 1.1e3)]:
+        got = c.jacobian_triplets(res, f_q, f_v).copy()
+        np.testing.assert_array_equal(got, _reference_triplets(c, res, f_q, f_v))

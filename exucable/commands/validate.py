@@ -1,5 +1,5 @@
-"""``exucable validate``: the paper's examples (default) and the published industry pulls against their
-references, one table each."""
+"""``exucable validate``: the paper's examples (default), the published industry pulls and three cables
+in one duct (``--suite bundle``) against their references, one table each."""
 
 from __future__ import annotations
 
@@ -10,18 +10,20 @@ from ..validation.paper import CASES, MODES, format_table, validate
 
 __all__ = ["add_arguments", "main", "SUITES"]
 
-SUITES = ("paper", "industry", "all")
+SUITES = ("paper", "industry", "bundle", "all")
 
 
 def add_arguments(p) -> None:
     p.add_argument("--suite", choices=SUITES, default="paper",
                    help="paper: the paper's examples (default); industry: the published worked pulls of "
-                        "scenarios/industry (minutes per route); all: both")
+                        "scenarios/industry (minutes per route); bundle: three cables in one duct against "
+                        "the rigid-circle closed forms (minutes); all: the three")
     p.add_argument("--fast", action="store_true",
                    help="paper: coarse variants (scenarios/fast), looser tolerances; industry: the default mesh "
-                        "only (no refined run, no mesh check)")
+                        "only (no refined run, no mesh check); bundle: the unit tests' coarse meshes, fewer D/d")
     p.add_argument("--out", "-o", default="validation",
-                   help="output directory (default: validation/; the industry suite writes into its industry/)")
+                   help="output directory (default: validation/; the industry and bundle suites write into "
+                        "industry/ and bundle/ there)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress output")
     p.add_argument("--case", action="append", choices=list(CASES),
                    help="paper suite: run only these cases (repeatable)")
@@ -87,6 +89,19 @@ def _industry(args) -> int:
     return 1 if iv.failures else 0
 
 
+def _bundle(args) -> int:
+    from ..validation.bundle import format_bundle_table, validate_bundle
+    out = Path(args.out) / "bundle"
+    bv = validate_bundle(fast=args.fast, out_dir=out, progress=None if args.quiet else _say)
+    print(format_bundle_table(bv))
+    for f in bv.failures:
+        print(f"bundle: FAIL {f}", file=sys.stderr)
+    n_pass = sum(c.passed for c in bv.checks)
+    print(f"\nbundle: {n_pass}/{len(bv.checks)} checks passed in {bv.cpu_time_s:.1f} s CPU ({bv.wall_time_s:.1f} s "
+          f"wall); table in {out}/")
+    return 1 if bv.failures else 0
+
+
 def main(args) -> int:
     from .compile import announce_compiling
 
@@ -96,4 +111,6 @@ def main(args) -> int:
         status = max(status, _paper(args))
     if args.suite in ("industry", "all"):
         status = max(status, _industry(args))
+    if args.suite in ("bundle", "all"):
+        status = max(status, _bundle(args))
     return status

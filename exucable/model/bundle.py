@@ -3,7 +3,8 @@
 One ANCF cable per conductor, each with the scenario's cable data, laid along the conduit in the
 arrangement's cross-section (:func:`arrangement_offsets`) turned, station by station, toward the
 lateral load on a cable (:func:`load_turn_rad`: in a bend the tension presses the bundle onto the
-bend's inner wall), and pre-tensioned to the rope solution of one cable carrying its share. Each cable has its own wall contact (the cable-conduit kernel in its
+bend's inner wall), and pre-tensioned to the rope solution of one cable carrying its share, except
+that a cable resting on the others only starts at its back tension (:func:`start_tensions`). Each cable has its own wall contact (the cable-conduit kernel in its
 steady-sliding form) and one more coupling carries the contact between the cables
 (:class:`~exucable.contact.cable_pairs.CableContactKernel`).
 
@@ -39,7 +40,7 @@ from .generic import add_user_force_object
 from .layout import CableLayout, lay_cable, plan_cable_mesh, steady_lead_out_m
 from .rig import Drive, add_drive, add_end_force
 
-__all__ = ["BundleModel", "arrangement_offsets", "load_turn_rad", "build_bundle_model", "check_bundle_supported",
+__all__ = ["BundleModel", "arrangement_offsets", "load_turn_rad", "start_tensions", "build_bundle_model", "check_bundle_supported",
            "bundle_arrangement", "bundle_report", "bundle_tension_profile", "straight_weight_correction",
            "bundle_sections", "bundle_cross_sections", "bundle_tension_along_conduit"]
 
@@ -169,6 +170,37 @@ def load_turn_rad(centreline, s_m, tension_N, weight_per_length_N_per_m: float, 
         k = np.exp(-0.5 * (np.arange(-half, half + 1) / sigma) ** 2)
         phi = np.convolve(np.pad(phi, half, mode="edge"), k / k.sum(), mode="valid")
     return phi
+
+
+def start_tensions(centreline, share_rope, offsets_m, clearance_m: float, weight_per_length_N_per_m: float,
+                   back_tension_N: float) -> list:
+    """Each cable's start tension, s along the pull-oriented centreline [m] → T [N], one per cable.
+
+    A cable of the arrangement that rests on the others only (``offsets_m`` inside the clearance
+    ``clearance_m``: the triangle's top one) slides on them without friction (``contact.cable_friction``
+    0, the default; with friction between the cables this is only a start) and touches no wall, so
+    only its weight along the route changes its tension: T_free = T_b/n + w (z(s) - z(s_0)), at
+    least 0 (z the centreline's height, s_0 the trailing end's place). The cables on the wall carry the
+    rest of the bundle's rope, n·T_share(s) (``share_rope``: one cable's share with μ times the
+    weight correction factor, back tension T_b/n), in equal parts. With every cable on the wall
+    (cradled) each starts at T_share. Starting every cable at T_share instead left the top one of a
+    triangle stretched by the bottom ones' strain (1.2 % against 0.07 % at the head of the 100 m
+    route), which the solve must undo by sliding it along the whole route.
+    """
+    from .layout import extended_point
+
+    s_r = np.asarray(share_rope.s_conduit_m, dtype=float)
+    T_share = np.asarray(share_rope.tension_N, dtype=float)
+    radius = np.hypot(offsets_m[:, 0], offsets_m[:, 1])
+    on_wall = radius >= clearance_m * (1.0 - 1e-6)
+    n = len(offsets_m)
+    if on_wall.all() or not on_wall.any():
+        return [lambda s: np.interp(s, s_r, T_share)] * n
+    z = extended_point(centreline, s_r)[:, 2]
+    T_free = np.maximum(back_tension_N + weight_per_length_N_per_m * (z - z[0]), 0.0)
+    n_free = n - int(np.count_nonzero(on_wall))
+    T_wall = np.maximum((n * T_share - n_free * T_free) / (n - n_free), 0.0)
+    return [(lambda s, T=(T_wall if wall else T_free): np.interp(s, s_r, T)) for wall in on_wall]
 
 
 @dataclass
@@ -474,8 +506,7 @@ def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
     mesh = plan_cable_mesh(sc, conduit, rope, refine)
     n_el = mesh.elements
 
-    def tension_fn(s):
-        return np.interp(s, rope.s_conduit_m, rope.tension_N)
+    tension_fns = start_tensions(centre, rope, offsets, sc.conduit.inner_radius_m - c.radius_m, w, back)
 
     # the arrangement turned, station by station, to the lateral load the share rope puts on a cable
     # (its rigid-circle rest under that load): in a bend the tension presses the bundle to the
@@ -497,14 +528,14 @@ def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
     # they are laid, and there they are the rigid circles (a gap held open at the eye is not the pull's)
     L_e = L_cable / n_el
     layouts = []
-    for (h0, v0), (h1, v1) in zip(offsets, laid):
+    for (h0, v0), (h1, v1), cable_tension_fn in zip(offsets, laid, tension_fns):
         def offset_fn(s, h0=h0, v0=v0, h1=h1, v1=v1):
             eh, ev = _cross_section_frame(centre, s)
             f = np.clip((centre.length_m - np.asarray(s, dtype=float)) / L_e, 0.0, 1.0)[:, None]
             h, v = h0 + f * (h1 - h0), v0 + f * (v1 - v0)
             phi = np.interp(s, s_grid, turn)[:, None]
             return (h * np.cos(phi) - v * np.sin(phi)) * eh + (h * np.sin(phi) + v * np.cos(phi)) * ev
-        layouts.append(lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, tension_fn,
+        layouts.append(lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, cable_tension_fn,
                                  offset_fn, lead_out_m=lead_out))
     Le = layouts[0].element_length_m
     layout = BundleLayout(element_length_m=Le, cables=layouts, n_cables=n)

@@ -59,9 +59,13 @@ class ContactCoupling:
         rows, cols = block_sparsity(kernel.n_elements)
         lin = rows.astype(np.int64) * self.n + cols
         unique, self._inverse = np.unique(lin, return_inverse=True)
-        self._rows = (unique // self.n).astype(float)
-        self._cols = (unique % self.n).astype(float)
         self._n_unique = unique.size
+        # the triplets (row, column, value) handed to Exudyn, rows and columns filled once; a row is
+        # also one 24-byte record, so that dropping the zero values is one gather of records
+        self._triplets = np.zeros((self._n_unique, 3))
+        self._triplets[:, 0] = unique // self.n
+        self._triplets[:, 1] = unique % self.n
+        self._records = self._triplets.view(np.dtype((np.void, 24))).reshape(-1)
         self.kernel_time_s = 0.0
         self.user_time_s = 0.0
         self.force_calls = 0
@@ -153,15 +157,35 @@ class ContactCoupling:
         qa, va = self.absolute(q, q_t)
         res = self._evaluate(t, qa, va, jacobian=True)
         self.jacobian_calls += 1
-        # LHS derivative: the contact force is on the right-hand side, hence the minus sign.
-        blocks = -(f_q * res.jac_q_blocks + f_v * res.jac_qt_blocks)
-        vals = np.bincount(self._inverse, weights=blocks.reshape(-1), minlength=self._n_unique)
-        nz = vals != 0.0  # Exudyn's sparse triplets must not contain zeros
         m = exu.MatrixContainer()
-        if nz.any():
-            trip = np.column_stack([self._rows[nz], self._cols[nz], vals[nz]])
+        trip = self.jacobian_triplets(res, f_q, f_v)
+        if trip.shape[0]:
             m.SetWithSparseMatrix(trip, self.n, self.n, False)
         else:
             m.Initialize(self.n, self.n, False)
         self.user_time_s += time.perf_counter() - t0
         return m
+
+    def jacobian_triplets(self, res, f_q: float, f_v: float) -> np.ndarray:
+        """Sparse triplets (row, column, value) of the LHS derivative ``-(f_q ∂Q/∂q + f_v ∂Q/∂q̇)``
+        of the kernel result ``res``, the element blocks summed where they share a node, zero
+        values left out (Exudyn leaves an element's zero entries out of the system matrix too, so
+        the sparsity pattern, and with it the LU's ordering, is the one Exudyn's elements make).
+
+        Without a velocity term (``f_v = 0``, or the steady kernel's zero q̇-blocks) the blocks
+        are ``(-f_q) ∂Q/∂q``: the same values bit for bit as the general formula (a product's
+        rounding does not depend on its sign; the only difference, a zero's sign, is dropped).
+        The array returned is reused by the next call.
+        """
+        jq, jv = res.jac_q_blocks, res.jac_qt_blocks
+        if f_v == 0.0 or jv is None or not jv.any():
+            blocks = (-f_q) * jq
+        else:
+            # LHS derivative: the contact force is on the right-hand side, hence the minus sign.
+            blocks = -(f_q * jq + f_v * jv)
+        vals = np.bincount(self._inverse, weights=blocks.reshape(-1), minlength=self._n_unique)
+        self._triplets[:, 2] = vals
+        nz = vals != 0.0
+        if nz.all():
+            return self._triplets
+        return self._records[nz].view(float).reshape(-1, 3)

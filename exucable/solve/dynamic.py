@@ -42,6 +42,7 @@ class SolveOutcome:
     newton_iterations: int
     jacobian_updates: int
     wall_time_s: float
+    started_from: str = "rope"   # a steady solve's start that converged: "rope" or "coarse mesh"
 
 
 class Progress:

@@ -93,14 +93,17 @@ def combine(value_N: float, coarse_N: float, elements: int, coarse_elements: int
 
 
 def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None,
-                     refine: float = 1.0) -> SteadyErrorBar:
+                     refine: float = 1.0, coarse_outcome=None) -> SteadyErrorBar:
     """Solve ``scenario`` again on a mesh ``COARSE_RATIO`` times coarser than ``model``'s and state
     the uncertainty of ``value_N`` (the solved model's ``quantity``: ``"pull_force_N"`` or
     ``"trailing_tension_N"``) [N].
 
     ``coarse``: that coarser model, already built (steady mode on the mesh rule builds the rule's
     mesh first); otherwise it is built here at ``refine`` / ``COARSE_RATIO`` (``refine``: the solved
-    model's) with the solved model's check points per element.
+    model's) with the solved model's check points per element. ``coarse_outcome``: ``coarse``'s steady
+    solve, already made (steady mode solves the coarse mesh first and starts the solved mesh from
+    its state, :func:`exucable.solve.start.nested_start`), its state still the model's; otherwise
+    it is solved here from the rope start.
 
     Never raises for a coarse mesh the rule refuses or a coarse solve that fails: the result then
     has ``uncertainty_N = None`` and the method says why.
@@ -128,7 +131,11 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
     if m >= n:
         return SteadyErrorBar(None, None, solve_N, None, m, f"{head} not possible: {n} elements cannot be coarsened",
                               time.perf_counter() - t0)
-    out = solve_steady(coarse, settings=settings)
+    if coarse_outcome is None:
+        out = solve_steady(coarse, settings=settings)
+    else:
+        out = coarse_outcome
+        t0 -= out.wall_time_s   # the bar's cost includes its solve, made before this call
     if out.status == "failed":
         return SteadyErrorBar(None, None, solve_N, None, m, f"{head} failed ({out.message})", time.perf_counter() - t0)
     pull, trail, _ = steady_forces(coarse)

@@ -43,6 +43,16 @@ the one at 1/1000 of the stop tolerance (reference/README.md, "Speed"). Where it
 exact-step continuation above runs from the start.
 Where that does not converge either, the loads themselves are ramped (friction, gravity and end forces
 scaled by λ) with the increment halved on failure (:meth:`SteadySolver.ramp_loads`).
+
+A solve may instead start warm, from a state near its steady state (``warm_start``: the coarse mesh's
+solved state subdivided, :func:`exucable.solve.start.nested_start`). The phases above assume the rope
+start, far from equilibrium: their first pseudo-time steps are short (c0, an isotropic spring) because
+the start's lateral and axial misfits are large. From a warm start those steps would only creep, so
+the warm solve skips them: it runs the one-iteration continuation from the rate and axial share it
+would have reached after ``warm_start_skipped_steps`` accepted steps, with its own smaller budget
+(``max_warm_start_steps``), and no load ramp (the loads are already carried). If that does not
+converge, the solve starts again from the rope start with every phase, so that the answer does not
+depend on the start (``tests/test_nested_start.py``).
 """
 
 from __future__ import annotations
@@ -136,6 +146,18 @@ class SteadySettings:
     time_limit_s : float
         CPU time [s] the solve may take before it stops as failed (``[solver] steady_time_limit``).
         CPU, not wall: a loaded machine must not turn a converging solve into a failed one.
+    warm_start_skipped_steps : int
+        A warm start (:class:`SteadySolver`'s ``warm_start``) begins the one-iteration continuation
+        at the spring rate c0 / ``rate_fall``^k and the axial share ``axial_share`` ·
+        ``axial_release``^k, k this many [-]: the first steps' short springs are for the rope
+        start's misfit, which a warm start does not have. Measured (the nested start on
+        ``benchmarks/long_routes.py``'s 1, 2, 5 km routes, Newton iterations): k = 2: 10, 9, 10;
+        3: 7, 8, 9; 4: 13, 8, 26; 5: -, 10, 29 (k = 0 at 1 km: 12; from the rope start 19, 26, 24):
+        a softer first spring lets the first Newton step overshoot.
+    max_warm_start_steps : int
+        Pseudo-time steps (accepted and rejected) a warm start may take, the stall rule
+        (``max_one_iteration_stall``) included, before the solve starts again from the rope start [-]
+        (a warm start that converges took at most 10 on the long routes).
     """
 
     steady_residual: float = 1e-6
@@ -154,6 +176,8 @@ class SteadySettings:
     max_one_iteration_stall: int = 20
     min_continuation_step: float = 1.0 / 16.0
     time_limit_s: float = 60.0
+    warm_start_skipped_steps: int = 3
+    max_warm_start_steps: int = 20
 
     def __post_init__(self):
         for f in fields(self):
@@ -412,10 +436,16 @@ class SteadySolver:
         The stop tolerance and the continuation's rules.
     progress : Progress, optional
         Told the residual reached after every accepted pseudo-time step, closed at the end.
+    warm_start : tuple of numpy.ndarray, optional
+        The system's ODE2 and algebraic coordinates of a state near the steady state to start from
+        (:func:`exucable.solve.start.nested_start`); the model's own start (the rope's) is the
+        fallback. See the module's notes.
     """
 
-    def __init__(self, model, settings: SteadySettings = SteadySettings(), progress: Progress | None = None):
+    def __init__(self, model, settings: SteadySettings = SteadySettings(), progress: Progress | None = None,
+                 warm_start: tuple | None = None):
         self.model = model
+        self.warm_start = warm_start
         self.settings = settings
         self.progress = progress
         self.mbs = model.mbs
@@ -515,17 +545,21 @@ class SteadySolver:
         _set_scale(self.model, lam)
         self.store.saved = self.store.saved[:2] + (None,)
 
-    def relax_one_iteration(self, lam: float) -> tuple[bool, str]:
+    def relax_one_iteration(self, lam: float, skip: int = 0, max_steps: int | None = None) -> tuple[bool, str]:
         """Pseudo-time steps of one Newton iteration each at load scale ``lam`` [-] from the stored
         state, accepted while the true residual does not grow more than ``reject_growth``-fold,
-        until it is below the tolerance: converged?, and why not."""
+        until it is below the tolerance: converged?, and why not.
+
+        ``skip``: begin at the spring rate and axial share reached after that many accepted steps
+        (a warm start); ``max_steps``: the budget of steps instead of ``max_one_iteration_steps``."""
         self.at_scale(lam)
         s = self.settings
-        c = self.c0
-        self.spring.axial_share = s.axial_share
+        c = self.c0 / s.rate_fall ** skip
+        self.spring.axial_share = s.axial_share * s.axial_release ** skip
         previous, after_reject, message = np.inf, False, ""
         best, stalled = np.inf, 0
-        for _ in range(s.max_one_iteration_steps):
+        budget = s.max_one_iteration_steps if max_steps is None else max_steps
+        for _ in range(budget):
             if self.out_of_time():
                 return False, f"stopped at `{TIME_LIMIT_KEY}`"
             if stalled >= s.max_one_iteration_stall:
@@ -550,7 +584,7 @@ class SteadySolver:
             after_reject = False
             self.spring.axial_share *= s.axial_release
             previous = residual
-        return False, (f"one-iteration pseudo-time steps: no equilibrium after {s.max_one_iteration_steps} "
+        return False, (f"one-iteration pseudo-time steps: no equilibrium after {budget} "
                        f"steps{f' ({message})' if message else ''}")
 
     def relax(self, lam: float) -> tuple[bool, str]:
@@ -643,12 +677,24 @@ class SteadySolver:
         model = self.model
         status, message = "ok", ""
         outside_at_start = _outside_points(model)
-        ok, first_message = self.relax_one_iteration(1.0)
-        if not ok and not self.timed_out:
+        ok, warm_note, started_from = False, "", "rope"
+        if self.warm_start is not None:
+            ok, why = self.relax_warm()
+            if ok:
+                started_from = "coarse mesh"
+            else:
+                warm_note = f" (from the coarse mesh's state: {why}; again from the rope start)"
+                self.forget_history()
+        if not ok:
             self.store.saved = self.start
-            ok, first_message = self.relax(1.0)
+            ok, first_message = self.relax_one_iteration(1.0)
+            if not ok and not self.timed_out:
+                self.store.saved = self.start
+                ok, first_message = self.relax(1.0)
+            first_message += warm_note
         if ok:
-            message = f"{self.accepted} pseudo-time steps"
+            message = (f"{self.accepted} pseudo-time steps from the coarse mesh's state" if started_from != "rope"
+                       else f"{self.accepted} pseudo-time steps{warm_note}")
         else:
             status, message = self.ramp_loads(first_message)
         self.store.restore_as_initial()
@@ -669,23 +715,39 @@ class SteadySolver:
             self.progress.close()
         return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
                             steps=self.steps, newton_iterations=self.newton_iterations,
-                            jacobian_updates=self.jacobian_updates, wall_time_s=wall)
+                            jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from)
+
+    def relax_warm(self) -> tuple[bool, str]:
+        """The one-iteration continuation at the full loads from :attr:`warm_start`, its first
+        ``warm_start_skipped_steps`` skipped, within ``max_warm_start_steps``: converged?, and why not."""
+        s = self.settings
+        ode2, ae = self.warm_start
+        self.store.saved = (np.asarray(ode2, dtype=float), np.asarray(ae, dtype=float), None)
+        return self.relax_one_iteration(1.0, skip=s.warm_start_skipped_steps, max_steps=s.max_warm_start_steps)
+
+    def forget_history(self) -> None:
+        """Drop the accepted steps' rows (a warm start given up): the history is of the start that
+        converged; the counts of steps and Newton iterations keep every attempt."""
+        self.history = History()
+        self.accepted = 0
+        self._trace_lam, self._trace = 0.0, []
 
 
 def solve_steady(model, progress: Progress | None = None, tolerance: float | None = None,
-                 settings: SteadySettings | None = None) -> SolveOutcome:
+                 settings: SteadySettings | None = None, warm_start: tuple | None = None) -> SolveOutcome:
     """Solve ``model`` (built with ``solver.mode = "steady"``) for its steady sliding state:
     ``SteadySolver(model, settings, progress).solve()``.
 
     ``tolerance`` [-]: the stop residual relative to the rope solution's largest tension
     (:attr:`SteadySettings.steady_residual`, the scenario's ``[solver] steady_residual``; a tighter
     one shows how converged the pulling force is, ``benchmarks/steady_scale.py --tolerance-check``);
-    given, it replaces that of ``settings`` (default :class:`SteadySettings`).
+    given, it replaces that of ``settings`` (default :class:`SteadySettings`). ``warm_start``: a
+    state near the steady state to start from, the rope start the fallback (:class:`SteadySolver`).
     """
     settings = SteadySettings() if settings is None else settings
     if tolerance is not None:
         settings = replace(settings, steady_residual=float(tolerance))
-    return SteadySolver(model, settings, progress).solve()
+    return SteadySolver(model, settings, progress, warm_start=warm_start).solve()
 
 
 #: What to change when a steady solve ends in a state that is not the steady pull.
