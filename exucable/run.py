@@ -482,7 +482,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         wall_time_s=out.wall_time_s,
         build_time_s=build_s,
         mesh=model.mesh.to_dict() if model.mesh is not None else None,
-        warnings=list(model.mesh.warnings) if model.mesh is not None else [],
+        warnings=(list(model.mesh.warnings) if model.mesh is not None else []) + _jam_band_warning(sc, model),
         scenario=sc.to_dict(),
         versions=versions(),
     )
@@ -651,6 +651,16 @@ def _bundle_places(sc, report: dict, found: dict) -> list[dict]:
     pick = rows if len(rows) <= MAX_CROSS_SECTIONS else [rows[i] for i in np.linspace(0, len(rows) - 1, MAX_CROSS_SECTIONS).round().astype(int)]
     return [{"s_conduit_m": 0.5 * (r["s_conduit_start_m"] + r["s_conduit_end_m"]), "label": f"{r['kind']} {r['section']}"}
             for r in pick]
+
+
+def _jam_band_warning(sc, model) -> list[str]:
+    """The summary's warning when three cables could wedge (:func:`exucable.post.bundle.jam_band_warning`)."""
+    from .post.bundle import jam_band_warning
+
+    mu = sc.contact.static_friction if sc.contact.static_friction is not None else sc.contact.friction
+    bends = any(p.is_curved for p in model.conduit.centreline.pieces)
+    text = jam_band_warning(sc.cable.count, sc.conduit.inner_radius_m / sc.cable.radius_m, mu, bends)
+    return [text] if text else []
 
 
 def _jam_flag(sc, report: dict) -> dict:

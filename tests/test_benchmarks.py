@@ -50,6 +50,7 @@ SCRIPTS = {
     "studies/fit_engines.py": "mu_rope",
     "benchmarks/pull_in_history.py": "CPU per point [s]",
     "studies/bundle_bend_study.py": "p/formula",
+    "studies/bundle_jam_study.py": "F/formula",
     "studies/bundle_physics_study.py": "| place | arrangement | D/d | μ_c |",
 }
 

@@ -42,7 +42,7 @@ import numpy as np
 from .pressure import windowed_load
 
 __all__ = ["ACROSS_DEG", "CONTACT_TOLERANCE", "cross_section_frame", "frame_across", "cable_points", "cross_section_offsets",
-           "classify_cross_section", "arrangement_sections", "bend_pressures"]
+           "classify_cross_section", "arrangement_sections", "bend_pressures", "jam_band_warning"]
 
 #: Gap, as a fraction of the cable radius, below which two surfaces count as touching [-]. Contact
 #: acts at check points, not in every plane, and the kernel sees the other cable as the polyline of
@@ -281,3 +281,24 @@ def bend_pressures(pieces, cable_points_s_m, cable_points_force_N, cable_tension
         for k, row in enumerate(rows):
             row["bend"] = k + 1
     return rows
+
+
+def jam_band_warning(count: int, duct_over_cable_diameter: float, friction: float, bends: bool) -> str | None:
+    """One sentence when ``count`` = 3 cables at this D/d [-] could wedge: a keystone across the duct
+    stands on a wall of friction ``friction`` [-] (the static one where given) in the band of
+    :func:`exucable.quasistatic.bundle_jam.wedge_band_d_over_D`, widened by a bend's ovality where
+    the route ``bends``; None outside it. The steady sliding state never shows the keystone (its
+    friction acts along the slip, :mod:`exucable.quasistatic.bundle_jam`), so a run there says so
+    rather than a silent "ok"."""
+    from ..quasistatic.bundle_jam import BEND_OVALITY, wedge_band_d_over_D
+
+    if count != 3 or not friction > 0.0:
+        return None
+    lo, hi = wedge_band_d_over_D(friction, BEND_OVALITY if bends else 0.0)
+    r = float(duct_over_cable_diameter)
+    if not lo <= r <= hi:
+        return None
+    return (f"D/d = {r:.3g}: three cables that stop here can wedge side by side across the duct (a keystone stands "
+            f"on a wall of friction {friction:g} for D/d {lo:.3g}-{hi:.3g}{', bends 5 % oval' if bends else ''}); the "
+            "steady sliding state cannot show it (sliding friction acts along the slip); fix: keep the pull moving, "
+            "a duct outside that band (conduit.inner_radius), or the cables bound as a trefoil")

@@ -1,0 +1,204 @@
+"""The jam of three cables: the keystone statics (exucable/quasistatic/bundle_jam.py) and what the
+steady sliding bundle does in the jam range (exucable/model/bundle.py), studies/bundle_jam_study.py.
+
+The keystone's closed forms are checked against the vector balance of each circle (an independent
+check of the algebra), the frictionless case against the triangle it must fall into, and the band
+against NFPA 70 Ch. 9 Table 1 Note 2's 2.8-3.2 with the calculators' 5 % bend ovality. The simulated
+case: three cradled cables at D/d = 2.9 (inside the NEC range) round a 90° bend with gravity slide
+through it cradled, unflagged, with cable-cable forces the rigid cradle's, not a keystone's.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import exucable as xc
+from exucable.errors import ModelError
+from exucable.post.bundle import classify_cross_section, jam_band_warning
+from exucable.quasistatic.bundle_jam import (frictionless_keystone_psi_rad, keystone, keystone_friction_needed,
+                                             wedge_band_d_over_D)
+
+
+@pytest.mark.parametrize("ratio", [2.6, 2.9, 2.99])
+def test_keystone_forces_balance_each_circle(ratio):
+    """Each circle's loads sum to zero in the cross-section (to 1e-12 of p): the load p down, the
+    contact forces along the lines of centres, the wall's normal through the duct's axis and the
+    friction along the wall, at angles across the whole spread range."""
+    d, rho = 1.0, 0.5 * (ratio - 1.0)
+    lo = math.asin(0.5 * d / rho)
+    hi = min(math.pi / 2, math.asin(min(1.0, d / rho)))
+    psi = np.linspace(lo, hi, 7)
+    k = keystone(ratio, d, psi)
+    for i in range(len(psi)):
+        a, m, b = k.positions_m[i]
+        G, N, F = k.contact_force_per_load[i], k.wall_force_per_load[i], k.wall_friction_per_load[i]
+        assert np.linalg.norm(a - m) == pytest.approx(d, rel=1e-12)
+        down = np.array([0.0, -1.0])
+        on_m = down + G * (m - a) / d + G * (m - b) / d
+        n_a = -a / np.linalg.norm(a)                   # the wall pushes toward the duct's axis
+        up_wall = np.array([-math.cos(psi[i]), math.sin(psi[i])])
+        on_a = down + G * (a - m) / d + N * n_a + F * up_wall
+        np.testing.assert_allclose(on_m, 0.0, atol=1e-12)
+        np.testing.assert_allclose(on_a, 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("ratio", [2.5, 2.8, 2.9, 2.95, 2.99])
+def test_no_frictionless_keystone_below_three(ratio):
+    """Without friction in the cross-section (steady sliding) no keystone stands for D/d < 3: the
+    outer cables need F > 0 up the wall at every spread, so they slide down until they touch
+    (the triangle)."""
+    rho = 0.5 * (ratio - 1.0)
+    psi = np.linspace(math.asin(0.5 / rho) + 1e-9, math.pi / 2, 2001)
+    assert np.all(keystone(ratio, 1.0, psi).wall_friction_per_load > 0.0)
+
+
+def test_keystone_across_the_duct_multiplies_the_load_toward_three():
+    """Across the duct (ψ = 90°) G/p = d/(2√(d² − ρ²)) and μ needed 3√(d² − ρ²)/ρ: at D/d = 2.99
+    G/p = 5.006 and the friction needed at 90° 0.301; the least friction over the across range
+    (2ψ ≥ 150°) is at most the 90° value."""
+    k = keystone(2.99, 1.0, math.pi / 2)
+    rho = 0.995
+    assert k.contact_force_per_load[0] == pytest.approx(1.0 / (2 * math.sqrt(1 - rho**2)), rel=1e-12)
+    assert k.wall_friction_per_load[0] / k.wall_force_per_load[0] == pytest.approx(3 * math.sqrt(1 - rho**2) / rho,
+                                                                                   rel=1e-12)
+    assert keystone_friction_needed(2.99, 1.0) <= k.wall_friction_per_load[0] / k.wall_force_per_load[0]
+    # just above D/d = 3 a frictionless keystone balances (unstable); beyond 3.07 none reaches across
+    assert keystone_friction_needed(3.05, 1.0) < 1e-3
+    assert keystone_friction_needed(3.1, 1.0) == math.inf
+    ratios = [2.8, 2.9, 2.95, 2.98, 2.99]
+    needed = [keystone_friction_needed(r, 1.0) for r in ratios]
+    assert needed == sorted(needed, reverse=True)
+
+
+def test_frictionless_keystone_only_above_three():
+    """Above D/d = 3 a keystone balances without friction where sin²ψ = (9d²/ρ² − 1)/8 (F = 0 to
+    1e-12 of p; at 3.05 ψ = 76.5°, G/p = 6.3); at and below 3 there is none."""
+    for ratio in (3.02, 3.05, 3.1):
+        psi = frictionless_keystone_psi_rad(ratio, 1.0)
+        k = keystone(ratio, 1.0, psi)
+        assert abs(k.wall_friction_per_load[0]) < 1e-12 and k.contact_force_per_load[0] > 4.0
+    assert math.degrees(frictionless_keystone_psi_rad(3.05, 1.0)) == pytest.approx(76.536, abs=1e-3)
+    assert frictionless_keystone_psi_rad(3.0, 1.0) is None and frictionless_keystone_psi_rad(2.9, 1.0) is None
+
+
+def test_wedge_band_with_bend_ovality_is_the_nec_range():
+    """μ_s 0.5 holds a keystone across the duct for D/d 2.967-3.071 in a round duct (the upper end
+    1 + 2/sin 75°, where the outer cables can no longer both touch the middle one 150° apart); with
+    the calculators' 5 % ovality of a bend either way the band is 2.83-3.22, NFPA 70's 2.8-3.2 to
+    within 0.03 at either end."""
+    lo, hi = wedge_band_d_over_D(0.5)
+    assert keystone_friction_needed(lo, 1.0) == pytest.approx(0.5, abs=1e-3)
+    assert hi == pytest.approx(1 + 2 / math.sin(math.radians(75.0)), rel=1e-12)
+    lo5, hi5 = wedge_band_d_over_D(0.5, 0.05)
+    assert lo5 == pytest.approx(lo / 1.05, rel=1e-12) and hi5 == pytest.approx(hi * 1.05, rel=1e-12)
+    assert abs(lo5 - 2.8) < 0.03 and abs(hi5 - 3.2) < 0.03
+    # more friction holds a wider band
+    assert wedge_band_d_over_D(1.0)[0] < lo < wedge_band_d_over_D(0.3)[0]
+    with pytest.raises(ModelError):
+        wedge_band_d_over_D(-0.1)
+
+
+def test_classifier_flags_the_keystone_across_and_not_the_triangle():
+    """The keystone's own positions (D/d 2.95, ψ 85°, 90°) classify as side by side, wedged; the
+    touching end of the family (the triangle) does not."""
+    D, d = 2.95 * 0.03, 0.03
+    for deg in (85.0, 90.0):
+        pos = keystone(D, d, math.radians(deg)).positions_m[0]
+        c = classify_cross_section(pos[[0, 1, 2]], D / 2, d / 2)
+        assert c["arrangement"] == "side_by_side" and c["wedged"]
+    rho = (D - d) / 2
+    tri = keystone(D, d, math.asin(0.5 * d / rho) + 1e-9).positions_m[0]
+    c = classify_cross_section(tri, D / 2, d / 2)
+    assert c["arrangement"] == "triangular" and not c["wedged"]
+
+
+@pytest.mark.parametrize("ratio, friction, bends, warned", [
+    (2.9, 0.3, True, True), (2.9, 0.3, False, False), (3.0, 0.3, False, True), (3.2, 0.3, True, True),
+    (3.3, 0.3, True, False), (2.75, 0.5, True, False), (2.9, 0.0, True, False)])
+def test_jam_band_warning(ratio, friction, bends, warned):
+    """The run's warning follows the keystone band: μ 0.3 holds one for D/d 2.989-3.071 in a round
+    duct, 2.846-3.224 with a bend's 5 % ovality; no friction, no keystone."""
+    text = jam_band_warning(3, ratio, friction, bends)
+    assert (text is not None) == warned
+    if warned:
+        assert f"D/d = {ratio:.3g}" in text and "conduit.inner_radius" in text
+    assert jam_band_warning(2, ratio, friction, bends) is None
+
+
+D_CABLE, RADIUS, STRAIGHT = 0.03, 2.0, 0.5
+
+
+def bend_scenario(ratio):
+    """The study's case (studies/bundle_jam_study.py): a horizontal 90° bend of 2 m radius, gravity,
+    wall μ 0.3, frictionless between the cables, 100 N per cable in, 16 elements."""
+    route = (xc.Route(inner_radius=ratio * D_CABLE / 2).straight(STRAIGHT).bend(90, radius=RADIUS, turn="left")
+             .straight(STRAIGHT))
+    return xc.Scenario(route=route,
+                       cable=xc.Cable(radius=D_CABLE / 2, density=2000.0, youngs_modulus=2e8, bending_stiffness=1.0,
+                                      count=3, arrangement="cradled", elements=16),
+                       contact=xc.Contact(friction=0.3, check_points_per_element=8),
+                       pull=xc.Pull(speed=0.1, back_tension=300.0), gravity=xc.Gravity(g=9.81),
+                       solver=xc.Solver(mode="steady", end_time=1.0, steady_lead_out=0.0))
+
+
+def test_a_cradle_in_the_jam_range_slides_cradled_and_says_it_could_wedge():
+    """D/d = 2.9, inside NFPA 70's 2.8-3.2: the steady bundle goes round the bend cradled, no cable
+    lifted off the wall between the others, so no jam flag and status ok, but with the keystone
+    band's warning. The middle cable's contact force per length over the bend's middle half is the
+    rigid cradle's 2x·p = 1.053 p within 10 % (p = T κ n − w e_z⊥ per cable, T the share rope's),
+    not the keystone's 1.60 p."""
+    res = xc.run(bend_scenario(2.9))
+    b = res.summary.bundle
+    assert res.status == "ok" and b["jam"] is False
+    bend = next(s for s in b["sections"] if s["kind"] == "bend")
+    assert bend["arrangement"] == "cradled" and not bend["jam"]
+    assert any("wedge side by side" in w for w in res.summary.warnings)
+    model = res.model
+    kernel = model.between
+    q_all = np.concatenate([q.reshape(-1) for q in model.cable_coordinates()])
+    c = kernel.contacts(q_all)
+    cable, point = c["index"][:, 0] // kernel.n_points, c["index"][:, 0] % kernel.n_points
+    line = (kernel.weight[point] * kernel.law.stiffness * c["penetration_m"] ** kernel.law.exponent
+            / (kernel.element_length_m[point // kernel.n_k] / kernel.n_k))
+    x_pts, _ = kernel.point_forces_N(q_all)
+    s = np.array([np.interp(x_pts[j], model.layout.cables[i].node_x_m, model.layout.cables[i].node_s_m)
+                  for i, j in zip(cable, point)])
+    a, e = STRAIGHT + 0.25 * RADIUS * math.pi / 2, STRAIGHT + 0.75 * RADIUS * math.pi / 2
+    mid = (s >= a) & (s <= e)
+    centre = model.conduit.centreline
+    T = np.interp(s[mid], model.rope.s_conduit_m, model.rope.tension_N)
+    w = model.scenario.cable.mass_per_length_kg_per_m * 9.81
+    p = np.hypot(T / RADIUS, w)          # a horizontal bend: T κ across, the weight down
+    assert centre.length_m > e
+    ratio = line[mid] / p
+    assert np.max(ratio) == pytest.approx(2.0 / (2.9 - 1.0), rel=0.10)
+
+
+def test_laid_as_the_keystone_the_steady_bundle_does_not_stay_wedged(monkeypatch):
+    """Started in the jam itself (a 2 m horizontal straight with gravity, D/d 3.05, the cables laid as
+    the keystone at its frictionless balance ψ = 76.5°, G = 6.3 w), the steady solve does not hold it
+    (it is unstable, and sliding friction gives no hold across the duct): the middle cable drops
+    between the outer ones, the straight reads cradled (7 of its 9 planes; the 2 by the eye, which
+    holds the leading ends as laid, triangular), no plane side by side, no jam, status ok, the
+    pull within 5 % of the calculators' cradle (measured +3.7 %: the eye holds the leading ends in
+    the keystone as laid) rather than the keystone's w_c = 2N/3w = 4.3."""
+    import exucable.model.bundle as bundle_model
+
+    def keystone_offsets(count, arrangement, inner_radius_m, cable_radius_m):
+        D, d = 2.0 * inner_radius_m, 2.0 * cable_radius_m
+        psi = frictionless_keystone_psi_rad(D, d)
+        return keystone(D, d, math.pi / 2 if psi is None else psi).positions_m[0]
+
+    monkeypatch.setattr(bundle_model, "arrangement_offsets", keystone_offsets)
+    ratio = 3.05
+    sc = bend_scenario(ratio).replace(**{"conduit.path": [{"straight": 2.0}]})
+    res = xc.run(sc)
+    b = res.summary.bundle
+    assert res.status == "ok" and b["jam"] is False
+    (straight,) = b["sections"]
+    assert straight["arrangement"] == "cradled" and "side_by_side" not in straight["arrangements_seen"]
+    formula = 3 * res.model.rope.pull_force_N
+    assert res.pull_force_N == pytest.approx(formula, rel=0.05)
