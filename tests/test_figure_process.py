@@ -113,3 +113,62 @@ def test_the_helper_is_forked_only_from_a_fresh_process():
     assert first == str(hasattr(os, "fork"))
     assert "thread" in thread and "False" in thread
     assert "matplotlib is loaded" in mpl
+
+
+@needs_fork
+def test_two_processes_draw_the_same_files(tmp_path):
+    """draw_in_two (the helper's way) writes byte for byte what one process draws, listed in the same
+    order; the second process's share is drawn here if it fails."""
+    from exucable.output import figure_process as fp
+
+    one = fp.draw_figures(tmp_path / "one", _result())
+    two = fp.draw_in_two(tmp_path / "two", _result())
+    assert [p.name for p in two] == [p.name for p in one] == fp.figure_names(_result())
+    for p in one:
+        assert (tmp_path / "two" / p.name).read_bytes() == p.read_bytes(), p.name
+
+
+@needs_fork
+def test_a_failing_second_process_costs_no_figure(tmp_path, monkeypatch):
+    from exucable.output import figure_process as fp
+
+    here, draw = os.getpid(), fp._DRAW["pull_force.png"]
+
+    def fails_in_the_fork(path, result):
+        if os.getpid() != here:
+            raise RuntimeError("drawing failed")
+        draw(path, result)
+
+    monkeypatch.setitem(fp._DRAW, "pull_force.png", fails_in_the_fork)
+    paths = fp.draw_in_two(tmp_path, _result())
+    assert all(p.stat().st_size > 1000 for p in paths) and "pull_force.png" in {p.name for p in paths}
+
+
+@needs_fork
+def test_a_helper_given_nothing_is_killed_at_once():
+    """Bad input or a failed run is not held up by the helper's import of matplotlib."""
+    with Figures(helper=True) as figures:
+        proc = figures._proc
+    assert proc.exitcode is not None and proc.exitcode != 0
+
+
+@needs_fork
+def test_exucable_run_draws_its_figures_in_the_helper(tmp_path):
+    """The command forks the helper before anything loads Exudyn, so that the helper is used: a check
+    before the solve that imports Exudyn must not silently keep it out. Coarse Example 2, steady mode."""
+    script = textwrap.dedent(f"""
+        from exucable.output import figure_process as fp
+        write = fp.Figures.write
+        def spy(self, *a, **k):
+            print("helper", self.helper_running, repr(self.helper_reason))
+            return write(self, *a, **k)
+        fp.Figures.write = spy
+        from exucable.cli import main
+        raise SystemExit(main(["run", "fast/paper_ex2_bend90", "-q", "--mode", "steady", "-o", r"{tmp_path}"]))
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert p.returncode in (0, 1), p.stderr
+    assert "helper True ''" in p.stdout, p.stdout + p.stderr
+    assert {"pull_force.png", "tension_profile.png", "pressure.png"} <= {f.name for f in tmp_path.iterdir()}
+
