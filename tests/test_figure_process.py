@@ -172,3 +172,22 @@ def test_exucable_run_draws_its_figures_in_the_helper(tmp_path):
     assert "helper True ''" in p.stdout, p.stdout + p.stderr
     assert {"pull_force.png", "tension_profile.png", "pressure.png"} <= {f.name for f in tmp_path.iterdir()}
 
+
+
+def test_a_long_title_is_wrapped_and_not_clipped():
+    """The fixed layout: a title up to the overhang widens the margins; a longer one is wrapped, each
+    line within the axes' width plus the overhang; the subplot area keeps its size [in]."""
+    from exucable.plots.results import TITLE_OVERHANG_IN, _text_width_in, framed_figure
+
+    fig, title = framed_figure((5.0, 3.0), "short: tension along the cable", 12)
+    assert "\n" not in title
+    w, h = fig.get_size_inches()
+    sp = fig.subplotpars
+    assert (sp.right - sp.left) * w == pytest.approx(5.0) and (sp.top - sp.bottom) * h == pytest.approx(3.0)
+    long = "a-very-long-scenario-name-" * 6 + ": sidewall pressure (bends shaded; point loads at bend ends)"
+    fig, title = framed_figure((5.0, 3.0), long, 12)
+    lines = title.split("\n")
+    assert len(lines) >= 2 and " ".join(lines).replace(" ", "") == long.replace(" ", "")
+    assert all(_text_width_in(line, 12) <= 5.0 + TITLE_OVERHANG_IN for line in lines)
+    w, _ = fig.get_size_inches()
+    assert w >= max(_text_width_in(line, 12) for line in lines)          # within the figure
