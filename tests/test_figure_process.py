@@ -57,6 +57,7 @@ def test_the_helpers_figures_are_those_drawn_here(tmp_path):
     for name in set(FIGURE_FILES) & {p.name for p in here}:
         assert (tmp_path / "helper" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
     assert not figures.helper_running and figures.helper_reason == ""
+    assert {"warm_up_s", "draw_s"} <= set(figures.helper_cpu_s) and all(v > 0 for v in figures.helper_cpu_s.values())
 
 
 @needs_fork

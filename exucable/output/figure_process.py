@@ -26,6 +26,7 @@ import os
 import pickle
 import sys
 import threading
+import time
 from pathlib import Path
 
 from ..plots.bundle import plot_cross_sections
@@ -72,14 +73,19 @@ def _warm_up() -> None:
 
 def _serve(conn) -> None:
     """The helper: warm up, wait for ``(out_dir, result)`` (or None: nothing to draw), draw, reply
-    ``("ok", paths)``, ``("oserror", errno, strerror, filename)`` or ``("failed", reason)``."""
+    ``("ok", paths, cpu)`` (``cpu``: :attr:`Figures.helper_cpu_s`), ``("oserror", errno, strerror,
+    filename)`` or ``("failed", reason)``."""
     try:
         _warm_up()
+        cpu = {"warm_up_s": time.process_time()}        # a fork's CPU time starts at zero
         msg = conn.recv()
         if msg is None:
             return
         out, result = msg
-        reply = ("ok", [str(p) for p in draw_in_two(Path(out), result)])
+        c0 = time.process_time()
+        paths = draw_in_two(Path(out), result, cpu)
+        cpu["draw_s"] = time.process_time() - c0
+        reply = ("ok", [str(p) for p in paths], cpu)
     except EOFError:
         return                                  # the run is gone or ended without figures
     except BaseException as exc:  # reported, and the run draws the figures itself
@@ -139,12 +145,13 @@ def _raise(reply: tuple) -> None:
     raise RuntimeError(reply[1])
 
 
-def draw_in_two(out: Path, result) -> list[Path]:
+def draw_in_two(out: Path, result, cpu: dict | None = None) -> list[Path]:
     """Draw the figures in two processes at once (this one and a fork of it, which draws
     :data:`SECOND_PROCESS`); returns their paths in :func:`figure_names`' order. Drawing is CPU-bound
     and single-threaded, so on two free cores the figures take the time of the slower half. The fork
     reports through a pipe; whatever it did not draw (it failed or died) is drawn here, and an
-    :class:`OSError` of its write is raised here."""
+    :class:`OSError` of its write is raised here. ``cpu``: a dict given the fork's CPU time [s] as
+    ``second_process_draw_s``."""
     names = figure_names(result)
     second = [n for n in names if n in SECOND_PROCESS]
     if not second or len(second) == len(names) or len(os.sched_getaffinity(0)) < 2:
@@ -157,7 +164,7 @@ def draw_in_two(out: Path, result) -> list[Path]:
             os.close(read_end)
             try:
                 draw_figures(out, result, second)
-                reply = ("ok",)
+                reply = ("ok", time.process_time())
             except BaseException as exc:  # reported; the first process draws what is missing
                 reply = _outcome(exc)
             with os.fdopen(write_end, "wb") as f:
@@ -177,6 +184,8 @@ def draw_in_two(out: Path, result) -> list[Path]:
         _raise(reply)
     if reply[0] != "ok":
         draw_figures(out, result, second)
+    elif cpu is not None:
+        cpu["second_process_draw_s"] = reply[1]
     return [out / n for n in names]
 
 
@@ -195,6 +204,10 @@ class Figures:
         self._proc = self._conn = None
         self._sent = False               # whether the helper was given results to draw
         self.helper_reason = ""          # why the figures were drawn here, if they were
+        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import and warm-up,
+        #: beside the solve), ``draw_s`` (its drawing after the results arrived) and, where a second
+        #: process drew, ``second_process_draw_s`` (at the same time); empty otherwise
+        self.helper_cpu_s: dict[str, float] = {}
         if helper is None:
             helper, self.helper_reason = helper_allowed()
         elif helper and "fork" not in multiprocessing.get_all_start_methods():
@@ -246,6 +259,7 @@ class Figures:
         finally:
             self.close()
         if reply is not None and reply[0] == "ok":
+            self.helper_cpu_s = reply[2]
             return [Path(p) for p in reply[1]]
         if reply is not None and reply[0] == "oserror":
             _raise(reply)
