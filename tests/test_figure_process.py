@@ -192,3 +192,25 @@ def test_a_long_title_is_wrapped_and_not_clipped():
     assert all(_text_width_in(line, 12) <= 5.0 + TITLE_OVERHANG_IN for line in lines)
     w, _ = fig.get_size_inches()
     assert w >= max(_text_width_in(line, 12) for line in lines)          # within the figure
+
+
+def test_a_dense_scatter_keeps_one_point_per_occupied_half_pixel():
+    """Beyond `most` points, every half-pixel cell that had a point keeps exactly one of them (the
+    figure lights the same pixels); up to `most`, the points are drawn as they are."""
+    from exucable.plots.results import thinned_scatter
+
+    rng = np.random.default_rng(1)
+    x, y = np.sort(rng.uniform(0.0, 1e4, 200_000)), rng.normal(300.0, 5.0, 200_000)
+    y[:10] = [-5.0, 900.0, np.nan, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]     # outside the y-range, not finite
+    same = thinned_scatter(x[:1000], y[:1000], (0.0, 480.0), (744, 370), most=1000)
+    assert np.array_equal(same[0], x[:1000]) and np.array_equal(same[1], y[:1000], equal_nan=True)
+    tx, ty = thinned_scatter(x, y, (0.0, 480.0), (744, 370), most=1000)
+    assert 1000 < tx.size < 0.5 * x.size and np.isin(tx, x).all()
+
+    def cells(a, b):
+        ok = np.isfinite(a) & np.isfinite(b)
+        i = np.floor((a[ok] - x.min()) / (x.max() - x.min()) * 1488)
+        j = np.clip(np.floor(b[ok] / 480.0 * 740), -1, 740)
+        return set(zip(i.tolist(), j.tolist()))
+
+    assert cells(tx, ty) == cells(x, y) and len(cells(tx, ty)) == tx.size

@@ -2,10 +2,13 @@
 
 Importing matplotlib costs about as much CPU as drawing a run's three figures (``benchmarks/
 figure_cost.py``); in a fresh process both came after the solve and nearly doubled a short run. The
-helper is forked when the run starts, imports matplotlib and loads its fonts while this process builds
-and solves the model, then waits. Once the results are post-processed they are sent to it through a
-pipe; it draws and writes the figures (atomically, :func:`exucable.io.save_figure`) while this process
-writes the data files and ``summary.json``; :meth:`Figures.write` returns once every figure is on disk.
+helper is forked when the run starts (``exucable run`` forks it first thing, before anything loads
+Exudyn or numba), imports matplotlib and loads its fonts while this process imports, builds and solves
+the model, then waits. Once the results are post-processed they are sent to it through a pipe; it
+draws and writes the figures (atomically, :func:`exucable.io.save_figure`), in two processes at once
+(:func:`draw_in_two`), while this process writes the data files and ``summary.json``;
+:meth:`Figures.write` returns once every figure is on disk. A helper given nothing to draw (bad input,
+an error) is killed at once; :class:`Figures` is a context manager, so an error or Ctrl-C stops it.
 
 Deterministic: the helper is a fork of this process (the same matplotlib settings) and draws with the
 same functions, so its files are byte for byte those drawn here. Whatever goes wrong in the helper (it

@@ -9,13 +9,15 @@ import numpy as np
 
 from ..io import new_figure, save_figure
 
-__all__ = ["plot_pull_force", "plot_tension_profile", "plot_pressure", "framed_figure"]
+__all__ = ["plot_pull_force", "plot_tension_profile", "plot_pressure", "framed_figure", "thinned_scatter"]
 
 # A fixed layout: margins [in] around the axes, room for y tick labels of up to ~8 characters and the
 # y label (left), the x tick labels and x label (bottom). Not ``bbox_inches="tight"``: that lays each
 # figure out twice to find its extent (a quarter of its drawing time); only the title's width varies
 # enough to need measuring, and measuring one line of text is cheap.
 LEFT_IN, RIGHT_IN, BOTTOM_IN = 0.9, 0.3, 0.6
+#: The resolution the figures are written at [dpi] (:func:`exucable.io.save_figure`'s default).
+SAVE_DPI = 120
 #: A title wider than the axes by more than this [in] is wrapped onto more lines instead of widening the figure.
 TITLE_OVERHANG_IN = 2.0
 
@@ -66,6 +68,31 @@ def _zoom(values: np.ndarray, centre: float, references, spread: float) -> tuple
     for r in references:
         half = max(half, 1.25 * abs(r - centre))
     return centre - half, centre + half
+
+
+def thinned_scatter(x, y, y_range: tuple[float, float], size_px: tuple[float, float], most: int = 20_000):
+    """The points of a scatter drawn as single pixels, at most one per half pixel of an axes
+    ``size_px`` (width, height) [px] whose y-axis spans ``y_range`` (the x-axis spans at least the
+    points). Up to ``most`` points are kept as they are; beyond, most fall on pixels already drawn (a
+    10 km run has ~10^6 check points for ~750 pixel columns), and drawing them again costs time and
+    changes only how dark the overlaps are. Points outside ``y_range`` keep one each side."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.size <= most:
+        return x, y
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    if x.size == 0:
+        return x, y
+    nx, ny = 2 * int(np.ceil(size_px[0])), 2 * int(np.ceil(size_px[1]))
+    ix = np.floor((x - x.min()) / max(float(x.max() - x.min()), 1e-300) * nx).astype(np.int64)
+    iy = np.floor((y - y_range[0]) / max(y_range[1] - y_range[0], 1e-300) * ny)
+    iy = np.clip(iy, -1, ny).astype(np.int64) + 1
+    # one point per occupied cell: each cell keeps the index written into it last (a linear pass,
+    # no sort of 10^6 keys)
+    cell = np.full((nx + 1) * (ny + 2), -1, dtype=np.int64)
+    cell[ix * (ny + 2) + iy] = np.arange(x.size)
+    kept = cell[cell >= 0]
+    return x[kept], y[kept]
 
 
 def plot_pull_force(path, result) -> None:
@@ -152,14 +179,15 @@ def plot_pressure(path, result) -> None:
     fig, title = framed_figure((6.2, 3.08), f"{s.get('name', '')}: sidewall pressure (bends shaded; point loads "
                                "at bend ends)", 12, bottom_in=0.16 * 3.08 + 0.45)
     ax = fig.subplots()
+    top = 1.6 * max(float(np.max(pp["windowed_pressure_N_per_m"])), float(np.max(pp["rope_windowed_pressure_N_per_m"])), 1e-9)
     cp = result.contact_profile
     if cp is not None:
-        ax.plot(cp["s_conduit_m"], cp["normal_force_per_length_N_per_m"], ",", color="0.6", alpha=0.5,
-                label="check points (force / element share)")
+        size_px = (6.2 * SAVE_DPI, 3.08 * SAVE_DPI)
+        ax.plot(*thinned_scatter(cp["s_conduit_m"], cp["normal_force_per_length_N_per_m"], (0.0, top), size_px),
+                ",", color="0.6", alpha=0.5, label="check points (force / element share)")
     ax.plot(pp["s_conduit_m"], pp["windowed_pressure_N_per_m"], lw=1.8,
             label=f"exucable, windowed over {s.get('pressure_window_m', float('nan')):.3g} m")
     ax.plot(pp["s_conduit_m"], pp["rope_windowed_pressure_N_per_m"], "k--", lw=1, label="rope (T/R and weight), windowed")
-    top = 1.6 * max(float(np.max(pp["windowed_pressure_N_per_m"])), float(np.max(pp["rope_windowed_pressure_N_per_m"])), 1e-9)
     loads = []
     for b in result.bends or []:
         ax.axvspan(b["s_conduit_start_m"], b["s_conduit_end_m"], color="b", alpha=0.05)
@@ -178,4 +206,4 @@ def plot_pressure(path, result) -> None:
     ax.set_title(title, fontsize=12)
     ax.grid(alpha=0.3)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
-    save_figure(fig, path)
+    save_figure(fig, path, dpi=SAVE_DPI)
