@@ -141,7 +141,7 @@ def large(result, repeat: int, tmp: Path) -> None:
     import dataclasses
 
     import numpy as np
-    from exucable.output.figure_process import _DRAW
+    from exucable.output.figure_process import draw_figures
 
     def stretch(table, key, n):
         x = np.asarray(table[key], dtype=float)
@@ -160,7 +160,7 @@ def large(result, repeat: int, tmp: Path) -> None:
         cpu = []
         for _ in range(repeat):
             c0 = time.process_time()
-            _DRAW[name](tmp / name, big)
+            draw_figures(tmp, big, [name])
             cpu.append(time.process_time() - c0)
         print(f"| {name} | {statistics.median(cpu):.3f} |")
 
