@@ -170,8 +170,10 @@ def draw_in_two(out: Path, result, cpu: dict | None = None) -> list[Path]:
                 reply = ("ok", time.process_time())
             except BaseException as exc:  # reported; the first process draws what is missing
                 reply = _outcome(exc)
-            with os.fdopen(write_end, "wb") as f:
-                pickle.dump(reply, f)
+            data = memoryview(pickle.dumps(reply))
+            while data:                             # a pipe, not a file: a short reply, written whole
+                data = data[os.write(write_end, data):]
+            os.close(write_end)
             code = 0
         finally:
             os._exit(code)                          # no cleanup of the parent's state in the fork
