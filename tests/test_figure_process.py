@@ -192,6 +192,9 @@ def test_a_long_title_is_wrapped_and_not_clipped():
     assert all(_text_width_in(line, 12) <= 5.0 + TITLE_OVERHANG_IN for line in lines)
     w, _ = fig.get_size_inches()
     assert w >= max(_text_width_in(line, 12) for line in lines)          # within the figure
+    unbroken = "a_name_with_no_spaces_or_hyphens_" * 5 + ": tension along the cable"
+    lines = framed_figure((5.0, 3.0), unbroken, 12)[1].split("\n")
+    assert 2 <= len(lines) <= 4 and all(_text_width_in(line, 12) <= 5.0 + TITLE_OVERHANG_IN for line in lines)
 
 
 def test_a_dense_scatter_keeps_one_point_per_occupied_half_pixel():

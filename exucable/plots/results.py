@@ -32,12 +32,14 @@ def _text_width_in(text: str, size_pt: float) -> float:
 
 
 def _wrap_title(title: str, size_pt: float, width_in: float) -> list[str]:
-    """``title`` in as few lines as fit ``width_in`` [in]; a line that cannot be broken stays whole."""
-    for chars in range(len(title), 10, -max(1, len(title) // 40)):
-        lines = textwrap.wrap(title, chars, break_long_words=False) or [""]
-        if max(_text_width_in(line, size_pt) for line in lines) <= width_in:
-            return lines
-    return textwrap.wrap(title, 10, break_long_words=False) or [""]
+    """``title`` in as few lines as fit ``width_in`` [in], broken between words (a name without
+    spaces or hyphens, within it, if it must)."""
+    for breaking in (False, True):
+        for chars in range(len(title), 10, -max(1, len(title) // 40)):
+            lines = textwrap.wrap(title, chars, break_long_words=breaking) or [""]
+            if max(_text_width_in(line, size_pt) for line in lines) <= width_in:
+                return lines
+    return textwrap.wrap(title, 10) or [""]
 
 
 def framed_figure(axes_in: tuple[float, float], title: str, title_pt: float, bottom_in: float = BOTTOM_IN):
