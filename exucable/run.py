@@ -155,7 +155,7 @@ def is_loaded(sc) -> bool:
     return g > 0.0 or sc.pull.back_tension_N > 0.0 or sc.pull.force_N is not None
 
 
-def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool = True,
+def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = True, plots: bool | Figures = True,
                  steady_stop: bool | None = None, refine: float = 1.0,
                  check_points_per_element: int | None = None, mode: str | None = None,
                  error_bar: bool = True, cpu_budget_s: float | None = None) -> RunResult:
@@ -173,7 +173,9 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     coarser mesh (:mod:`exucable.solve.error_bar`); False skips that solve (its uncertainty is then
     None), as ``exucable converge`` does, whose levels are the error bar. ``cpu_budget_s`` (several
     cables only): the steady solve gives up once it has used this much CPU time [s], checked after
-    each accepted pseudo-time step (status ``failed``, saying so).
+    each accepted pseudo-time step (status ``failed``, saying so). ``plots`` may be a
+    :class:`~exucable.output.figure_process.Figures` the caller started before anything loaded Exudyn
+    (``exucable run`` does, first thing), so that its helper process draws the figures.
     """
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
@@ -187,8 +189,9 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     _refuse_snapshot_times_in_steady_mode(sc)
     if out_dir is None:
         return solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
-    # the figures' helper process is forked before the solve, to import matplotlib beside it
-    with owned_out_dir(out_dir) as out, (Figures() if plots else contextlib.nullcontext(False)) as figures:
+    # the figures' helper process is forked before the solve (or was, by the caller), to import matplotlib beside it
+    started = plots if isinstance(plots, Figures) else Figures() if plots else contextlib.nullcontext(False)
+    with owned_out_dir(out_dir) as out, started as figures:
         result = solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
         write_results(out, result, plots=figures)
     return result

@@ -57,6 +57,7 @@ def test_the_helpers_figures_are_those_drawn_here(tmp_path):
     for name in set(FIGURE_FILES) & {p.name for p in here}:
         assert (tmp_path / "helper" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
     assert not figures.helper_running and figures.helper_reason == ""
+    assert {"warm_up_s", "draw_s"} <= set(figures.helper_cpu_s) and all(v > 0 for v in figures.helper_cpu_s.values())
 
 
 @needs_fork
@@ -113,3 +114,106 @@ def test_the_helper_is_forked_only_from_a_fresh_process():
     assert first == str(hasattr(os, "fork"))
     assert "thread" in thread and "False" in thread
     assert "matplotlib is loaded" in mpl
+
+
+@needs_fork
+def test_two_processes_draw_the_same_files(tmp_path):
+    """draw_in_two (the helper's way) writes byte for byte what one process draws, listed in the same
+    order; the second process's share is drawn here if it fails."""
+    from exucable.output import figure_process as fp
+
+    one = fp.draw_figures(tmp_path / "one", _result())
+    two = fp.draw_in_two(tmp_path / "two", _result())
+    assert [p.name for p in two] == [p.name for p in one] == fp.figure_names(_result())
+    for p in one:
+        assert (tmp_path / "two" / p.name).read_bytes() == p.read_bytes(), p.name
+
+
+@needs_fork
+def test_a_failing_second_process_costs_no_figure(tmp_path, monkeypatch):
+    from exucable.output import figure_process as fp
+
+    here, draw = os.getpid(), fp._DRAW["pull_force.png"]
+
+    def fails_in_the_fork(path, result):
+        if os.getpid() != here:
+            raise RuntimeError("drawing failed")
+        draw(path, result)
+
+    monkeypatch.setitem(fp._DRAW, "pull_force.png", fails_in_the_fork)
+    paths = fp.draw_in_two(tmp_path, _result())
+    assert all(p.stat().st_size > 1000 for p in paths) and "pull_force.png" in {p.name for p in paths}
+
+
+@needs_fork
+def test_a_helper_given_nothing_is_killed_at_once():
+    """Bad input or a failed run is not held up by the helper's import of matplotlib."""
+    with Figures(helper=True) as figures:
+        proc = figures._proc
+    assert proc.exitcode is not None and proc.exitcode != 0
+
+
+@needs_fork
+def test_exucable_run_draws_its_figures_in_the_helper(tmp_path):
+    """The command forks the helper before anything loads Exudyn, so that the helper is used: a check
+    before the solve that imports Exudyn must not silently keep it out. Coarse Example 2, steady mode."""
+    script = textwrap.dedent(f"""
+        from exucable.output import figure_process as fp
+        write = fp.Figures.write
+        def spy(self, *a, **k):
+            print("helper", self.helper_running, repr(self.helper_reason))
+            return write(self, *a, **k)
+        fp.Figures.write = spy
+        from exucable.cli import main
+        raise SystemExit(main(["run", "fast/paper_ex2_bend90", "-q", "--mode", "steady", "-o", r"{tmp_path}"]))
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert p.returncode in (0, 1), p.stderr
+    assert "helper True ''" in p.stdout, p.stdout + p.stderr
+    assert {"pull_force.png", "tension_profile.png", "pressure.png"} <= {f.name for f in tmp_path.iterdir()}
+
+
+
+def test_a_long_title_is_wrapped_and_not_clipped():
+    """The fixed layout: a title up to the overhang widens the margins; a longer one is wrapped, each
+    line within the axes' width plus the overhang; the subplot area keeps its size [in]."""
+    from exucable.plots.results import TITLE_OVERHANG_IN, _text_width_in, framed_figure
+
+    fig, title = framed_figure((5.0, 3.0), "short: tension along the cable", 12)
+    assert "\n" not in title
+    w, h = fig.get_size_inches()
+    sp = fig.subplotpars
+    assert (sp.right - sp.left) * w == pytest.approx(5.0) and (sp.top - sp.bottom) * h == pytest.approx(3.0)
+    long = "a-very-long-scenario-name-" * 6 + ": sidewall pressure (bends shaded; point loads at bend ends)"
+    fig, title = framed_figure((5.0, 3.0), long, 12)
+    lines = title.split("\n")
+    assert len(lines) >= 2 and " ".join(lines).replace(" ", "") == long.replace(" ", "")
+    assert all(_text_width_in(line, 12) <= 5.0 + TITLE_OVERHANG_IN for line in lines)
+    w, _ = fig.get_size_inches()
+    assert w >= max(_text_width_in(line, 12) for line in lines)          # within the figure
+    unbroken = "a_name_with_no_spaces_or_hyphens_" * 5 + ": tension along the cable"
+    lines = framed_figure((5.0, 3.0), unbroken, 12)[1].split("\n")
+    assert 2 <= len(lines) <= 4 and all(_text_width_in(line, 12) <= 5.0 + TITLE_OVERHANG_IN for line in lines)
+
+
+def test_a_dense_scatter_keeps_one_point_per_occupied_half_pixel():
+    """Beyond `most` points, every half-pixel cell that had a point keeps exactly one of them (the
+    figure lights the same pixels); up to `most`, the points are drawn as they are."""
+    from exucable.plots.results import thinned_scatter
+
+    rng = np.random.default_rng(1)
+    x, y = np.sort(rng.uniform(0.0, 1e4, 200_000)), rng.normal(300.0, 5.0, 200_000)
+    y[:10] = [-5.0, 900.0, np.nan, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]     # outside the y-range, not finite
+    same = thinned_scatter(x[:1000], y[:1000], (0.0, 480.0), (744, 370), most=1000)
+    assert np.array_equal(same[0], x[:1000]) and np.array_equal(same[1], y[:1000], equal_nan=True)
+    tx, ty = thinned_scatter(x, y, (0.0, 480.0), (744, 370), most=1000)
+    assert 1000 < tx.size < 0.5 * x.size and np.isin(tx, x).all()
+
+    def cells(a, b):
+        ok = np.isfinite(a) & np.isfinite(b)
+        i = np.floor((a[ok] - x.min()) / (x.max() - x.min()) * 1488)
+        j = np.clip(np.floor(b[ok] / 480.0 * 740), -1, 740)
+        return set(zip(i.tolist(), j.tolist()))
+
+    assert cells(tx, ty) == cells(x, y) and len(cells(tx, ty)) == tx.size

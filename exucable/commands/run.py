@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from ..output.figure_process import Figures
 from ..output.outdir import default_out_dir
 from ..run import run_scenario
 from .compile import announce_compiling
@@ -49,9 +51,12 @@ def main(args) -> int:
 
     sc = load_scenario(args.scenario)
     out_dir = Path(args.out) if args.out else default_out_dir(sc.name)
-    announce_compiling()
-    res = run_scenario(sc, out_dir, quiet=args.quiet, plots=not args.no_plots, steady_stop=args.steady_stop,
-                       mode=args.mode)
+    # the figures' helper is forked now, before anything loads Exudyn or numba: it imports matplotlib
+    # on the other core while this process imports, builds and solves
+    with contextlib.nullcontext(False) if args.no_plots else Figures() as figures:
+        announce_compiling()
+        res = run_scenario(sc, out_dir, quiet=args.quiet, plots=figures, steady_stop=args.steady_stop,
+                           mode=args.mode)
     s = res.summary
     if "bundle" in s:
         return _print_bundle(s, out_dir)

@@ -2,10 +2,13 @@
 
 Importing matplotlib costs about as much CPU as drawing a run's three figures (``benchmarks/
 figure_cost.py``); in a fresh process both came after the solve and nearly doubled a short run. The
-helper is forked when the run starts, imports matplotlib and loads its fonts while this process builds
-and solves the model, then waits. Once the results are post-processed they are sent to it through a
-pipe; it draws and writes the figures (atomically, :func:`exucable.io.save_figure`) while this process
-writes the data files and ``summary.json``; :meth:`Figures.write` returns once every figure is on disk.
+helper is forked when the run starts (``exucable run`` forks it first thing, before anything loads
+Exudyn or numba), imports matplotlib and loads its fonts while this process imports, builds and solves
+the model, then waits. Once the results are post-processed they are sent to it through a pipe; it
+draws and writes the figures (atomically, :func:`exucable.io.save_figure`), in two processes at once
+(:func:`draw_in_two`), while this process writes the data files and ``summary.json``;
+:meth:`Figures.write` returns once every figure is on disk. A helper given nothing to draw (bad input,
+an error) is killed at once; :class:`Figures` is a context manager, so an error or Ctrl-C stops it.
 
 Deterministic: the helper is a fork of this process (the same matplotlib settings) and draws with the
 same functions, so its files are byte for byte those drawn here. Whatever goes wrong in the helper (it
@@ -22,14 +25,18 @@ from __future__ import annotations
 
 import dataclasses
 import multiprocessing
+import os
+import pickle
 import sys
 import threading
+import time
 from pathlib import Path
 
 from ..plots.bundle import plot_cross_sections
 from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
 
-__all__ = ["Figures", "draw_figures", "helper_allowed", "HELPER_TIMEOUT_S"]
+__all__ = ["Figures", "draw_figures", "draw_in_two", "figure_names", "helper_allowed", "HELPER_TIMEOUT_S",
+           "SECOND_PROCESS"]
 
 #: Seconds to wait for the helper's figures before drawing them here instead. Drawing a 10 km run's
 #: three figures takes a few seconds; a helper taking this long is stuck (or the machine is).
@@ -69,20 +76,23 @@ def _warm_up() -> None:
 
 def _serve(conn) -> None:
     """The helper: warm up, wait for ``(out_dir, result)`` (or None: nothing to draw), draw, reply
-    ``("ok", paths)``, ``("oserror", errno, strerror, filename)`` or ``("failed", reason)``."""
+    ``("ok", paths, cpu)`` (``cpu``: :attr:`Figures.helper_cpu_s`), ``("oserror", errno, strerror,
+    filename)`` or ``("failed", reason)``."""
     try:
         _warm_up()
+        cpu = {"warm_up_s": time.process_time()}        # a fork's CPU time starts at zero
         msg = conn.recv()
         if msg is None:
             return
         out, result = msg
-        reply = ("ok", [str(p) for p in draw_figures(Path(out), result)])
+        c0 = time.process_time()
+        paths = draw_in_two(Path(out), result, cpu)
+        cpu["draw_s"] = time.process_time() - c0
+        reply = ("ok", [str(p) for p in paths], cpu)
     except EOFError:
         return                                  # the run is gone or ended without figures
-    except OSError as exc:
-        reply = ("oserror", exc.errno, exc.strerror, exc.filename)
     except BaseException as exc:  # reported, and the run draws the figures itself
-        reply = ("failed", f"{type(exc).__name__}: {exc}")
+        reply = _outcome(exc)
     try:
         conn.send(reply)
     except OSError:
@@ -91,23 +101,103 @@ def _serve(conn) -> None:
         conn.close()
 
 
-def draw_figures(out: Path, result) -> list[Path]:
+def _cross_sections(path, result) -> None:
+    x = result.cross_sections
+    plot_cross_sections(path, x["panels"], x["inner_radius_m"], x["cable_radius_m"], title=result.summary.get("name", ""))
+
+
+def figure_names(result) -> list[str]:
+    """The file names of ``result``'s figures, in the order they are drawn and listed."""
+    return [name for name, has, _ in _FIGURES if has(result)]
+
+
+#: (file name, whether ``result`` has it, drawing function(path, result))
+_FIGURES = (("pull_force.png", lambda r: True, plot_pull_force),
+            ("tension_profile.png", lambda r: r.tension_profile is not None, plot_tension_profile),
+            ("pressure.png", lambda r: r.pressure_profile is not None, plot_pressure),
+            ("cross_sections.png", lambda r: bool(r.cross_sections), _cross_sections))
+_DRAW = {name: draw for name, _, draw in _FIGURES}
+
+#: The figures the helper's second process draws; the helper draws the others at the same time.
+#: The pulling force's figure (two axes) is the costliest alone, ~2/3 of the other two together.
+SECOND_PROCESS = frozenset({"pull_force.png", "cross_sections.png"})
+
+
+def draw_figures(out: Path, result, names=None) -> list[Path]:
     """Draw the run's figures into ``out`` (each written atomically); returns their paths. Called
-    after the numbers are computed: a failure to draw must not hold back (or lose) a result."""
-    plot_pull_force(out / "pull_force.png", result)
-    written = [out / "pull_force.png"]
-    if result.tension_profile is not None:
-        plot_tension_profile(out / "tension_profile.png", result)
-        written.append(out / "tension_profile.png")
-    if result.pressure_profile is not None:
-        plot_pressure(out / "pressure.png", result)
-        written.append(out / "pressure.png")
-    if result.cross_sections:
-        x = result.cross_sections
-        plot_cross_sections(out / "cross_sections.png", x["panels"], x["inner_radius_m"], x["cable_radius_m"],
-                            title=result.summary.get("name", ""))
-        written.append(out / "cross_sections.png")
+    after the numbers are computed: a failure to draw must not hold back (or lose) a result.
+    ``names``: only these of :func:`figure_names` (default: all)."""
+    written = []
+    for name in figure_names(result):
+        if names is None or name in names:
+            _DRAW[name](out / name, result)
+            written.append(out / name)
     return written
+
+
+def _outcome(exc: BaseException) -> tuple:
+    """A drawing exception as a picklable reply."""
+    if isinstance(exc, OSError):
+        return ("oserror", exc.errno, exc.strerror, exc.filename)
+    return ("failed", f"{type(exc).__name__}: {exc}")
+
+
+def _raise(reply: tuple) -> None:
+    if reply[0] == "oserror":
+        raise OSError(reply[1], reply[2], reply[3])
+    raise RuntimeError(reply[1])
+
+
+def draw_in_two(out: Path, result, cpu: dict | None = None) -> list[Path]:
+    """Draw the figures in two processes at once (this one and a fork of it, which draws
+    :data:`SECOND_PROCESS`); returns their paths in :func:`figure_names`' order. Drawing is CPU-bound
+    and single-threaded, so on two free cores the figures take the time of the slower half. The fork
+    reports through a pipe; whatever it did not draw (it failed or died) is drawn here, and an
+    :class:`OSError` of its write is raised here. ``cpu``: a dict given the fork's CPU time [s] as
+    ``second_process_draw_s``."""
+    names = figure_names(result)
+    second = [n for n in names if n in SECOND_PROCESS]
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if not second or len(second) == len(names) or cores < 2:
+        return draw_figures(out, result)
+    read_end, write_end = os.pipe()
+    try:
+        pid = os.fork()
+    except OSError:                                 # no process to spare: not a file's error, draw here
+        os.close(read_end)
+        os.close(write_end)
+        return draw_figures(out, result)
+    if pid == 0:                                    # the second process: draw, report, leave at once
+        code = 1
+        try:
+            os.close(read_end)
+            try:
+                draw_figures(out, result, second)
+                reply = ("ok", time.process_time())
+            except BaseException as exc:  # reported; the first process draws what is missing
+                reply = _outcome(exc)
+            data = memoryview(pickle.dumps(reply))
+            while data:                             # a pipe, not a file: a short reply, written whole
+                data = data[os.write(write_end, data):]
+            os.close(write_end)
+            code = 0
+        finally:
+            os._exit(code)                          # no cleanup of the parent's state in the fork
+    os.close(write_end)
+    try:
+        draw_figures(out, result, [n for n in names if n not in SECOND_PROCESS])
+    finally:
+        with os.fdopen(read_end, "rb") as f:
+            data = f.read()
+        os.waitpid(pid, 0)
+    reply = pickle.loads(data) if data else ("failed", "the second drawing process died")
+    if reply[0] == "oserror":
+        _raise(reply)
+    if reply[0] != "ok":
+        draw_figures(out, result, second)
+    elif cpu is not None:
+        cpu["second_process_draw_s"] = reply[1]
+    return [out / n for n in names]
 
 
 class Figures:
@@ -123,7 +213,12 @@ class Figures:
 
     def __init__(self, helper: bool | None = None):
         self._proc = self._conn = None
+        self._sent = False               # whether the helper was given results to draw
         self.helper_reason = ""          # why the figures were drawn here, if they were
+        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import and warm-up,
+        #: beside the solve), ``draw_s`` (its drawing after the results arrived) and, where a second
+        #: process drew, ``second_process_draw_s`` (at the same time); empty otherwise
+        self.helper_cpu_s: dict[str, float] = {}
         if helper is None:
             helper, self.helper_reason = helper_allowed()
         elif helper and "fork" not in multiprocessing.get_all_start_methods():
@@ -162,7 +257,7 @@ class Figures:
         try:
             # the solved model stays here: it is not data, and it cannot cross a pipe
             self._conn.send((str(out), dataclasses.replace(result, model=None)))
-            sent = True
+            sent = self._sent = True
         except (OSError, ValueError):
             sent = False
         try:
@@ -175,16 +270,21 @@ class Figures:
         finally:
             self.close()
         if reply is not None and reply[0] == "ok":
+            self.helper_cpu_s = reply[2]
             return [Path(p) for p in reply[1]]
         if reply is not None and reply[0] == "oserror":
-            raise OSError(reply[1], reply[2], reply[3])
+            _raise(reply)
         self.helper_reason = ("the helper failed: " + reply[1]) if reply else "the helper gave no figures"
         return draw_figures(out, result)
 
     def close(self) -> None:
-        """Stop the helper (if any): told to end, then killed if it does not within a second."""
+        """Stop the helper (if any): killed at once if it was given nothing to draw (it has written
+        nothing: a failed run or bad input is not held up by matplotlib's import), else told to end
+        and killed if it does not within a second."""
         if self._proc is None:
             return
+        if not self._sent:
+            self._proc.kill()
         try:
             self._conn.send(None)
         except (OSError, ValueError):

@@ -3,11 +3,63 @@ solve's steps), tension along the cable, sidewall pressure along the conduit."""
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
 from ..io import new_figure, save_figure
 
-__all__ = ["plot_pull_force", "plot_tension_profile", "plot_pressure"]
+__all__ = ["plot_pull_force", "plot_tension_profile", "plot_pressure", "framed_figure", "thinned_scatter"]
+
+# A fixed layout: margins [in] around the axes, room for y tick labels of up to ~8 characters and the
+# y label (left), the x tick labels and x label (bottom). Not ``bbox_inches="tight"``: that lays each
+# figure out twice to find its extent (a quarter of its drawing time); only the title's width varies
+# enough to need measuring, and measuring one line of text is cheap.
+LEFT_IN, RIGHT_IN, BOTTOM_IN = 0.9, 0.3, 0.6
+#: The resolution the figures are written at [dpi] (:func:`exucable.io.save_figure`'s default).
+SAVE_DPI = 120
+#: A title wider than the axes by more than this [in] is wrapped onto more lines instead of widening the figure.
+TITLE_OVERHANG_IN = 2.0
+
+
+def _text_width_in(text: str, size_pt: float) -> float:
+    """Width [in] of one line of ``text`` in the default font at ``size_pt``, with a margin for hinting."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    width_pt = TextToPath().get_text_width_height_descent(text, FontProperties(size=size_pt), ismath=False)[0]
+    return 1.04 * width_pt / 72.0
+
+
+def _wrap_title(title: str, size_pt: float, width_in: float) -> list[str]:
+    """``title`` in as few lines as fit ``width_in`` [in], broken between words (a name without
+    spaces or hyphens, within it, if it must)."""
+    for breaking in (False, True):
+        for chars in range(len(title), 10, -max(1, len(title) // 40)):
+            lines = textwrap.wrap(title, chars, break_long_words=breaking) or [""]
+            if max(_text_width_in(line, size_pt) for line in lines) <= width_in:
+                return lines
+    return textwrap.wrap(title, 10) or [""]
+
+
+def framed_figure(axes_in: tuple[float, float], title: str, title_pt: float, bottom_in: float = BOTTOM_IN):
+    """A figure whose subplot area is ``axes_in`` (width, height) [in], with the fixed margins and
+    room above for ``title`` (at ``title_pt`` points), centred on the axes as matplotlib places it.
+    A title wider than the axes widens both side margins to hold it (as a tight bounding box would),
+    up to :data:`TITLE_OVERHANG_IN`; a wider one is wrapped. Returns the figure and the title's text
+    (lines joined), to be set with ``fontsize=title_pt``."""
+    import matplotlib
+
+    w_axes, h_axes = axes_in
+    lines = _wrap_title(title, title_pt, w_axes + TITLE_OVERHANG_IN)
+    half_extra = max(max(_text_width_in(line, title_pt) for line in lines) - w_axes, 0.0) / 2 + 0.1
+    left, right = max(LEFT_IN, half_extra), max(RIGHT_IN, half_extra)
+    pad_in = matplotlib.rcParams["axes.titlepad"] / 72.0
+    top = 0.1 + pad_in + len(lines) * 1.25 * title_pt / 72.0
+    w, h = left + w_axes + right, bottom_in + h_axes + top
+    fig = new_figure(figsize=(w, h))
+    fig.subplots_adjust(left=left / w, right=1.0 - right / w, bottom=bottom_in / h, top=1.0 - top / h)
+    return fig, "\n".join(lines)
 
 
 def _zoom(values: np.ndarray, centre: float, references, spread: float) -> tuple[float, float]:
@@ -20,6 +72,31 @@ def _zoom(values: np.ndarray, centre: float, references, spread: float) -> tuple
     return centre - half, centre + half
 
 
+def thinned_scatter(x, y, y_range: tuple[float, float], size_px: tuple[float, float], most: int = 20_000):
+    """The points of a scatter drawn as single pixels, at most one per half pixel of an axes
+    ``size_px`` (width, height) [px] whose y-axis spans ``y_range`` (the x-axis spans at least the
+    points). Up to ``most`` points are kept as they are; beyond, most fall on pixels already drawn (a
+    10 km run has ~10^6 check points for ~750 pixel columns), and drawing them again costs time and
+    changes only how dark the overlaps are. Points outside ``y_range`` keep one each side."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.size <= most:
+        return x, y
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    if x.size == 0:
+        return x, y
+    nx, ny = 2 * int(np.ceil(size_px[0])), 2 * int(np.ceil(size_px[1]))
+    ix = np.floor((x - x.min()) / max(float(x.max() - x.min()), 1e-300) * nx).astype(np.int64)
+    iy = np.floor((y - y_range[0]) / max(y_range[1] - y_range[0], 1e-300) * ny)
+    iy = np.clip(iy, -1, ny).astype(np.int64) + 1
+    # one point per occupied cell: each cell keeps the index written into it last (a linear pass,
+    # no sort of 10^6 keys)
+    cell = np.full((nx + 1) * (ny + 2), -1, dtype=np.int64)
+    cell[ix * (ny + 2) + iy] = np.arange(x.size)
+    kept = cell[cell >= 0]
+    return x[kept], y[kept]
+
+
 def plot_pull_force(path, result) -> None:
     """Pulling force [N] on a scale that shows its scatter and its gap to the rope references (top),
     trailing tension [N] below it. A dynamic run is drawn against time [s] with its steady window; a
@@ -29,10 +106,15 @@ def plot_pull_force(path, result) -> None:
     steady_mode = s.get("mode") == "steady"
     x = np.asarray(h["time_s"], dtype=float)
     pull_h = np.asarray(h["pull_force_N"], dtype=float)
-    fig = new_figure(figsize=(7, 5.2))
+    pull = s.get("pull_force_N")
+    status = "" if s.get("status") in ("ok", "steady") else f" (status {s.get('status')})"
+    if s.get("status") == "failed":
+        status = f" (FAILED at t = {s.get('failed_at_s', float('nan')):.4g} s)"
+    what = "steady sliding state, pulling force" if steady_mode else "pulling force"
+    fig, title = framed_figure((5.425, 4.0), f"{s.get('name', '')}: {what} "
+                               f"{'n/a' if pull is None else format(pull, '.5g')} N{status}", 10)
     ax, low = fig.subplots(2, 1, sharex=True, gridspec_kw=dict(height_ratios=(2.3, 1.0)))
     ax.plot(x, pull_h, ".-" if steady_mode else "-", ms=3, lw=1.2, label="pulling force (leading end)")
-    pull = s.get("pull_force_N")
     refs = []
     for key, style, what in (("rope_pull_force_N", "--", "rope reference"),
                              ("rope_clearance_pull_force_N", ":", "rope free in its clearance")):
@@ -67,22 +149,17 @@ def plot_pull_force(path, result) -> None:
     low.set_xlabel("static solve step (one steady state: no time axis)" if steady_mode else "time [s]")
     ax.ticklabel_format(axis="y", useOffset=False, style="plain")
     ax.set_ylabel("pulling force [N]")
-    status = "" if s.get("status") in ("ok", "steady") else f" (status {s.get('status')})"
-    if s.get("status") == "failed":
-        status = f" (FAILED at t = {s.get('failed_at_s', float('nan')):.4g} s)"
-    what = "steady sliding state, pulling force" if steady_mode else "pulling force"
-    ax.set_title(f"{s.get('name', '')}: {what} "
-                 f"{'n/a' if pull is None else format(pull, '.5g')} N{status}", fontsize=10)
+    ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=7)
-    save_figure(fig, path, bbox_inches="tight")
+    save_figure(fig, path)
 
 
 def plot_tension_profile(path, result) -> None:
     """Tension [N] along the cable (arc length from the trailing end [m]) at the final time,
     beside the rope reference."""
     p = result.tension_profile
-    fig = new_figure(figsize=(7, 4))
+    fig, title = framed_figure((5.425, 3.08), f"{result.summary.get('name', '')}: tension along the cable", 12)
     ax = fig.subplots()
     ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N from the equilibrium of its loads)")
     rp = result.rope_profile
@@ -90,26 +167,29 @@ def plot_tension_profile(path, result) -> None:
         ax.plot(result.extras["x_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
     ax.set_xlabel("x: material coordinate from the trailing end [m]")
     ax.set_ylabel("tension [N]")
-    ax.set_title(f"{result.summary.get('name', '')}: tension along the cable")
+    ax.set_title(title, fontsize=12)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    save_figure(fig, path, bbox_inches="tight")
+    save_figure(fig, path)
 
 
 def plot_pressure(path, result) -> None:
     """Sidewall bearing pressure [N/m] along the conduit: the check points' raw values (faint),
     the windowed pressure and the rope's, windowed alike; bends shaded, point loads marked [N]."""
     pp, s = result.pressure_profile, result.summary
-    fig = new_figure(figsize=(8, 4))
+    # below the axes: the x label, then the legend (two rows of 7 pt) 0.16 axes heights down
+    fig, title = framed_figure((6.2, 3.08), f"{s.get('name', '')}: sidewall pressure (bends shaded; point loads "
+                               "at bend ends)", 12, bottom_in=0.16 * 3.08 + 0.45)
     ax = fig.subplots()
+    top = 1.6 * max(float(np.max(pp["windowed_pressure_N_per_m"])), float(np.max(pp["rope_windowed_pressure_N_per_m"])), 1e-9)
     cp = result.contact_profile
     if cp is not None:
-        ax.plot(cp["s_conduit_m"], cp["normal_force_per_length_N_per_m"], ",", color="0.6", alpha=0.5,
-                label="check points (force / element share)")
+        size_px = (6.2 * SAVE_DPI, 3.08 * SAVE_DPI)
+        ax.plot(*thinned_scatter(cp["s_conduit_m"], cp["normal_force_per_length_N_per_m"], (0.0, top), size_px),
+                ",", color="0.6", alpha=0.5, label="check points (force / element share)")
     ax.plot(pp["s_conduit_m"], pp["windowed_pressure_N_per_m"], lw=1.8,
             label=f"exucable, windowed over {s.get('pressure_window_m', float('nan')):.3g} m")
     ax.plot(pp["s_conduit_m"], pp["rope_windowed_pressure_N_per_m"], "k--", lw=1, label="rope (T/R and weight), windowed")
-    top = 1.6 * max(float(np.max(pp["windowed_pressure_N_per_m"])), float(np.max(pp["rope_windowed_pressure_N_per_m"])), 1e-9)
     loads = []
     for b in result.bends or []:
         ax.axvspan(b["s_conduit_start_m"], b["s_conduit_end_m"], color="b", alpha=0.05)
@@ -125,7 +205,7 @@ def plot_pressure(path, result) -> None:
     ax.set_ylim(0, top)
     ax.set_xlabel("s along the conduit [m]")
     ax.set_ylabel("sidewall bearing pressure [N/m]")
-    ax.set_title(f"{s.get('name', '')}: sidewall pressure (bends shaded; point loads at bend ends)")
+    ax.set_title(title, fontsize=12)
     ax.grid(alpha=0.3)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
-    save_figure(fig, path, bbox_inches="tight")
+    save_figure(fig, path, dpi=SAVE_DPI)
