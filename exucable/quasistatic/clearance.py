@@ -67,14 +67,18 @@ _COARSEN = 4
 # levels below 4000 segments cost more than they saved (100 m: 150 -> 210 ms, commscope: 190 -> 260 ms),
 # and Example 2's 559 segments, which open no long spans, 18 -> 26 ms.
 _COARSEN_REQUESTED_ABOVE = 800
-# Nodes of the default chain beyond which its spacing grows past 2 cm (routes over 2 km): the solve's
-# cost is linear in the nodes, and the free spans of a long route's high tensions are tens of metres
-# long. Measured on a 10 km route (30 mm cable in a 60 mm duct, 15° bends of 10 m radius): 2 cm,
-# 500 000 nodes, 11.8 s CPU; 10 cm 3.4 s; the pulling force differs by 1.5e-5 relative
-# (benchmarks/long_routes.py --clearance-spacing). A light cable at low tension needs the finer
-# chain: an 18 mm cable, 8 mm clearance, μ 0.5, 100 N back tension, 10 km of 20 m bends moved by
-# 2.5e-4 at 10 cm and 1.4e-3 at 20 cm, hence no coarser than 10 cm at 10 km.
-_MAX_NODES = 100_000
+# Nodes of the default chain beyond which its spacing grows past 2 cm (routes over 400 m), up to the
+# bends' hundredth of a radius: the solve's cost is linear in the nodes, and what the answer needs is
+# set by the bends (each node turns ≤ 0.01 rad) and the free spans (metres long at a long route's
+# tensions). Measured (benchmarks/long_routes.py --clearance-spacing and the light cable below), the
+# pulling force's change from the 2 cm chain: a 30 mm cable (1.5 kg/m) in a 60 mm duct, 15° bends of
+# 10 m radius: 1 km at 5 cm -1.1e-6, at 10 cm -2.8e-6; 10 km at 10 cm 1.5e-5 (500 000 nodes 11.8 s
+# CPU, 100 000 nodes 3.4 s); an 18 mm cable (0.21 kg/m), 8 mm clearance, μ 0.5, 100 N back tension,
+# bends of 3 m radius: 1 km at 3 cm (the bends' rule) -1.7e-5, at 5 cm +1.1e-5, at 10 cm +8.7e-5; on
+# 10 km of 20 m bends 2.5e-4 at 10 cm and 1.4e-3 at 20 cm, hence the bends' rule stays. Every change
+# is within a fifth of the 1e-4 relative floor of a steady run's error bar, the finest this reference
+# is compared at.
+_MAX_NODES = 20_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,8 +152,8 @@ def default_node_spacing_m(centreline, clearance_m: float) -> float:
 
     A hundredth of the tightest bend radius (each node turns 0.01 rad; the discrete capstan's
     error is O((μ·0.01)³) per node) and at most 2 cm (free spans across 10 mm clearances are
-    metres long), or on routes over 2 km at most a ``_MAX_NODES``-th of the route; at least 400
-    nodes over the route.
+    metres long), or on routes over 400 m at most a ``_MAX_NODES``-th of the route (20 000 nodes);
+    at least 400 nodes over the route. The measured effect of the cap is at ``_MAX_NODES``.
     """
     L = centreline.length_m
     h = min(0.01 * centreline.min_bend_radius_m, max(0.02, L / _MAX_NODES), L / 400.0)
