@@ -36,12 +36,11 @@ from .scenario.specs import (
     PullSpec,
     Scenario,
     SolverSpec,
-    _build_conduit,
-    _coerce,
-    _conduit_length_m,
-    _FIELD_BY_KEY,
-    _parse_conduit,
-    _quantities_to_si,
+    conduit_from_spec,
+    coerce_value,
+    FIELD_BY_KEY,
+    parse_conduit,
+    quantities_to_si,
 )
 from .output.summary import RunSummary
 from .scenario.fields import REQUIRED, fields_of
@@ -77,7 +76,7 @@ def _keys_doc(section: str) -> str:
 def _part(section: str, spec_cls, summary: str):
     def make(**keys):
         # quantities read as in a file: a number in SI, or a string with its unit ("2.5 mm")
-        return spec_cls.from_keys(**_quantities_to_si({section: keys}, "si")[section])
+        return spec_cls.from_keys(**quantities_to_si({section: keys}, "si")[section])
 
     make.__name__ = make.__qualname__ = section.capitalize()
     make.__doc__ = (f"{summary}\n\nTakes the ``[{section}]`` keys of a scenario file, read as in a file (SI "
@@ -121,8 +120,8 @@ class Route:
                  max_segment_angle: float | None = None, segments_per_bend: int | None = None,
                  _pieces: tuple = (), _survey: dict | None = None):
         # read and checked here, so that a bad radius is named before the first piece
-        inner_radius = _coerce(_FIELD_BY_KEY["conduit.inner_radius"],
-                               _quantities_to_si({"conduit": {"inner_radius": inner_radius}}, "si")["conduit"]
+        inner_radius = coerce_value(FIELD_BY_KEY["conduit.inner_radius"],
+                               quantities_to_si({"conduit": {"inner_radius": inner_radius}}, "si")["conduit"]
                                ["inner_radius"])
         keys: dict[str, Any] = {"inner_radius": inner_radius}
         if _survey is None:
@@ -143,7 +142,7 @@ class Route:
             keys.update(self._survey)
         else:
             keys["path"] = [dict(p) for p in self._pieces]
-        return _parse_conduit(keys, base_dir)
+        return parse_conduit(keys, base_dir)
 
     def _with(self, piece: dict) -> "Route":
         if self._survey is not None:
@@ -151,7 +150,7 @@ class Route:
         k = self._keys
         i = len(self._pieces)
         # lengths as in a file ("10 ft"), errors keyed conduit.path[i]
-        piece = _quantities_to_si({"conduit": {"path": [{}] * i + [dict(piece)]}}, "si")["conduit"]["path"][i]
+        piece = quantities_to_si({"conduit": {"path": [{}] * i + [dict(piece)]}}, "si")["conduit"]["path"][i]
         return Route(k["inner_radius"], k["start"], k["heading"], k.get("max_segment_angle"),
                      k.get("segments_per_bend"), _pieces=self._pieces + (piece,))
 
@@ -204,7 +203,7 @@ class Route:
     @property
     def length_m(self) -> float:
         """Centreline length [m]."""
-        return _conduit_length_m(_build_conduit(self.to_spec()))
+        return float(conduit_from_spec(self.to_spec()).centreline.length_m)
 
     def __repr__(self) -> str:
         what = f"{len(self._pieces)} pieces" if self._survey is None else "survey"

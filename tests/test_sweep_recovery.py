@@ -104,3 +104,25 @@ def test_a_killed_sweep_leaves_no_case_process_running(tmp_path):
         except ProcessLookupError:
             pass
         proc.wait(timeout=10)
+
+
+def test_the_table_is_not_rewritten_after_every_case(tmp_path, runners, monkeypatch):
+    """A sweep of n cases must not rewrite sweep.csv n times (O(n²) in all): while running it is
+    refreshed at most every TABLE_REFRESH_S, and it is complete when the sweep ends."""
+    import exucable.sweep.execute as execute
+    writes = []
+    real = execute.write_table
+
+    def counting(path, rows, columns):
+        writes.append(len(rows))
+        real(path, rows, columns)
+
+    monkeypatch.setattr(execute, "write_table", counting)
+    monkeypatch.setattr(execute, "TABLE_REFRESH_S", 3600.0)     # no refresh can fall due in this test
+    frictions = [round(0.01 * k, 2) for k in range(1, 41)]
+    sw = parse_sweep({"base": str(BASE), "vary": {"contact.friction": frictions}}, DATA)
+    rows = run_sweep(sw, tmp_path / "out", workers=2, runner=runners.quick_runner, plots=False)
+    assert [r["status"] for r in rows] == ["ok"] * 40
+    assert len(writes) == 2                      # the empty table when it starts, the whole one at its end
+    with open(tmp_path / "out" / "sweep.csv") as f:
+        assert sum(1 for _ in f) == 41           # a header and every case

@@ -13,7 +13,7 @@ from ..output.outdir import default_out_dir
 from ..sweep.execute import PLOT, plan, run_sweep
 from ..sweep.plot import plot_sweep
 from ..sweep.spec import OUTPUTS, load_sweep
-from ..sweep.store import TABLE, _extra_columns, is_finished, make_row, table_columns, write_table
+from ..sweep.store import TABLE, extra_columns, is_finished, make_row, table_columns, write_table
 
 __all__ = ["add_arguments", "main", "load_runner"]
 
@@ -86,7 +86,7 @@ def main(args) -> int:
     if args.dry_run or args.collect:
         records, todo = plan(sweep, out_dir, args.retry_failed)
         ids = sweep.case_ids()
-        extra = _extra_columns(sweep.output)
+        extra = extra_columns(sweep.output)
         rows = [make_row(sweep.keys, c.params, cid, records[cid], extra) for c, cid in zip(sweep.cases, ids)]
         if args.collect:
             if not out_dir.is_dir():

@@ -50,6 +50,11 @@ __all__ = [
     "load_scenario",
     "parse_scenario",
     "default_elements",
+    "FIELD_BY_KEY",
+    "coerce_value",
+    "quantities_to_si",
+    "parse_conduit",
+    "conduit_from_spec",
 ]
 
 _DEFAULT_MIN_STEP_S = 1.0e-8
@@ -76,12 +81,12 @@ MAX_SNAPSHOTS = 10_000        # snapshot files
 # e^(μθ) up to e^50 ≈ 5e21: tension ratios beyond any real pull; the rope's exponentials stay finite
 MAX_FRICTION_TURNING = 50.0
 
-_FIELD_BY_KEY: dict[str, Field] = {f.key: f for f in FIELDS}
+FIELD_BY_KEY: dict[str, Field] = {f.key: f for f in FIELDS}
 
 
 def _default(key: str):
     """The dataclass default of a table row: its plain default, else None."""
-    d = _FIELD_BY_KEY[key].default
+    d = FIELD_BY_KEY[key].default
     return None if d is REQUIRED else d
 
 
@@ -95,7 +100,7 @@ def _what(f: Field) -> str:
     }.get(f.kind, "a value")
 
 
-def _coerce(f: Field, value):
+def coerce_value(f: Field, value):
     """Check ``value`` against its table row and return it in canonical form (float, tuple)."""
     key = f.key
     if f.kind == "float":
@@ -171,7 +176,7 @@ class _Spec:
                     raise ScenarioError(f.key, f"must be {_what(f)}, got None; leave the key out for its default "
                                                f"{f.default!r}")
                 continue
-            object.__setattr__(self, f.attr, _coerce(f, value))
+            object.__setattr__(self, f.attr, coerce_value(f, value))
         # Not a dataclass field: no part in equality, hashing or repr.
         object.__setattr__(self, "_derived", frozenset(derived))
         self._check()
@@ -290,7 +295,7 @@ class CableSpec(_Spec):
             given = self.mass_per_length_kg_per_m
             if given is not None and not math.isclose(given, from_density, rel_tol=1e-12):
                 raise ScenarioError("cable.mass_per_length", "give either density or mass_per_length, not both")
-            row = _FIELD_BY_KEY["cable.mass_per_length"]
+            row = FIELD_BY_KEY["cable.mass_per_length"]
             if not row.ge <= from_density <= row.le:
                 raise ScenarioError("cable.density", f"gives a mass per length ρ·π r² = {from_density!r} kg/m with "
                                                      f"cable.radius {self.radius_m!r} m, outside {row.ge:g} … "
@@ -388,7 +393,7 @@ class ConduitSpec(_Spec):
             object.__setattr__(self, "max_segment_angle_deg", None)
             return
         if self.max_segment_angle_deg is None:
-            object.__setattr__(self, "max_segment_angle_deg", _FIELD_BY_KEY["conduit.max_segment_angle"].default)
+            object.__setattr__(self, "max_segment_angle_deg", FIELD_BY_KEY["conduit.max_segment_angle"].default)
         super().__post_init__()
 
     def _check(self) -> None:
@@ -422,7 +427,7 @@ class ConduitSpec(_Spec):
     @classmethod
     def from_keys(cls, **keys):
         """Build from TOML key names (``points_csv`` relative to the working directory)."""
-        return _parse_conduit(keys, Path("."))
+        return parse_conduit(keys, Path("."))
 
 
 @dataclass(frozen=True)
@@ -949,10 +954,10 @@ class Scenario:
             object.__setattr__(self, "conduit", route.to_spec())
         if self.name is None:
             object.__setattr__(self, "name", "scenario")
-        _coerce(_FIELD_BY_KEY["name"], self.name)
+        coerce_value(FIELD_BY_KEY["name"], self.name)
         if not self.name.strip():
             raise ScenarioError("name", "must be a non-empty string")
-        _coerce(_FIELD_BY_KEY["description"], self.description)
+        coerce_value(FIELD_BY_KEY["description"], self.description)
         for part, cls, how in (
             ("cable", CableSpec, "exucable.Cable(...)"),
             ("conduit", ConduitSpec, "route=exucable.Route(...)"),
@@ -1010,10 +1015,10 @@ class Scenario:
         conduit_length_m = _conduit_length_m(conduit)
         # A relative tolerance absorbs float round-off when the length is written as the sum
         # of the route's pieces (e.g. ex1: 50 m cable in a 50 m conduit).
-        shortest = _FIELD_BY_KEY["cable.length"].ge
+        shortest = FIELD_BY_KEY["cable.length"].ge
         if self.cable.length_m is None and conduit_length_m < shortest:
             raise ScenarioError("conduit.path", f"the route is {conduit_length_m:.3g} m long, and so the cable: at least "
-                                                f"{shortest:g} m ({_FIELD_BY_KEY['cable.length'].why})")
+                                                f"{shortest:g} m ({FIELD_BY_KEY['cable.length'].why})")
         if self.cable.length_m is not None and self.cable.length_m > conduit_length_m * (1.0 + 1e-9):
             raise ScenarioError(
                 "cable.length",
@@ -1029,12 +1034,12 @@ class Scenario:
         if self.cable.elements is None:
             n = default_elements(conduit.centreline, self.conduit.inner_radius_m - self.cable.radius_m,
                                  self.cable_length_m, self.cable.element_length_m)
-            limit = _FIELD_BY_KEY["cable.elements"].le
+            limit = FIELD_BY_KEY["cable.elements"].le
             if n > limit:
                 key = "cable.element_length" if self.cable.element_length_m is not None else "conduit.inner_radius"
                 raise ScenarioError(key, f"gives {n} cable elements (cable length {self.cable_length_m:.6g} m, clearance "
                                          f"{self.conduit.inner_radius_m - self.cable.radius_m:.3g} m under the mesh rule), "
-                                         f"more than {limit} ({_FIELD_BY_KEY['cable.elements'].why}); give a longer "
+                                         f"more than {limit} ({FIELD_BY_KEY['cable.elements'].why}); give a longer "
                                          "cable.element_length, fewer cable.elements, or a larger clearance")
             # a copy, not dataclasses.replace: that would re-check, and elements next to a given
             # element_length reads as both given
@@ -1057,7 +1062,7 @@ class Scenario:
         """
         cached = self.__dict__.get("_conduit")
         if cached is None:
-            cached = _build_conduit(self.conduit)
+            cached = conduit_from_spec(self.conduit)
             # Frozen dataclass: bypass __setattr__; the cache is not a field, so it takes
             # no part in equality, hashing or repr.
             object.__setattr__(self, "_conduit", cached)
@@ -1260,7 +1265,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     top = _Table(data, "", {"name", "description", "cable", "conduit", "contact", "pull", "gravity", "solver",
                             "output", "limits", "display"})
     display = _parse_table("display", top.table("display", default={}), DisplaySpec)
-    data = _quantities_to_si(data, display.units)
+    data = quantities_to_si(data, display.units)
     top = _Table(data, "", set(data))
     name = top.string("name", default=default_name)
     if not name.strip():
@@ -1268,7 +1273,7 @@ def parse_scenario(data: dict, base_dir: Path, default_name: str = "scenario") -
     description = top.string("description", default="")
 
     cable = _parse_cable(top.table("cable"))
-    conduit = _parse_conduit(top.table("conduit"), Path(base_dir))
+    conduit = parse_conduit(top.table("conduit"), Path(base_dir))
     contact = _parse_contact(top.table("contact", default={}))
     pull = _parse_pull(top.table("pull"))
     gravity_data = top.table("gravity", default=None)
@@ -1313,7 +1318,7 @@ _QUANTITY_KEYS = {
 _PATH_QUANTITY_KEYS = {"straight": "length", "radius": "length", "pitch": "length"}
 
 
-def _quantities_to_si(data: dict, system: str) -> dict:
+def quantities_to_si(data: dict, system: str) -> dict:
     """A copy of ``data`` with its quantity keys as SI numbers (:mod:`exucable.scenario.units`).
 
     In SI, bare numbers pass unchanged (only strings are converted), so SI files read as before.
@@ -1352,7 +1357,7 @@ _SI_UNIT = {"length": "m", "mass_per_length": "kg/m", "force": "N", "speed": "m/
 
 
 def _quantities_as_si_strings(d: dict) -> dict:
-    """The inverse of :func:`_quantities_to_si` for an imperial scenario's echo: quantities as exact
+    """The inverse of :func:`quantities_to_si` for an imperial scenario's echo: quantities as exact
     ``"<repr> <SI unit>"`` strings, so that reading the echo gives the same numbers."""
     def text(value, dim):
         return f"{float(value)!r} {_SI_UNIT[dim]}" if isinstance(value, (int, float)) and not isinstance(value, bool) else value
@@ -1587,9 +1592,9 @@ _BEND_TURNS = ("left", "right", "up", "down")
 _HELIX_TURNS = ("left", "right")
 
 
-def _parse_conduit(data, base_dir: Path) -> ConduitSpec:
+def parse_conduit(data, base_dir: Path) -> ConduitSpec:
     t = _Table(data, "conduit", {f.name for f in fields_of("conduit")})
-    inner_radius = _coerce(_FIELD_BY_KEY["conduit.inner_radius"], t.data["inner_radius"]) if t.has(
+    inner_radius = coerce_value(FIELD_BY_KEY["conduit.inner_radius"], t.data["inner_radius"]) if t.has(
         "inner_radius") else t.number("inner_radius", "m")
     if t.has("max_segment_angle") and t.has("segments_per_bend"):
         raise ScenarioError(
@@ -1653,7 +1658,7 @@ def _parse_conduit(data, base_dir: Path) -> ConduitSpec:
 
 _PARSERS = {
     "cable": _parse_cable,
-    "conduit": lambda data: _parse_conduit(data, Path(".")),
+    "conduit": lambda data: parse_conduit(data, Path(".")),
     "contact": _parse_contact,
     "pull": _parse_pull,
     "gravity": _parse_gravity,
@@ -1732,7 +1737,7 @@ def _parse_points(key: str, value) -> tuple[tuple[float, float, float], ...]:
         raise ScenarioError(key, f"must be an array of at least 2 points [[x, y, z], ...] (m), got {_describe(value)}")
     if len(value) > MAX_POINTS:
         raise ScenarioError(key, f"must have at most {MAX_POINTS} points, got {len(value)} ({_SIZE_WHY})")
-    start = _FIELD_BY_KEY["conduit.start"]
+    start = FIELD_BY_KEY["conduit.start"]
     return tuple(_vector3(f"{key}[{i}]", p, "m", max_abs=start.max_abs, why=start.why) for i, p in enumerate(value))
 
 
@@ -1813,7 +1818,7 @@ def _rekey(exc: GeometryError, item_key: str | None = None) -> ScenarioError:
     return ScenarioError(full, exc.message)
 
 
-def _build_conduit(spec: ConduitSpec):
+def conduit_from_spec(spec: ConduitSpec):
     try:
         if spec.path is not None:
             centreline = _geo.centreline_from_path(spec.start_m, spec.heading, list(spec.path))

@@ -30,6 +30,7 @@ import copy
 import multiprocessing
 import os
 import sys
+import time
 import uuid
 import warnings
 from pathlib import Path
@@ -42,7 +43,7 @@ from .store import (
     CASES_DIR,
     TABLE,
     SweepLock,
-    _extra_columns,
+    extra_columns,
     case_dir,
     is_finished,
     make_row,
@@ -57,6 +58,9 @@ from .worker import install_packed, record_failure, run_case_packed
 __all__ = ["run_sweep", "default_workers", "worker_context", "plan"]
 
 PLOT = "sweep.png"
+
+#: While a sweep runs, ``sweep.csv`` is rewritten at most this often [s] (and always when it ends).
+TABLE_REFRESH_S = 2.0
 
 
 def default_workers() -> int:
@@ -145,7 +149,7 @@ def _run_sweep(sweep, out: Path, workers, client, retry_failed, quiet, plots, ru
     cases_dir = check_out_dir(out / CASES_DIR)
     keys = sweep.keys
     ids = sweep.case_ids()
-    extra = _extra_columns(sweep.output)
+    extra = extra_columns(sweep.output)
     columns = table_columns(keys, sweep.output)
 
     with SweepLock(out):
@@ -166,10 +170,18 @@ def _run_sweep(sweep, out: Path, workers, client, retry_failed, quiet, plots, ru
         progress = SweepProgress(sweep.name, len(ids), enabled=not quiet)
         state = {"running": 0}
 
+        last_table = [time.monotonic()]
+
         def on_record(cid: str, record: dict) -> None:
             records[cid] = record
             pending.discard(cid)
-            write_table(out / TABLE, rows(), columns)
+            # Rewriting the whole table after every case costs O(n) per case, O(n²) per sweep; the case
+            # directories are the durable record (the table is rebuilt from them on resume), so while
+            # running the table is refreshed at most every TABLE_REFRESH_S, and always at the end.
+            now = time.monotonic()
+            if now - last_table[0] >= TABLE_REFRESH_S:
+                write_table(out / TABLE, rows(), columns)
+                last_table[0] = now
             progress.update(*counts(), state["running"])
 
         def on_running(n: int) -> None:

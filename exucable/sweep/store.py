@@ -3,7 +3,8 @@
 Layout of ``DIR``::
 
     DIR/sweep.json              the sweep: keys, mode, output, every case's hash and parameters
-    DIR/sweep.csv               one row per case (rewritten atomically after each finished case)
+    DIR/sweep.csv               one row per case (rewritten atomically every few seconds while
+                                running and when the sweep ends)
     DIR/sweep.png               output against the first varied key
     DIR/cases/<hash>/           one finished case: run_scenario's files + case.json
     DIR/cases/.<hash>.tmp-<pid> a case being run by process <pid> (never read; removed by a later
@@ -33,7 +34,7 @@ __all__ = [
     "CASES_DIR", "CASE_JSON", "MANIFEST", "TABLE", "FINISHED", "RESULT_COLUMNS", "RECORD_OUTPUTS",
     "case_dir", "temp_dir", "read_record", "read_verified_record", "files_intact", "is_finished",
     "write_record", "install_case", "remove_stale",
-    "write_manifest", "read_manifest", "make_row", "rows_from_disk", "table_columns", "write_table",
+    "write_manifest", "read_manifest", "make_row", "rows_from_disk", "extra_columns", "table_columns", "write_table",
     "read_table", "SweepLock",
 ]
 
@@ -241,12 +242,12 @@ def rows_from_disk(out_dir) -> list[dict]:
     """Rebuild the table rows of a sweep directory from ``sweep.json`` and the cases' ``case.json``."""
     man = read_manifest(out_dir)
     keys = man["keys"]
-    extra = _extra_columns(man.get("output", "pull_force_N"))
+    extra = extra_columns(man.get("output", "pull_force_N"))
     return [make_row(keys, c["params"], c["case"], read_verified_record(case_dir(out_dir, c["case"])), extra)
             for c in man["cases"]]
 
 
-def _extra_columns(output: str) -> tuple[str, ...]:
+def extra_columns(output: str) -> tuple[str, ...]:
     from .spec import OUTPUTS
     cols = [c for c in (output, OUTPUTS.get(output)) if c and c not in RESULT_COLUMNS]
     return tuple(cols)
@@ -254,7 +255,7 @@ def _extra_columns(output: str) -> tuple[str, ...]:
 
 def table_columns(keys, output: str = "pull_force_N") -> list[str]:
     """Column order of ``sweep.csv``: varied keys, result columns (message last)."""
-    return list(keys) + list(RESULT_COLUMNS[:-1]) + list(_extra_columns(output)) + ["message"]
+    return list(keys) + list(RESULT_COLUMNS[:-1]) + list(extra_columns(output)) + ["message"]
 
 
 def _cell(v) -> str:

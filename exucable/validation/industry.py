@@ -489,8 +489,8 @@ def table_rows(iv: IndustryValidation):
 
 
 def format_industry_table(iv: IndustryValidation) -> str:
-    from .paper import _text_table
-    text = _text_table(*table_rows(iv))
+    from .paper import text_table
+    text = text_table(*table_rows(iv))
     text += "\n\nThe differences, explained:\n" + "\n".join(f"  {r.example} ({r.mode}): {r.explanation()}" for r in iv.rows)
     diffs = iv.mode_differences()
     if diffs:

@@ -25,7 +25,7 @@ from ..io import atomic_write_text
 from ..plots.validation import plot_validation_figures
 from ..data.reference_values import load_reference
 
-__all__ = ["Check", "ModeDifference", "MODES", "ValidationRun", "validate", "format_table", "write_report", "TOLERANCES", "CASES"]
+__all__ = ["text_table", "Check", "ModeDifference", "MODES", "ValidationRun", "validate", "format_table", "write_report", "TOLERANCES", "CASES"]
 
 #: The validation cases, in the order they run.
 CASES = ("ex1", "ex2", "ex3", "fig12", "ex4")
@@ -363,7 +363,7 @@ def difference_rows(vr: ValidationRun):
     return header, rows
 
 
-def _text_table(header, rows) -> str:
+def text_table(header, rows) -> str:
     widths = [max(len(str(x)) for x in col) for col in zip(header, *rows)]
     line = "  ".join(h.ljust(w) for h, w in zip(header, widths))
     out = [line, "-" * len(line)]
@@ -372,10 +372,10 @@ def _text_table(header, rows) -> str:
 
 
 def format_table(vr: ValidationRun) -> str:
-    text = _text_table(*table_rows(vr))
+    text = text_table(*table_rows(vr))
     if vr.differences:
         text += "\n\nSteady against dynamic (see reference/README.md where they differ):\n"
-        text += _text_table(*difference_rows(vr))
+        text += text_table(*difference_rows(vr))
     return text
 
 
