@@ -412,9 +412,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     (:mod:`exucable.model.bundle`), its report in ``summary.json`` and each cable's tension in
     ``cable_tensions.csv``; ``tension_profile.csv`` holds the bundle's, the sum over the cables
     (no files here: :func:`run_scenario` writes them)."""
-    from .model.bundle import (build_bundle_model, bundle_cross_sections, bundle_report, bundle_sections,
-                               bundle_tension_profile, check_bundle_supported)
-    from .post.bundle import classify_cross_section
+    from .model.bundle import build_bundle_model, bundle_report, bundle_tension_profile, check_bundle_supported
     from .solve.dynamic import Progress
     from .solve.steady import SteadySettings, solve_steady
 
@@ -422,6 +420,8 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         raise ModelError("contact.check_points_per_element", "several cables take the scenario's check points; "
                          "set the key in the scenario instead")
     check_bundle_supported(sc)
+    if sc.solver.mode == "dynamic":
+        return _solve_bundle_dynamic(sc, quiet, steady_stop, refine)
     t_start = time.perf_counter()
     model = build_bundle_model(sc, refine=refine)
     build_s = time.perf_counter() - t_start
@@ -450,25 +450,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         h["max_tension_N"][-1] = report["max_tension_N"]
     total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
     flags = []
-    panels = None
-    # a failed solve has no state to classify: the keys say so (jam unknown), not a silent false
-    report.update(sections=[], bends=[], jam=None, jam_s_conduit_m=None, cross_sections=[])
-    if out.status != "failed":
-        places = _bundle_places(sc, report, bundle_sections(model))
-        offsets = bundle_cross_sections(model, [p["s_conduit_m"] for p in places])
-        panels = []
-        for p, offs in zip(places, offsets):
-            if np.isnan(offs).any():
-                continue        # outside some cable's extent
-            c = classify_cross_section(offs, sc.conduit.inner_radius_m, sc.cable.radius_m)
-            panels.append(dict(p, offsets_m=offs.tolist(), label=f"{p['label']}: {c['arrangement']}", **c))
-        report["cross_sections"] = [{k: v for k, v in p.items() if k != "label"} for p in panels]
-        if report["jam"]:
-            flags.append(_jam_flag(sc, report))
-    if report["contacts_at_window_edge"]:
-        flags.append({"flag": "window_edge", "s_conduit_m": None, "time_s": None,
-                      "message": f"{report['contacts_at_window_edge']} cable-cable contacts at the broad phase's window "
-                                 "edge: the cables slid apart along the route further than it covers"})
+    panels = _bundle_panels(sc, model, report, flags, out.status != "failed")
     status = out.status if out.status == "failed" or not flags else flags[0]["flag"]
     message = out.message if not flags else "; ".join([out.message] + [f["message"] for f in flags])
     summary = RunSummary(
@@ -495,6 +477,148 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
                        cross_sections={"panels": panels, "inner_radius_m": sc.conduit.inner_radius_m,
                                        "cable_radius_m": sc.cable.radius_m} if panels else None)
     return result
+
+
+def _bundle_panels(sc, model, report: dict, flags: list, solved: bool) -> list | None:
+    """Adds the arrangement found along the route, the jam and the drawn cross-sections to a bundle's
+    ``report`` (:func:`exucable.model.bundle.bundle_sections`) and their flags (``jam``,
+    ``window_edge``) to ``flags``; returns the panels to draw (None when not ``solved``: a failed
+    solve has no state to classify, and the keys say so, jam unknown, not a silent false)."""
+    from .model.bundle import bundle_cross_sections, bundle_sections
+    from .post.bundle import classify_cross_section
+
+    panels = None
+    report.update(sections=[], bends=[], jam=None, jam_s_conduit_m=None, cross_sections=[])
+    if solved:
+        places = _bundle_places(sc, report, bundle_sections(model))
+        offsets = bundle_cross_sections(model, [p["s_conduit_m"] for p in places])
+        panels = []
+        for p, offs in zip(places, offsets):
+            if np.isnan(offs).any():
+                continue        # outside some cable's extent
+            c = classify_cross_section(offs, sc.conduit.inner_radius_m, sc.cable.radius_m)
+            panels.append(dict(p, offsets_m=offs.tolist(), label=f"{p['label']}: {c['arrangement']}", **c))
+        report["cross_sections"] = [{k: v for k, v in p.items() if k != "label"} for p in panels]
+        if report["jam"]:
+            flags.append(_jam_flag(sc, report))
+    if report["contacts_at_window_edge"]:
+        flags.append({"flag": "window_edge", "s_conduit_m": None, "time_s": None,
+                      "message": f"{report['contacts_at_window_edge']} cable-cable contacts at the broad phase's window "
+                                 "edge: the cables slid apart along the route further than it covers"})
+    return panels
+
+
+def _solve_bundle_dynamic(sc, quiet: bool, steady_stop, refine: float) -> RunResult:
+    """Several cables in the dynamic mode (:mod:`exucable.model.bundle_rig`): the bundle integrated in
+    time until the eye's pull is steady, as one cable's run (:func:`_solve`): ``history.csv`` with
+    the bundle's row, the pulling force the steady window's mean with its uncertainty, the trust
+    checks; ``summary.json``'s ``bundle`` report as in steady mode, each cable's share the window's
+    mean and the weight correction against one cable alone at the window's extent."""
+    from .model.bundle import bundle_report, bundle_tension_profile
+    from .model.bundle_rig import build_bundle_dynamic_model
+    from .quasistatic.extent import pull_force_references_N
+    from .solve.dynamic import Progress, earliest_steady_s, expected_drift_N_per_s, simulate
+    from .solve.start import bundle_steady_start
+
+    _refuse_pulling_the_cable_out(sc)
+    sp = sc.solver
+    t_start = time.perf_counter()
+    first = bundle_steady_start(sc, refine=refine, solve=sp.start_from == "steady")
+    model = build_bundle_dynamic_model(sc, refine=refine, start=first.model, layouts=first.layouts)
+    build_s = time.perf_counter() - t_start
+    out = simulate(model, progress=Progress(sp.end_time_s, label=sc.name, enabled=not quiet), steady_stop=steady_stop)
+    h = out.history.arrays()
+    drift = expected_drift_N_per_s(model)
+    st = detect_steady_state(h["time_s"], h["pull_force_N"], sp.steady_window_s, sp.steady_tolerance,
+                             expected_drift_N_per_s=drift, earliest_s=earliest_steady_s(model))
+    from_s = st.from_s if np.isfinite(st.from_s) else 0.0
+    i0 = int(np.searchsorted(h["time_s"], from_s)) if len(h["time_s"]) else 0
+    has_history = bool(len(h["time_s"]))
+    pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"], from_s) if has_history else None
+    pull_force_N = float(np.mean(h["pull_force_N"][i0:])) if has_history else None
+    status, flags = _assess(model, out, st, h, pull_force_N)
+
+    n, Tb = sc.cable.count, sc.pull.back_tension_N
+    report = bundle_report(model)          # the last state's, then the window's means below
+    shares = model.mean_shares_N(from_s)
+    if shares is not None:
+        F = float(np.sum(shares))
+        for row, share in zip(report["cables"], shares):
+            row["pull_share_N"], row["pull_share"] = float(share), (float(share / F) if F != 0.0 else None)
+    # one cable alone with T_b/n over the cables' extent at the window's mean time (the cables have
+    # been pulled on by then), as one cable's references (window_references)
+    t_mean = float(np.mean(h["time_s"][i0:])) if has_history else 0.0
+    alone = pull_force_references_N(sc.replace(**{"pull.back_tension": Tb / n}), model.conduit,
+                                    model.lead_out_m + model.pulled_m(t_mean), with_clearance=False)
+    F1 = alone["rope_pull_force_N"]
+    report["rope_pull_force_one_cable_N"] = F1
+    report["weight_correction_factor"] = ((pull_force_N - Tb) / (n * (F1 - Tb / n))
+                                          if pull_force_N is not None and F1 - Tb / n > 0.0 else None)
+    cables = bundle_tension_profile(model)
+    total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
+    panels = _bundle_panels(sc, model, report, flags, out.status != "failed")
+    bundle_flags = [f for f in flags if f["flag"] in ("jam", "window_edge")]
+    if bundle_flags and status in ("ok", "steady"):
+        status = bundle_flags[0]["flag"]
+    message = out.message
+    if flags and not message:
+        message = "; ".join(f["message"] for f in flags)
+    warnings = list(model.mesh.warnings) if model.mesh is not None else []
+    start = None
+    if sp.start_from == "steady":
+        start = {"kind": "steady" if first.layouts is not None else "rope",
+                 "steady_pull_force_N": first.pull_force_N if first.layouts is not None else None,
+                 "lead_out_m": model.lead_out_m,
+                 "steady_solve_message": first.message, "steady_solve_wall_time_s": first.wall_time_s}
+        if first.layouts is None:
+            warnings.append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
+                            "started from the rope instead")
+    summary = RunSummary(
+        name=sc.name,
+        mode="dynamic",
+        status=status,
+        message=message,
+        flags=flags,
+        pull_force_N=pull_force_N,
+        pull_force_std_N=float(np.std(h["pull_force_N"][i0:] - drift * h["time_s"][i0:])) if has_history else None,
+        reference_drift_N_per_s=drift,
+        pull_force_uncertainty_N=pf.uncertainty_N if pf else None,
+        pull_force_uncertainty_method=pf.method if pf else "no history: none",
+        pull_force_drift_N_per_s=pf.drift_N_per_s + drift if pf else None,
+        pull_force_unexplained_drift_N_per_s=pf.drift_N_per_s if pf else None,
+        pull_force_uncertainty=({"mean_over_periods_N": pf.mean_N + drift * 0.5 * (pf.window_s[0] + pf.window_s[1]),
+                                 "periods": pf.periods, "period_s": pf.period_s, "window_s": list(pf.window_s),
+                                 "method": pf.method} if pf else None),
+        steady_quantity="pull_force_N",
+        steady_drift_N=st.drift_N,
+        trailing_tension_N=float(np.mean(h["trailing_tension_N"][i0:])) if has_history else None,
+        max_tension_N=float(np.max(h["max_tension_N"][i0:])) if has_history else None,
+        bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
+        steady=st.steady,
+        steady_from_s=st.from_s,
+        simulated_time_s=out.end_time_s,
+        steps=out.steps,
+        newton_iterations=out.newton_iterations,
+        newton_iterations_per_step=out.newton_iterations / out.steps if out.steps else None,
+        jacobian_updates=out.jacobian_updates,
+        wall_time_s=out.wall_time_s,
+        build_time_s=build_s,
+        kernel_time_s=model.coupling.kernel_time_s + model.between_coupling.kernel_time_s,
+        mesh=model.mesh.to_dict() if model.mesh is not None else None,
+        warnings=warnings,
+        scenario=sc.to_dict(),
+        versions=versions(),
+        start=start,
+        failed_at_s=out.end_time_s if out.status == "failed" else None,
+        trust_limits={"penetration_fraction_of_min_clearance_radius": PENETRATION_LIMIT,
+                      "dynamic_rhoAv2_over_pull_force": DYNAMIC_LIMIT,
+                      "friction_deficit_fraction_of_mu": FRICTION_DEFICIT_LIMIT,
+                      "outside": "cable axis farther from the conduit axis than its inner radius"},
+    )
+    return RunResult(summary=summary, history=h, tension_profile={"x_m": cables["x_m"], "tension_N": total},
+                     cable_tensions=cables, model=model,
+                     cross_sections={"panels": panels, "inner_radius_m": sc.conduit.inner_radius_m,
+                                     "cable_radius_m": sc.cable.radius_m} if panels else None)
 
 
 def _bundle_places(sc, report: dict, found: dict) -> list[dict]:

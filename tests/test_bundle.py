@@ -113,7 +113,6 @@ def test_run_writes_the_bundle_report(tmp_path):
 
 
 @pytest.mark.parametrize("change, key", [
-    ({"solver.mode": "dynamic"}, "solver.mode"),
     ({"pull.force": 100.0, "pull.back_tension": 0.0}, "pull.force"),
     ({"contact.surface": "segments"}, "contact.surface"),
 ])

@@ -132,8 +132,15 @@ def _print_bundle(s: dict, out_dir: Path) -> int:
         share = None if c["pull_share"] is None else 100.0 * c["pull_share"]
         print(f"  cable {c['cable']}: pull {_f(c['pull_share_N'])} N ({_f(share, '.3g')} %), "
               f"wall {_f(c['wall_normal_force_N'], '.4g')} N, other cables {_f(c['cable_contact_force_N'], '.4g')} N")
-    print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
-          f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    if s["mode"] == "dynamic":
+        u = s.get("pull_force_uncertainty_N")
+        print(f"  time integration to t = {_f(s['simulated_time_s'], '.4g')} s, "
+              f"{'steady from ' + _f(s['steady_from_s'], '.4g') + ' s' if s['steady'] else 'not steady'}, "
+              f"pulling force uncertainty {_f(u, '.3g')} N: {s['steps']} steps, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
+    else:
+        print(f"  steady sliding, one static solve ({s['message']}): {s['steps']} solves, "
+              f"{s['newton_iterations']} Newton iterations, wall {s['wall_time_s']:.2f} s")
     print(f"  results in {out_dir}/")
     for w in s.get("warnings", []):
         print(f"  warning: {w}", file=sys.stderr)

@@ -15,8 +15,15 @@ conduit's wall replaced by another cable's axis:
   v_τ = (I - n nᵀ) v, with the cables' own coefficient μ_c (``contact.cable_friction``), shared
   likewise.
 
-No damping term: the bundle is solved in steady sliding (all cables flow at the pull speed, so δ̇
-vanishes); the dynamic mode refuses several cables.
+- the normal law's damping, as at the wall (Eq. 18 with the onset of ``contact.damping_onset``):
+  f_n = w max(0, K δ^e + C g(δ) δ̇), δ̇ = -n·v, g = min(δ/δ_d, 1) of the current δ (not held within
+  a step as at the wall: its derivative is in the Jacobian). Without it a cable dropped onto
+  another bounces on the elastic Hertz law for seconds (a dynamic run's top cable of a trefoil:
+  the pull swung ±40 % after 2 s); in steady sliding, where all cables flow at the pull speed,
+  the model passes C = 0.
+
+The points' velocities: in steady sliding U = V ∂r/∂x (the material flows along a fixed shape);
+in a dynamic run U = S q̇, the nodal rates mapped to the point, and ∂Q/∂q̇ = Sᵀ (∂F/∂U) S.
 
 Broad phase: the cables are meshed alike and laid side by side, so the check point at index p of
 one cable lies beside the points near index p of the others. Only the segments within ``window``
@@ -67,6 +74,9 @@ class CableContactResult:
         Largest δ [m] (-inf without contact).
     at_window_edge : int
         Contacts whose nearest segment lies at the broad phase's window edge.
+    jacobian_t : scipy.sparse.csr_matrix or None
+        ∂Q/∂q̇ [N·s/m, ...] of a dynamic evaluation (velocities from the nodal rates); None in
+        steady sliding, whose velocities follow from q.
     """
 
     generalized_force: np.ndarray
@@ -74,6 +84,7 @@ class CableContactResult:
     n_in_contact: int
     max_penetration_m: float
     at_window_edge: int
+    jacobian_t: object = None
 
 
 def _segment_search(P, X, first, last):
@@ -107,7 +118,8 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
     weight : ndarray (n_points,)
         w of each check point [-].
     law : ContactLaw
-        ``stiffness``, ``exponent``, ``friction`` (the cables' μ_c), ``regularisation_velocity_m_per_s``.
+        ``stiffness``, ``exponent``, ``friction`` (the cables' μ_c), ``regularisation_velocity_m_per_s``,
+        ``damping`` C and ``damping_onset_m`` δ_d.
 
     Returns
     -------
@@ -118,6 +130,7 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
     X = np.asarray(X, dtype=float)
     U = np.asarray(U, dtype=float)
     K, ex, mu = law.stiffness, law.exponent, law.friction
+    C, dd = law.damping, law.damping_onset_m
     eps2 = law.regularisation_velocity_m_per_s ** 2
     I3 = np.eye(3)
     rows = {k: [] for k in ("index", "t", "penetration_m", "force", "jac_x", "jac_u", "edge")}
@@ -160,6 +173,16 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
                 H = A.T @ dn + np.outer(swap, dt)                                 # ∂²d/∂x²
                 u = np.concatenate([U[i], U[b * n_points + j], U[b * n_points + j + 1]])
                 v = A @ u
+                dfu = np.zeros(9)                                                 # ∂f/∂u
+                if C > 0.0:
+                    rate = -(n @ v)                                               # δ̇
+                    on, don = (1.0, 0.0) if dd <= 0.0 else ((delta / dd, 1.0 / dd) if delta < dd else (1.0, 0.0))
+                    f = f + w * C * on * rate
+                    if not f > 0.0:
+                        continue                                                  # the damping lets go
+                    drate = -(v @ dn + n @ np.outer(u[3:6] - u[6:9], dt))         # ∂δ̇/∂x
+                    df = df + w * C * (-don * rate * g + on * drate)
+                    dfu = -w * C * on * g
                 vt = Pn @ v
                 h = 1.0 / np.sqrt(vt @ vt + eps2)
                 Ff = -mu * f * h * vt
@@ -175,7 +198,7 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
                     dvt_dx = Pn @ dv_dx - (np.outer(n, v) + (n @ v) * I3) @ dn
                     dFf_dx = -mu * np.outer(h * vt, df) - mu * f * M @ dvt_dx
                     jx = np.outer(g, df) + f * H + A.T @ dFf_dx + np.outer(np.concatenate([np.zeros(3), Ff, -Ff]), dt)
-                    ju = A.T @ (-mu * f * M @ Pn @ A)
+                    ju = np.outer(g, dfu) + A.T @ (-mu * np.outer(h * vt, dfu) - mu * f * M @ Pn @ A)
                     rows["jac_x"].append(jx)
                     rows["jac_u"].append(ju)
     m = len(rows["t"])
@@ -191,7 +214,7 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
 
 
 @njit(**_JIT)
-def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps2, jacobian,
+def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps2, C, dd, jacobian,
                    index, tpar, pen, force, jac_x, jac_u, edge):
     """Compiled :func:`pair_contacts_reference`; fills the output arrays, returns the contact count."""
     m = 0
@@ -262,6 +285,13 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 for k in range(3):
                     v[k] = u[k] - (1.0 - t) * u[3 + k] - t * u[6 + k]
                 vn = n[0] * v[0] + n[1] * v[1] + n[2] * v[2]
+                on, don = 1.0, 0.0
+                if C > 0.0:
+                    if dd > 0.0 and delta < dd:
+                        on, don = delta / dd, 1.0 / dd
+                    f = f + w * C * on * (-vn)
+                    if not f > 0.0:
+                        continue
                 vt = v - vn * n
                 h = 1.0 / np.sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2] + eps2)
                 Ff = -mu * f * h * vt
@@ -290,6 +320,11 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                     dn = (Pn @ dr) / d
                     coef = -w * K * ex * delta ** (ex - 1.0)
                     df = coef * g
+                    dfu = np.zeros(9)
+                    if C > 0.0:
+                        drate = -(v @ dn + n @ np.outer(u[3:6] - u[6:9], dt))
+                        df = df + w * C * (-don * (-vn) * g + on * drate)
+                        dfu = -w * C * on * g
                     swap = np.zeros(9)
                     for k in range(3):
                         swap[3 + k] = n[k]
@@ -304,7 +339,7 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                         fswap[3 + k] = Ff[k]
                         fswap[6 + k] = -Ff[k]
                     jac_x[m] = np.outer(g, df) + f * H + A.T @ dFf_dx + np.outer(fswap, dt)
-                    jac_u[m] = A.T @ (-mu * f * (M @ (Pn @ A)))
+                    jac_u[m] = np.outer(g, dfu) + A.T @ (-mu * np.outer(h * vt, dfu) - mu * f * (M @ (Pn @ A)))
                 m += 1
     return m
 
@@ -386,14 +421,18 @@ class CableContactKernel:
         from dataclasses import replace
         self.law = replace(self.base_law, friction=scale * self.base_law.friction)
 
-    def points(self, q):
-        """Check point positions [m] and steady-sliding velocities V ∂r/∂x [m/s], (n_cables·n_points, 3)."""
+    def points(self, q, q_t=None):
+        """Check point positions [m] and velocities [m/s], each (n_cables·n_points, 3): the
+        steady-sliding V ∂r/∂x, or with the nodal rates ``q_t`` (a dynamic state) S q̇."""
         q = np.asarray(q, dtype=float).reshape(-1)
+        if q_t is not None:
+            return (self.S @ q).reshape(-1, 3), (self.S @ np.asarray(q_t, dtype=float).reshape(-1)).reshape(-1, 3)
         return (self.S @ q).reshape(-1, 3), (self.speed_m_per_s * (self.dS @ q)).reshape(-1, 3)
 
-    def contacts(self, q, jacobian: bool = False) -> dict:
-        """Every contact at absolute coordinates ``q`` (see :func:`pair_contacts_reference`)."""
-        X, U = self.points(q)
+    def contacts(self, q, jacobian: bool = False, q_t=None) -> dict:
+        """Every contact at absolute coordinates ``q`` (see :func:`pair_contacts_reference`), the
+        points' velocities from the rates ``q_t`` when given (:meth:`points`)."""
+        X, U = self.points(q, q_t)
         law = self.law
         if self.backend == "numpy":
             return pair_contacts_reference(X, U, self.n_cables, self.n_points, self.window, 2.0 * self.radius_m,
@@ -401,7 +440,8 @@ class CableContactKernel:
         index, t, pen, force, jx, ju, edge = self._buffers
         m = _pair_contacts(X, U, self.n_cables, self.n_points, self.window, 2.0 * self.radius_m, self.weight,
                            float(law.stiffness), float(law.exponent), float(law.friction),
-                           float(law.regularisation_velocity_m_per_s) ** 2, bool(jacobian),
+                           float(law.regularisation_velocity_m_per_s) ** 2, float(law.damping),
+                           float(law.damping_onset_m), bool(jacobian),
                            index, t, pen, force, jx, ju, edge)
         out = {"index": index[:m].copy(), "t": t[:m].copy(), "penetration_m": pen[:m].copy(),
                "force": force[:m].copy(), "edge": edge[:m].copy()}
@@ -409,7 +449,7 @@ class CableContactKernel:
         out["jac_u"] = ju[:m].copy() if jacobian else np.zeros((0, 9, 9))
         return out
 
-    def point_forces_N(self, q) -> tuple[np.ndarray, np.ndarray]:
+    def point_forces_N(self, q, q_t=None) -> tuple[np.ndarray, np.ndarray]:
         """Each cable's contact load from the other cables, check point by check point.
 
         The force of a contact on its point P and, as reaction, on the two check points B0, B1 of the
@@ -425,7 +465,7 @@ class CableContactKernel:
         force_N : ndarray (n_cables, n_points, 3)
             The force on each cable's check points [N].
         """
-        c = self.contacts(q)
+        c = self.contacts(q, q_t=q_t)
         f = np.zeros((self.n_cables * self.n_points, 3))
         np.add.at(f, c["index"].reshape(-1), c["force"].reshape(-1, 3))
         x_nodes = np.concatenate([[0.0], np.cumsum(self.element_length_m)])
@@ -434,23 +474,28 @@ class CableContactKernel:
         x = x_nodes[e] + cable_check_points(self.n_k)[p % self.n_k] * self.element_length_m[e]
         return x, f.reshape(self.n_cables, self.n_points, 3)
 
-    def evaluate(self, q, jacobian: bool = True) -> CableContactResult:
-        """Generalized contact force on all cables and (optionally) its exact Jacobian ∂Q/∂q."""
+    def evaluate(self, q, jacobian: bool = True, q_t=None) -> CableContactResult:
+        """Generalized contact force on all cables and (optionally) its exact Jacobian ∂Q/∂q; with
+        the nodal rates ``q_t`` (a dynamic state) the points move with S q̇ and the Jacobian comes
+        as ∂Q/∂q and ∂Q/∂q̇ (``jacobian_t``)."""
         from scipy import sparse
 
-        c = self.contacts(q, jacobian)
+        c = self.contacts(q, jacobian, q_t)
         n3 = 3 * self.n_points * self.n_cables
         dof = (3 * c["index"][:, :, None] + np.arange(3)[None, None, :]).reshape(-1, 9)   # (m, 9)
         f_pts = np.bincount(dof.reshape(-1), weights=c["force"].reshape(-1), minlength=n3)
         Q = self.St @ f_pts
-        J = None
+        J = J_t = None
         if jacobian:
             r = np.broadcast_to(dof[:, :, None], (len(dof), 9, 9)).reshape(-1)
             k = np.broadcast_to(dof[:, None, :], (len(dof), 9, 9)).reshape(-1)
             Jx = sparse.csr_matrix((c["jac_x"].reshape(-1), (r, k)), shape=(n3, n3))
             Ju = sparse.csr_matrix((c["jac_u"].reshape(-1), (r, k)), shape=(n3, n3))
-            J = (self.St @ (Jx @ self.S) + self.speed_m_per_s * (self.St @ (Ju @ self.dS))).tocsr()
+            if q_t is None:
+                J = (self.St @ (Jx @ self.S) + self.speed_m_per_s * (self.St @ (Ju @ self.dS))).tocsr()
+            else:
+                J, J_t = (self.St @ (Jx @ self.S)).tocsr(), (self.St @ (Ju @ self.S)).tocsr()
         pen = c["penetration_m"]
         return CableContactResult(Q, J, int(len(pen)), float(pen.max()) if len(pen) else -np.inf,
-                                  int(np.count_nonzero(c["edge"])))
+                                  int(np.count_nonzero(c["edge"])), J_t)
 

@@ -17,8 +17,9 @@ All cables have the same material length and trailing end place; through a bend 
 path is longer, so its leading end sits a little short of the inner one's inside the eye (by the
 offset difference times the bend angle, millimetres to centimetres).
 
-Not covered yet, refused naming the key: the dynamic mode, a force-controlled pull,
-``solver.start_from``, the segmented wall.
+The dynamic mode's bundle is :mod:`exucable.model.bundle_rig` (the same cables, started from this
+model's start or its solved state). Not covered yet, refused naming the key: a force-controlled
+pull, the segmented wall, a dynamic bundle's snapshots.
 """
 
 from __future__ import annotations
@@ -107,9 +108,14 @@ def arrangement_offsets(count: int, arrangement: str, inner_radius_m: float, cab
 def check_bundle_supported(scenario) -> None:
     """Refuse, naming the key, what the several-cables model does not cover yet."""
     sc = scenario
-    if sc.solver.mode != "steady":
-        raise ModelError("solver.mode", f"cable.count = {sc.cable.count} is simulated in steady mode only; "
-                         'set solver.mode = "steady" (or cable.count = 1)')
+    if sc.solver.mode not in ("steady", "dynamic"):
+        raise ModelError("solver.mode", f"cable.count = {sc.cable.count}: {sc.solver.mode!r} is not a solver mode; "
+                         'set solver.mode = "steady" or "dynamic"')
+    out = sc.output
+    if sc.solver.mode == "dynamic" and (out.snapshots_s or out.snapshot_interval_s is not None):
+        key = "output.snapshots" if out.snapshots_s else "output.snapshot_interval"
+        raise ModelError(key, "several cables (cable.count > 1) write no snapshots yet; remove the key "
+                              "(output.cross_sections draws the cables across the duct)")
     if sc.pull.force_N is not None:
         raise ModelError("pull.force", "several cables (cable.count > 1) are pulled by the rig's speed only; "
                          "remove pull.force")

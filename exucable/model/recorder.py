@@ -158,4 +158,9 @@ class Recorder:
         if self._gauge is None and self.cable.kernel is not None:
             # built on first use: the axis samples cost a tree over the centreline
             self._gauge = AxisGauge(self.cable.conduit.centreline, self.cable.conduit.inner_radius_m)
-        record_state(self.cable, t, self.history, self._gauge)
+        # a model of several cables records its own row (the bundle's: exucable.model.bundle_rig)
+        own = getattr(self.cable, "record_state", None)
+        if own is not None:
+            own(t, self.history, self._gauge)
+        else:
+            record_state(self.cable, t, self.history, self._gauge)

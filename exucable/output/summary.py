@@ -21,8 +21,9 @@ from typing import Any, Iterator
 
 __all__ = ["RunSummary", "SUMMARY_KEYS"]
 
-# Which runs write a key: "cable" (one cable: cable.count = 1), "bundle" (cable.count > 1) or both.
-_ONE, _BUNDLE, _BOTH = "cable", "bundle", "both"
+# Which runs write a key: "cable" (one cable: cable.count = 1), "bundle" (cable.count > 1), both, or
+# "time" (one cable, and several cables in the dynamic mode: what a time integration finds).
+_ONE, _BUNDLE, _BOTH, _TIME = "cable", "bundle", "both", "time"
 
 
 def _key(doc: str, runs: str = _ONE, optional: bool | str = False, default: Any = None):
@@ -48,36 +49,36 @@ class RunSummary(Mapping):
                                       "or the steady sliding state's (steady); None without a recorded state",
                                       _BOTH)
     pull_force_std_N: float | None = _key("scatter of the pulling force in the steady window about the "
-                                          "references' drift [N]")
+                                          "references' drift [N]", _TIME)
     reference_drift_N_per_s: float | None = _key("how fast the references move as the cable leaves the "
-                                                 "conduit under gravity [N/s]")
-    pull_force_uncertainty_N: float | None = _key("uncertainty of pull_force_N [N] (None: none made)")
-    pull_force_uncertainty_method: str | None = _key("how pull_force_uncertainty_N was found")
+                                                 "conduit under gravity [N/s]", _TIME)
+    pull_force_uncertainty_N: float | None = _key("uncertainty of pull_force_N [N] (None: none made)", _TIME)
+    pull_force_uncertainty_method: str | None = _key("how pull_force_uncertainty_N was found", _TIME)
     trailing_tension_uncertainty_N: float | None = _key(
         "force-controlled steady solve: uncertainty of trailing_tension_N [N]",
         optional="trailing_tension_uncertainty_method")
     trailing_tension_uncertainty_method: str | None = _key(
         "force-controlled steady solve: how trailing_tension_uncertainty_N was found", optional=True)
     pull_force_drift_N_per_s: float | None = _key("dynamic mode: the pulling force's drift over the steady "
-                                                  "window [N/s]")
+                                                  "window [N/s]", _TIME)
     pull_force_unexplained_drift_N_per_s: float | None = _key(
-        "dynamic mode: that drift less the references' expected drift [N/s]")
+        "dynamic mode: that drift less the references' expected drift [N/s]", _TIME)
     pull_force_uncertainty: dict | None = _key("the uncertainty's parts (dynamic: periods and window [s]; "
-                                               "steady: mesh_N, solve_N, coarse_value_N, coarse_elements)")
-    steady_quantity: str | None = _key("the history column the steady detector watches")
-    steady_drift_N: float | None = _key("drift of that quantity over the steady window [N]")
+                                               "steady: mesh_N, solve_N, coarse_value_N, coarse_elements)", _TIME)
+    steady_quantity: str | None = _key("the history column the steady detector watches", _TIME)
+    steady_drift_N: float | None = _key("drift of that quantity over the steady window [N]", _TIME)
     trailing_tension_N: float | None = _key("tension at the trailing end [N] (a bundle: its back tension)", _BOTH)
     max_tension_N: float | None = _key("largest tension along the cable [N] (a bundle: in any cable)", _BOTH)
-    steady: bool | None = _key("whether a steady state was found")
-    steady_from_s: float | None = _key("start of the steady window [s]")
-    simulated_time_s: float | None = _key("simulated time reached [s] (steady mode: 0)")
+    steady: bool | None = _key("whether a steady state was found", _TIME)
+    steady_from_s: float | None = _key("start of the steady window [s]", _TIME)
+    simulated_time_s: float | None = _key("simulated time reached [s] (steady mode: 0)", _TIME)
     steps: int | None = _key("accepted time or pseudo-time steps", _BOTH)
     newton_iterations: int | None = _key("Newton iterations, those of rejected steps included", _BOTH)
-    newton_iterations_per_step: float | None = _key("newton_iterations per accepted step")
-    jacobian_updates: int | None = _key("Jacobian updates of the solver")
+    newton_iterations_per_step: float | None = _key("newton_iterations per accepted step", _TIME)
+    jacobian_updates: int | None = _key("Jacobian updates of the solver", _TIME)
     wall_time_s: float | None = _key("wall time of the solve [s]", _BOTH)
     build_time_s: float | None = _key("wall time of building the model [s]", _BOTH)
-    kernel_time_s: float | None = _key("wall time in the contact kernel [s]")
+    kernel_time_s: float | None = _key("wall time in the contact kernel [s]", _TIME)
     max_check_point_line_load_N_per_m: float | None = _key(
         "largest single check point's normal force over its share of the element [N/m] (a mesh-dependent "
         "line load, not a pressure to set against a cable's limit); None without contact")
@@ -103,11 +104,11 @@ class RunSummary(Mapping):
     warnings: list = _key("what the run warns about, one sentence each", _BOTH, default=())
     scenario: dict | None = _key("the scenario with every default filled in", _BOTH)
     versions: dict | None = _key("versions of exucable, Exudyn, numpy, Python", _BOTH)
-    start: dict | None = _key('solver.start_from = "steady": how the dynamic run was started', optional=True)
-    failed_at_s: float | None = _key("a failed run: the simulated time of the failure [s]", optional=True)
+    start: dict | None = _key('solver.start_from = "steady": how the dynamic run was started', _TIME, optional=True)
+    failed_at_s: float | None = _key("a failed run: the simulated time of the failure [s]", _TIME, optional=True)
     flags: list = _key("every trust flag found: flag, message, place s_conduit_m [m], time time_s [s]", _BOTH,
                        default=())
-    trust_limits: dict | None = _key("the limits the trust flags apply")
+    trust_limits: dict | None = _key("the limits the trust flags apply", _TIME)
     snapshots_s: list | None = _key("times of the snapshots written [s]", optional=True)
     snapshots_not_reached_s: list | None = _key("snapshot times the run did not reach [s]", optional=True)
     files: dict | None = _key("each data file the summary vouches for -> its size in bytes (set when written)",
@@ -116,12 +117,13 @@ class RunSummary(Mapping):
     @cached_property
     def _data(self) -> dict:
         kind = _BUNDLE if self.bundle is not None else _ONE
+        kinds = (kind, _BOTH) + ((_TIME,) if kind == _ONE or self.mode == "dynamic" else ())
         out = {}
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             optional = f.metadata["optional"]
             decides = getattr(self, optional) if isinstance(optional, str) else value
-            if f.metadata["runs"] not in (kind, _BOTH) or (optional and decides is None):
+            if f.metadata["runs"] not in kinds or (optional and decides is None):
                 continue
             out[f.name] = list(value) if isinstance(value, tuple) else value
         return out
@@ -157,5 +159,6 @@ SUMMARY_KEYS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(RunSumm
 
 RunSummary.__doc__ += "\n\nAttributes\n----------\n" + "\n".join(
     f"{f.name} : {f.type}\n    {f.metadata['doc']}" + (" (only when set)" if f.metadata["optional"] else "")
-    + ("" if f.metadata["runs"] == _BOTH else f" ({'one cable' if f.metadata['runs'] == _ONE else 'several cables'} only)")
+    + {_BOTH: "", _ONE: " (one cable only)", _BUNDLE: " (several cables only)",
+       _TIME: " (one cable, and several cables in the dynamic mode)"}[f.metadata["runs"]]
     for f in dataclasses.fields(RunSummary))

@@ -175,8 +175,9 @@ FIELDS: tuple[Field, ...] = (
     # ---- conduit (paper Sect. 2.3)
     F("cable.count", "count", "int", "", 1, ge=1, le=4, ours=True,
       rule="integer 1…4: identical cables of this kind in the duct; they must fit the duct. `exucable plan` uses "
-           "the calculators' formulas; `exucable run` simulates one ANCF cable each in steady mode (docs/results-format.md, "
-           "\"Several cables\")"),
+           "the calculators' formulas; `exucable run` simulates one ANCF cable each, in either solver mode "
+           "(`\"dynamic\"`: the cables' leading ends driven together at the eye, each trailing end with its share "
+           "of `pull.back_tension`; docs/results-format.md, \"Several cables\")"),
     F("cable.arrangement", "arrangement", "choice", "", "auto",
       choices=("auto", "single", "triangular", "cradled", "diamond"), ours=True,
       rule="`single` (1), `triangular` (2, 3), `cradled` (3, 4), `diamond` (4); `auto`: 3 cables triangular for "
@@ -209,7 +210,8 @@ FIELDS: tuple[Field, ...] = (
     F("contact.friction", "friction", "float", "", 0.0, ge=0.0, rule="≥ 0 (kinetic μ)", le=5.0, why="cable–duct friction is 0.1 to 1; e^(μθ) must stay finite"),
     F("contact.cable_friction", "cable_friction", "float", "", 0.0, ge=0.0, ours=True,
       rule="≥ 0: kinetic μ between the cables of a bundle (`cable.count` > 1); 0 (default): frictionless, the "
-           "calculators' rigid-circle statics", le=5.0, why="cable–cable friction is below 1"),
+           "calculators' rigid-circle statics. Their normal law is the wall's (`contact.stiffness`, `exponent`; "
+           "in the dynamic mode also `damping` with its `damping_onset`)", le=5.0, why="cable–cable friction is below 1"),
     F("contact.static_friction", "static_friction", "float", "", None, ge=0.0, ours=True, default_doc="none",
       rule="≥ `friction`", le=5.0, why="cable–duct friction is 0.1 to 1"),
     F("contact.stribeck_velocity", "stribeck_velocity_m_per_s", "float", "m/s", 0.01, gt=0.0, ge=1.0e-6, ours=True,

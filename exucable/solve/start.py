@@ -9,7 +9,9 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-__all__ = ["SteadyStart", "steady_start"]
+import numpy as np
+
+__all__ = ["SteadyStart", "steady_start", "BundleSteadyStart", "bundle_steady_start"]
 
 
 @dataclass
@@ -75,3 +77,52 @@ def steady_start(scenario, refine: float = 1.0, check_points_per_element: int | 
     cable = sliding_layout(rope.element_length_m, rope.node_x_m, rope.node_s_m, q[:, :3], q[:, 3:],
                            scenario.pull.speed_m_per_s)
     return SteadyStart(dataclasses.replace(start, cable=cable), float(pull), out.message, time.perf_counter() - t0)
+
+
+@dataclass
+class BundleSteadyStart:
+    """A dynamic bundle run's start (``cable.count`` > 1): the steady bundle model and, with
+    ``solver.start_from = "steady"``, its solved state.
+
+    Attributes
+    ----------
+    model : exucable.model.bundle.BundleModel
+        The steady bundle model of the scenario (mesh, arrangement, lead-out, rope references).
+    layouts : list of CableLayout or None
+        Each cable's solved shape sliding at the pull speed; None: start from the model's own start
+        (the rope's, ``solver.start_from = "rope"``, or the steady solve failed).
+    pull_force_N : float
+        The steady solve's pulling force [N] (nan when not solved or failed).
+    message : str
+        The steady solve's message ("" when not solved).
+    wall_time_s : float
+        Its wall time, model build included [s].
+    """
+
+    model: object
+    layouts: list | None
+    pull_force_N: float
+    message: str
+    wall_time_s: float
+
+
+def bundle_steady_start(scenario, refine: float = 1.0, solve: bool = True) -> BundleSteadyStart:
+    """The steady bundle model of ``scenario`` (its start is the dynamic run's with
+    ``solver.start_from = "rope"``) and, with ``solve``, its steady sliding state as the dynamic
+    run's start: the same reasons as for one cable (:func:`steady_start`), and for a bundle the
+    cables also start where they rest on one another and on the wall instead of falling the
+    start's gap onto each other."""
+    from ..model.bundle import build_bundle_model
+    from ..model.bundle_rig import solved_bundle_layouts
+    from .steady import SteadySettings, solve_steady
+
+    t0 = time.perf_counter()
+    model = build_bundle_model(scenario.replace(**{"solver.mode": "steady"}), refine=refine)
+    if not solve:
+        return BundleSteadyStart(model, None, float("nan"), "", time.perf_counter() - t0)
+    out = solve_steady(model, settings=SteadySettings.from_solver(model.scenario.solver))
+    if out.status == "failed":
+        # the model's start (model.layout, data) is untouched by the solve: the run starts from it
+        return BundleSteadyStart(model, None, float("nan"), out.message, time.perf_counter() - t0)
+    return BundleSteadyStart(model, solved_bundle_layouts(model), float(np.sum(model.pull_shares_N())), out.message,
+                             time.perf_counter() - t0)
