@@ -15,8 +15,8 @@ per length: elements, check points, Newton iterations of the solve and of the er
 time of the whole process and of each stage with its share (on a shared, loaded machine the CPU
 times are the ones to compare), the rope references' part of the build, the solve's CPU time per
 Newton iteration, peak memory (ru_maxrss) and the pulling force against the rope with clearance;
-then the exponent p of a least-squares fit CPU time ∝ L^p (whole process, the solves, the rest),
-measured in this one run.
+the share of everything outside the two steady solves (CPU time); then the exponent p of a
+least-squares fit CPU time ∝ L^p (whole process, the solves, the rest), measured in this one run.
 
 ``--profile`` runs the longest route once more under cProfile (in this process, after a short
 warm-up) and prints Exudyn's own timers of its static solver per Newton iteration (system
@@ -27,8 +27,14 @@ contact kernel, our coupling's and the pseudo-time spring's user functions, the 
 time): the residual, the ODE2 Jacobian with and without the loads' Jacobian, our contact
 coupling's user functions within them, and one whole one-iteration static solve.
 
-Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing] [--compare-cold]``;
-``--clearance-spacing`` solves the longest route's rope with clearance at a 2 cm node spacing and at
+``--before TREE`` runs each length first with the exucable package of the source tree TREE (e.g.
+``git archive <commit> | tar -x -C TREE``; copy ``exucable/contact/__pycache__`` into it with the
+sources' time stamps, ``touch -r``, or its kernels compile in its first child), then with the installed
+one, and prints the CPU time after/before of the whole process, the solves and the rest, and the
+pulling force's change: a pass's effect measured in one run.
+
+Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing] [--before TREE] [--compare-cold]``;
+``--clearance-spacing`` solves the longest route's rope with clearance at 2, 5 and 10 cm node spacings and at
 the default rule's, with the pulling force's change and the CPU time of each.
 ``--compare-cold`` runs each length a second time with the solved mesh started from the rope start
 instead of the error bar's coarse solve (steady mode's nested start), in a process of its own right
@@ -210,13 +216,21 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
             "cpu_s": cpu, "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **wall}
 
 
-def in_child(length_m: float, figures: bool, cold: bool = False) -> dict:
-    """:func:`one_case` in a fresh process; adds the whole process's wall time ``process_s``."""
+def in_child(length_m: float, figures: bool, cold: bool = False, tree: str | None = None) -> dict:
+    """:func:`one_case` in a fresh process; adds the whole process's wall time ``process_s``.
+    ``cold``: the solved mesh from the rope start (``--compare-cold``); ``tree``: an exucable source tree
+    whose package the child imports instead of the installed one."""
+    import os
+
     cmd = ([sys.executable, __file__, "--case", f"{length_m:g}"] + ([] if figures else ["--no-figures"])
            + (["--cold"] if cold else []))
+    env = None
+    if tree is not None:
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(tree).resolve())]
+                                                          + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     t0 = time.perf_counter()
     cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
     wall = time.perf_counter() - t0
     cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (cpu1.ru_utime - cpu0.ru_utime) + (cpu1.ru_stime - cpu0.ru_stime)
@@ -234,7 +248,9 @@ def report(r: dict) -> str:
     n = max(r["newton_iterations"], 1)
     F, Fc = r["pull_force_N"], r["rope_clearance_pull_force_N"]
     vs = f"{100 * (F / Fc - 1):+.2f} %" if F is not None and Fc else "-"
+    rest = whole - cpu["solve_s"] - cpu["error_bar_s"]
     return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process CPU {whole:6.2f} s (wall {r['process_s']:6.2f} s)  "
+            f"outside the two solves {rest:6.2f} s = {100 * rest / whole:3.0f} %  "
             f"elements {r['elements']:5d}  check points {r['check_points']:7d}  Newton {r['newton_iterations']:4d} "
             f"({r['steps']} pseudo-time steps, from the {r['started_from']}; error bar's coarse solve "
             f"{r['error_bar_newton_iterations']})  "
@@ -262,6 +278,26 @@ def cold_table(pairs) -> str:
                      f"{r['process_cpu_s']:.2f} / {c['process_cpu_s']:.2f} ({r['process_cpu_s'] / c['process_cpu_s']:.2f}) | "
                      f"{dF:+.2g} |")
     return "\n".join(lines)
+
+
+def compare(b: dict, a: dict) -> str:
+    """One line: CPU time after/before of the whole process, the two solves and everything else, and
+    the pulling force's and the rope with clearance's relative change (both runs of one length)."""
+    def parts(r):
+        cpu, whole = r["cpu_s"], r["process_cpu_s"]
+        solves = cpu["solve_s"] + cpu["error_bar_s"]
+        return whole, solves, whole - solves, cpu["build_s"], cpu["references_s"], cpu["post_s"] + cpu["write_s"]
+
+    names = ("whole", "solves", "outside the solves", "build", "rope references", "post + write")
+    ratios = "  ".join(f"{n} {x:.2f} -> {y:.2f} s ({y / x if x else float('nan'):.2f})"
+                       for n, x, y in zip(names, parts(b), parts(a)))
+
+    def rel(key):
+        x, y = b[key], a[key]
+        return "-" if x is None or y is None else f"{y / x - 1:+.1e}"
+    return (f"{'':9s}CPU after/before: {ratios}; change of the pulling force {rel('pull_force_N')}, "
+            f"of the rope with clearance's {rel('rope_clearance_pull_force_N')}; Newton "
+            f"{b['newton_iterations']}/{b['error_bar_newton_iterations']} -> {a['newton_iterations']}/{a['error_bar_newton_iterations']}")
 
 
 def profile(length_m: float, top: int = 25) -> None:
@@ -385,7 +421,7 @@ def newton_parts(length_m: float, reps: int = 5) -> None:
     print(f"  the Jacobian is {100 * jac / whole:.0f} % of the whole iteration")
 
 
-def clearance_spacing(length_m: float, spacings_m=(0.02, None)) -> None:
+def clearance_spacing(length_m: float, spacings_m=(0.02, 0.05, 0.10, None)) -> None:
     """The rope with clearance of the route of ``length_m`` [m] at node spacings ``spacings_m``
     (None: the default rule), with its pulling force and the CPU time of each solve."""
     import math
@@ -414,7 +450,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smoke run: 200 m and 400 m")
     ap.add_argument("--profile", action="store_true", help="also cProfile the longest route")
     ap.add_argument("--clearance-spacing", action="store_true",
-                    help="also the longest route's rope with clearance at 2 cm and at the default node spacing")
+                    help="also the longest route's rope with clearance at 2, 5, 10 cm and at the default node spacing")
     ap.add_argument("--newton-parts", action="store_true",
                     help="also the CPU time of each part of one Newton iteration on the longest route")
     ap.add_argument("--no-figures", action="store_true", help="skip the figures stage")
@@ -422,6 +458,9 @@ def main() -> None:
                     help="also run each length with the solved mesh from the rope start (not from the error "
                          "bar's coarse solve) in a process of its own, and print the two side by side")
     ap.add_argument("--cold", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--before", metavar="TREE",
+                    help="an exucable source tree to compare with (e.g. `git archive <commit> | tar -x -C TREE`): "
+                         "each length runs with it and then with the installed package, interleaved")
     ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.case:
@@ -430,8 +469,13 @@ def main() -> None:
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
     rows, pairs = [], []
     for L in lengths:
+        if args.before:
+            b = in_child(L, figures=not args.no_figures, tree=args.before)
+            print("before: " + report(b), flush=True)
         r = in_child(L, figures=not args.no_figures)
-        print(report(r), flush=True)
+        print(("after:  " if args.before else "") + report(r), flush=True)
+        if args.before:
+            print(compare(b, r), flush=True)
         if args.compare_cold:
             c = in_child(L, figures=not args.no_figures, cold=True)
             print(report(c), flush=True)

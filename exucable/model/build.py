@@ -140,6 +140,8 @@ class CableInConduit:
     end_loads: dict = field(default_factory=lambda: {"leading": [], "trailing": []})
     gravity_loads: tuple = ()
     _ode2_index: np.ndarray | None = field(default=None)
+    # a steady state's loads and the system state they were computed at (see :meth:`loads`)
+    _loads_memo: tuple | None = field(default=None)
 
     def __repr__(self) -> str:
         return (f"{type(self).__name__}({self.scenario.name!r}: {len(self.cable.elements)} cable elements, "
@@ -211,6 +213,26 @@ class CableInConduit:
         mbs = self.mbs
         sd = mbs.systemData
         static = self.scenario.solver.mode == "steady"
+        key = None
+        if state is None and static:
+            # a steady state's loads are asked for several times (its tension profile, the balance
+            # check, the pressure table): computed once per state (coordinates, the rig's reaction in
+            # the algebraic ones, the loads' scale); the check points' forces are most of a post-processing
+            key = (float(sd.GetTime()), np.asarray(sd.GetODE2Coordinates()).tobytes(),
+                   np.asarray(sd.GetODE2Coordinates_t()).tobytes(), np.asarray(sd.GetAECoordinates()).tobytes(),
+                   self.load_scale.gravity if self.load_scale is not None else None,
+                   self.load_scale.end_force if self.load_scale is not None else None)
+            if self._loads_memo is not None and self._loads_memo[0] == key:
+                return self._loads_memo[1]
+        loads = self._loads(state, static)
+        if key is not None:
+            self._loads_memo = (key, loads)
+        return loads
+
+    def _loads(self, state, static: bool) -> CableLoads:
+        """The loads of :meth:`loads`, computed."""
+        mbs = self.mbs
+        sd = mbs.systemData
         if state is None:
             q, v = self.coordinates()
             t = float(sd.GetTime())

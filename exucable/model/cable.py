@@ -88,25 +88,26 @@ def add_cable(mbs, coordinates, element_length_m, properties: CableProperties, v
     if coords.ndim != 2 or coords.shape[1] != 6 or coords.shape[0] != len(lengths) + 1:
         raise ValueError("coordinates must have shape (n_elements + 1, 6)")
     vel = np.zeros_like(coords) if velocities is None else np.asarray(velocities, dtype=float)
-    nodes = tuple(
-        mbs.AddNode(NodePointSlope1(referenceCoordinates=list(c), initialVelocities=list(v)))
-        for c, v in zip(coords, vel)
-    )
     p = properties
-    elements = tuple(
-        mbs.AddObject(ObjectANCFCable(
-            nodeNumbers=[nodes[i], nodes[i + 1]],
-            length=float(lengths[i]),
-            massPerLength=p.mass_per_length_kg_per_m,
-            axialStiffness=p.axial_stiffness_N,
-            bendingStiffness=p.bending_stiffness_N_m2,
-            axialDamping=p.axial_damping_N_s,
-            bendingDamping=p.bending_damping_N_m2_s,
-            useReducedOrderIntegration=INTEGRATION[p.integration],
-            visualization={"show": True, "radius": draw_radius_m, "color": [-1.0, -1.0, -1.0, -1.0]},
-        ))
-        for i in range(len(lengths))
-    )
+    # Each item from its interface class's dict with the per-item values replaced: the same items,
+    # at about half the cost of building an interface object per item (a long route adds tens of
+    # thousands). A fresh dict per call: Exudyn writes the item's name into the one it gets.
+    node = dict(NodePointSlope1(referenceCoordinates=[0.0] * 6))
+    nodes = tuple(mbs.AddNode(dict(node, referenceCoordinates=c, initialVelocities=v))
+                  for c, v in zip(coords.tolist(), vel.tolist()))
+    element = dict(ObjectANCFCable(
+        nodeNumbers=[0, 1],
+        length=1.0,
+        massPerLength=p.mass_per_length_kg_per_m,
+        axialStiffness=p.axial_stiffness_N,
+        bendingStiffness=p.bending_stiffness_N_m2,
+        axialDamping=p.axial_damping_N_s,
+        bendingDamping=p.bending_damping_N_m2_s,
+        useReducedOrderIntegration=INTEGRATION[p.integration],
+        visualization={"show": True, "radius": draw_radius_m, "color": [-1.0, -1.0, -1.0, -1.0]},
+    ))
+    elements = tuple(mbs.AddObject(dict(element, nodeNumbers=[nodes[i], nodes[i + 1]], length=length))
+                     for i, length in enumerate(lengths.tolist()))
     return CableHandles(nodes=nodes, elements=elements, element_length_m=lengths)
 
 
@@ -117,10 +118,11 @@ def add_gravity(mbs, cable: CableHandles, acceleration_m_per_s2, factor=None) ->
     """
     g = [float(a) for a in acceleration_m_per_s2]
     loads = []
+    marker, load = dict(MarkerBodyMass(bodyNumber=0)), dict(LoadMassProportional(markerNumber=0, loadVector=g))
     for e in cable.elements:
-        m = mbs.AddMarker(MarkerBodyMass(bodyNumber=e))
+        m = mbs.AddMarker(dict(marker, bodyNumber=e))    # as in add_cable: the item's dict, fresh
         if factor is None:
-            loads.append(mbs.AddLoad(LoadMassProportional(markerNumber=m, loadVector=g)))
+            loads.append(mbs.AddLoad(dict(load, markerNumber=m)))
         else:
             loads.append(mbs.AddLoad(LoadMassProportional(
                 markerNumber=m, loadVector=g,

@@ -227,23 +227,30 @@ def lay_cable(
     s0 = L - float(cable_length_m) + float(lead_out_m)
     # Fine grid along s, long enough to hold the stretched cable (strain < 50 % is asserted below).
     ds = cable_length_m / (n_elements * points_per_element)
-    s_end_max = s0 + 1.5 * cable_length_m
-    s = np.arange(s0, s_end_max + ds, ds)
-    T = np.zeros_like(s) if tension_N is None else np.asarray(tension_N(np.clip(s, 0.0, L)), dtype=float)
-    o = np.zeros((len(s), 3)) if offset_m is None else np.asarray(offset_m(np.clip(s, 0.0, L)), dtype=float)
-    P = extended_point(centreline, s) + o
-    dP = np.gradient(P, s, axis=0, edge_order=2)
-    speed_geom = np.linalg.norm(dP, axis=1)              # dσ/ds of the offset path
-    stretch = 1.0 + T / axial_stiffness_N                # dσ/dx
-    if np.any(stretch <= 0.5) or np.any(stretch > 1.5):
-        from ..errors import ModelError
-        raise ModelError("cable.youngs_modulus",
-                         f"the rope's tension (up to {float(np.max(np.abs(T))):.4g} N) would stretch the cable by "
-                         f"more than 50 % (EA = {axial_stiffness_N:.4g} N): the cable is far too soft for its loads; "
-                         "check cable.youngs_modulus (Pa), cable.radius and the loads")
-    dx_ds = speed_geom / stretch
-    x = np.concatenate([[0.0], np.cumsum(0.5 * (dx_ds[1:] + dx_ds[:-1]) * np.diff(s))])
+    s_full = np.arange(s0, s0 + 1.5 * cable_length_m + ds, ds)
     x_nodes = np.linspace(0.0, cable_length_m, n_elements + 1)
+    # First on the grid's leading part up to 1.15 cable lengths (enough below ~14 % strain): every
+    # value used below is then the full grid's, bit for bit (the same points; the integral is a
+    # running sum; only the last point's one-sided slope differs, and it is not used when the
+    # cable ends before it); else the whole grid.
+    for extent in (1.15, 1.5):
+        s = s_full if extent == 1.5 else s_full[:int(np.searchsorted(s_full, s0 + extent * cable_length_m)) + 1]
+        T = np.zeros_like(s) if tension_N is None else np.asarray(tension_N(np.clip(s, 0.0, L)), dtype=float)
+        o = np.zeros((len(s), 3)) if offset_m is None else np.asarray(offset_m(np.clip(s, 0.0, L)), dtype=float)
+        P = extended_point(centreline, s) + o
+        dP = np.gradient(P, s, axis=0, edge_order=2)
+        speed_geom = np.linalg.norm(dP, axis=1)              # dσ/ds of the offset path
+        stretch = 1.0 + T / axial_stiffness_N                # dσ/dx
+        if np.any(stretch <= 0.5) or np.any(stretch > 1.5):
+            from ..errors import ModelError
+            raise ModelError("cable.youngs_modulus",
+                             f"the rope's tension (up to {float(np.max(np.abs(T))):.4g} N) would stretch the cable by "
+                             f"more than 50 % (EA = {axial_stiffness_N:.4g} N): the cable is far too soft for its loads; "
+                             "check cable.youngs_modulus (Pa), cable.radius and the loads")
+        dx_ds = speed_geom / stretch
+        x = np.concatenate([[0.0], np.cumsum(0.5 * (dx_ds[1:] + dx_ds[:-1]) * np.diff(s))])
+        if len(s) >= 3 and x[-2] > cable_length_m:
+            break
     if x[-1] < cable_length_m:
         raise ValueError("internal: fine grid too short for the stretched cable")
     s_nodes = np.interp(x_nodes, x, s)

@@ -67,14 +67,18 @@ _COARSEN = 4
 # levels below 4000 segments cost more than they saved (100 m: 150 -> 210 ms, commscope: 190 -> 260 ms),
 # and Example 2's 559 segments, which open no long spans, 18 -> 26 ms.
 _COARSEN_REQUESTED_ABOVE = 800
-# Nodes of the default chain beyond which its spacing grows past 2 cm (routes over 2 km): the solve's
-# cost is linear in the nodes, and the free spans of a long route's high tensions are tens of metres
-# long. Measured on a 10 km route (30 mm cable in a 60 mm duct, 15° bends of 10 m radius): 2 cm,
-# 500 000 nodes, 11.8 s CPU; 10 cm 3.4 s; the pulling force differs by 1.5e-5 relative
-# (benchmarks/long_routes.py --clearance-spacing). A light cable at low tension needs the finer
-# chain: an 18 mm cable, 8 mm clearance, μ 0.5, 100 N back tension, 10 km of 20 m bends moved by
-# 2.5e-4 at 10 cm and 1.4e-3 at 20 cm, hence no coarser than 10 cm at 10 km.
-_MAX_NODES = 100_000
+# Nodes of the default chain beyond which its spacing grows past 2 cm (routes over 400 m), up to the
+# bends' hundredth of a radius: the solve's cost is linear in the nodes, and what the answer needs is
+# set by the bends (each node turns ≤ 0.01 rad) and the free spans (metres long at a long route's
+# tensions). Measured (benchmarks/long_routes.py --clearance-spacing and the light cable below), the
+# pulling force's change from the 2 cm chain: a 30 mm cable (1.5 kg/m) in a 60 mm duct, 15° bends of
+# 10 m radius: 1 km at 5 cm -1.1e-6, at 10 cm -2.8e-6; 10 km at 10 cm 1.5e-5 (500 000 nodes 11.8 s
+# CPU, 100 000 nodes 3.4 s); an 18 mm cable (0.21 kg/m), 8 mm clearance, μ 0.5, 100 N back tension,
+# bends of 3 m radius: 1 km at 3 cm (the bends' rule) -1.7e-5, at 5 cm +1.1e-5, at 10 cm +8.7e-5; on
+# 10 km of 20 m bends 2.5e-4 at 10 cm and 1.4e-3 at 20 cm, hence the bends' rule stays. Every change
+# is within a fifth of the 1e-4 relative floor of a steady run's error bar, the finest this reference
+# is compared at.
+_MAX_NODES = 20_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,13 +147,24 @@ class ClearanceRopeSolution:
         return spans
 
 
+def _row_norm(v) -> np.ndarray:
+    """Length of each row of an (n, 2) or (n, 3) array: ``np.linalg.norm(v, axis=1)`` bit for bit
+    (the same squares summed in the same order), without its generic reduction, which cost 5× as
+    much on the chain's 10⁵ rows (the shape solve takes a dozen per Newton step)."""
+    v = np.asarray(v, dtype=float)
+    total = v[:, 0] * v[:, 0]
+    for j in range(1, v.shape[1]):
+        total = total + v[:, j] * v[:, j]
+    return np.sqrt(total)
+
+
 def default_node_spacing_m(centreline, clearance_m: float) -> float:
     """Node spacing [m] that resolves the route's bends and the free spans across the clearance.
 
     A hundredth of the tightest bend radius (each node turns 0.01 rad; the discrete capstan's
     error is O((μ·0.01)³) per node) and at most 2 cm (free spans across 10 mm clearances are
-    metres long), or on routes over 2 km at most a ``_MAX_NODES``-th of the route; at least 400
-    nodes over the route.
+    metres long), or on routes over 400 m at most a ``_MAX_NODES``-th of the route (20 000 nodes);
+    at least 400 nodes over the route. The measured effect of the cap is at ``_MAX_NODES``.
     """
     L = centreline.length_m
     h = min(0.01 * centreline.min_bend_radius_m, max(0.02, L / _MAX_NODES), L / 400.0)
@@ -177,7 +192,7 @@ def _frames(tangents: np.ndarray) -> np.ndarray:
         prefix /= np.linalg.norm(prefix, axis=(1, 2))[:, None, None]
         shift *= 2
     n1 = prefix @ n0
-    n1 /= np.linalg.norm(n1, axis=1)[:, None]
+    n1 /= _row_norm(n1)[:, None]
     out = np.empty((n, 3, 2))
     out[:, :, 0] = n1
     out[:, :, 1] = np.cross(tangents, n1)
@@ -203,13 +218,13 @@ class _Chain:
 
     def segments(self, x):
         dx = np.diff(x, axis=0)
-        ell = np.linalg.norm(dx, axis=1)
+        ell = _row_norm(dx)
         return dx / ell[:, None], ell
 
     def energy(self, d, T, G):
         x = self.positions(d)
         _, ell = self.segments(x)
-        r = np.linalg.norm(d, axis=1)
+        r = _row_norm(d)
         pen = np.maximum(r - self.c, 0.0)
         return float(T @ ell - np.sum(G * x) + 0.5 * self.k * pen @ pen)
 
@@ -225,7 +240,7 @@ class _Chain:
         fx[1:] += T[:, None] * t
         fx -= G
         g = np.einsum("ijk,ij->ik", self.B, fx)
-        r = np.linalg.norm(d, axis=1)
+        r = _row_norm(d)
         over = r > self.c
         dhat = np.zeros_like(d)
         dhat[over] = d[over] / r[over, None]
@@ -270,7 +285,7 @@ class _Chain:
             # Nodes on the wall move along it (a step along its tangent, then back onto the circle of
             # their present radius): a straight step would cut into the round wall, where the stiff
             # penalty would cut the step to a sliver (observed: 100 Newton steps of 1e-5 m).
-            r = np.linalg.norm(d, axis=1)
+            r = _row_norm(d)
             wall = r > self.c
             er = np.zeros_like(d)
             er[wall] = d[wall] / r[wall, None]
@@ -287,7 +302,7 @@ class _Chain:
                     d_new[wall] = rad[:, None] * (np.cos(ang)[:, None] * er[wall] + np.sin(ang)[:, None] * ephi[wall])
                 # A free node the step carries through the wall stops just on it (the linear model did not
                 # see the wall; taken unclipped, the penalty would cut the step to a sliver for all nodes).
-                r_new = np.linalg.norm(d_new, axis=1)
+                r_new = _row_norm(d_new)
                 hit = ~wall & (r_new > self.c)
                 d_new[hit] *= (self.c * (1.0 + _ON_WALL) / r_new[hit])[:, None]
                 tried[alpha] = d_new, self.energy(d_new, T, G)
@@ -315,7 +330,7 @@ class _Chain:
         n, mu = self.n, self.mu
         x = self.positions(d)
         t, ell = self.segments(x)
-        r = np.linalg.norm(d, axis=1)
+        r = _row_norm(d)
         contact = r > self.c
         dhat = np.zeros_like(x)
         dhat[contact] = np.einsum("ijk,ik->ij", self.B[contact], d[contact] / r[contact, None])
@@ -326,7 +341,7 @@ class _Chain:
         tau = np.empty((n, 3))
         tau[0], tau[-1] = t[0], t[-1]
         bis = t[:-1] + t[1:]
-        tau[1:-1] = bis / np.linalg.norm(bis, axis=1)[:, None]
+        tau[1:-1] = bis / _row_norm(bis)[:, None]
         a, e = self.a, dhat
         into = np.concatenate([a[:1], t])          # direction of the force the cable brings into node i
         out = np.concatenate([t, a[-1:]])          # the leading end is pulled along the exit tangent
@@ -364,7 +379,7 @@ class _Chain:
         """Largest |node force imbalance| [N] with the wall reactions along −d̂."""
         x = self.positions(d)
         t, _ = self.segments(x)
-        r = np.linalg.norm(d, axis=1)
+        r = _row_norm(d)
         dhat = np.zeros_like(x)
         on = r > 0
         dhat[on] = np.einsum("ijk,ik->ij", self.B[on], d[on] / r[on, None])
@@ -373,7 +388,7 @@ class _Chain:
         res[1:] -= T[:, None] * t
         res[0] -= trailing_N * self.a[0]
         res[-1] += pull_N * self.a[-1]
-        return float(np.max(np.linalg.norm(res, axis=1)))
+        return float(np.max(_row_norm(res)))
 
 
 def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
@@ -453,7 +468,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     # start each node on the wall the centreline rope's load presses it against (T κn − w e_z, across)
     load = T_nodes[:, None] * np.asarray(curve.curvature_vector(s), dtype=float) - w * _E_Z[None, :]
     d = np.einsum("ijk,ij->ik", frames, load)
-    size = np.linalg.norm(d, axis=1)
+    size = _row_norm(d)
     pressed = size > 1e-12 * T_ref
     d[pressed] *= (c * (1.0 + _ON_WALL) / size[pressed])[:, None]
     d[~pressed] = 0.0
@@ -473,7 +488,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
         off = np.stack([np.interp(s, s_c[order], coarse.offset_m[order, j]) for j in range(3)], axis=1)
         d = np.einsum("ijk,ij->ik", frames, off)
         on_wall = np.interp(s, s_c[order], coarse.in_contact[order].astype(float)) >= 0.5
-        size = np.linalg.norm(d, axis=1)
+        size = _row_norm(d)
         d[on_wall] *= (c * (1.0 + _ON_WALL) / np.maximum(size[on_wall], 1e-300))[:, None]
         T_node = np.interp(s, s_c[order], coarse.tension_N[order])
         T = 0.5 * (T_node[1:] + T_node[:-1])
@@ -499,7 +514,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
 
     x = chain.positions(d)
     offset = x - centre
-    r = np.linalg.norm(d, axis=1)
+    r = _row_norm(d)
     node_T = np.concatenate([[Tb], 0.5 * (T[1:] + T[:-1]), [pull]])
     share = np.full(n_seg + 1, hs)
     share[[0, -1]] = 0.5 * hs
