@@ -180,20 +180,28 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     sc = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if mode is not None and mode != sc.solver.mode:
         sc = dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, mode=mode))
-    if sc.cable.count != 1:
-        def solve(*args):
-            return _solve_bundle(*args, cpu_budget_s=cpu_budget_s)
-    else:
-        _refuse_pulling_the_cable_out(sc)
-        solve = _solve
-    _refuse_snapshot_times_in_steady_mode(sc)
+
+    def checked_solver():
+        # the checks before the run may import Exudyn: after the figures' helper is forked
+        if sc.cable.count != 1:
+            def solve(*args):
+                return _solve_bundle(*args, cpu_budget_s=cpu_budget_s)
+        else:
+            _refuse_pulling_the_cable_out(sc)
+            solve = _solve
+        _refuse_snapshot_times_in_steady_mode(sc)
+        return solve
+
     if out_dir is None:
-        return solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
-    # the figures' helper process is forked before the solve (or was, by the caller), to import matplotlib beside it
+        return checked_solver()(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
+    # the figures' helper process is forked before anything loads Exudyn (or was, by the caller), to
+    # import matplotlib beside the solve; refused input stops it at once, before anything is written
     started = plots if isinstance(plots, Figures) else Figures() if plots else contextlib.nullcontext(False)
-    with owned_out_dir(out_dir) as out, started as figures:
-        result = solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
-        write_results(out, result, plots=figures)
+    with started as figures:
+        solve = checked_solver()
+        with owned_out_dir(out_dir) as out:
+            result = solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
+            write_results(out, result, plots=figures)
     return result
 
 

@@ -174,6 +174,26 @@ def test_exucable_run_draws_its_figures_in_the_helper(tmp_path):
     assert {"pull_force.png", "tension_profile.png", "pressure.png"} <= {f.name for f in tmp_path.iterdir()}
 
 
+def test_run_scenario_from_python_draws_its_figures_in_the_helper(tmp_path):
+    """The Python entry point forks the helper before its pre-run checks import Exudyn, as the command
+    does: a script calling ``run_scenario`` once gets its figures drawn beside the solve."""
+    script = textwrap.dedent(f"""
+        from exucable.output import figure_process as fp
+        write = fp.Figures.write
+        def spy(self, *a, **k):
+            print("helper", self.helper_running, repr(self.helper_reason))
+            return write(self, *a, **k)
+        fp.Figures.write = spy
+        from exucable.run import run_scenario
+        run_scenario("fast/paper_ex2_bend90", r"{tmp_path}", mode="steady")
+    """)
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert p.returncode == 0, p.stderr
+    assert "helper True ''" in p.stdout, p.stdout + p.stderr
+    assert {"pull_force.png", "tension_profile.png", "pressure.png"} <= {f.name for f in tmp_path.iterdir()}
+
+
 
 def test_a_long_title_is_wrapped_and_not_clipped():
     """The fixed layout: a title up to the overhang widens the margins; a longer one is wrapped, each
