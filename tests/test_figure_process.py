@@ -154,45 +154,39 @@ def test_a_helper_given_nothing_is_killed_at_once():
 
 
 @needs_fork
-def test_exucable_run_draws_its_figures_in_the_helper(tmp_path):
-    """The command forks the helper before anything loads Exudyn, so that the helper is used: a check
-    before the solve that imports Exudyn must not silently keep it out. Coarse Example 2, steady mode."""
-    script = textwrap.dedent(f"""
+def _helper_used_by(call: str, tmp_path) -> subprocess.CompletedProcess:
+    """Run ``call`` (Python source drawing a coarse run's figures into ``tmp_path``) in a fresh
+    process that prints whether the figures' helper was running when the figures were written."""
+    script = textwrap.dedent("""
         from exucable.output import figure_process as fp
         write = fp.Figures.write
         def spy(self, *a, **k):
             print("helper", self.helper_running, repr(self.helper_reason))
             return write(self, *a, **k)
         fp.Figures.write = spy
-        from exucable.cli import main
-        raise SystemExit(main(["run", "fast/paper_ex2_bend90", "-q", "--mode", "steady", "-o", r"{tmp_path}"]))
-    """)
+    """) + call
     p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
                        env=dict(os.environ, PYTHONPATH=str(ROOT)))
-    assert p.returncode in (0, 1), p.stderr
     assert "helper True ''" in p.stdout, p.stdout + p.stderr
     assert {"pull_force.png", "tension_profile.png", "pressure.png"} <= {f.name for f in tmp_path.iterdir()}
+    return p
+
+
+def test_exucable_run_draws_its_figures_in_the_helper(tmp_path):
+    """The command forks the helper before anything loads Exudyn, so that the helper is used: a check
+    before the solve that imports Exudyn must not silently keep it out. Coarse Example 2, steady mode."""
+    p = _helper_used_by("from exucable.cli import main\n"
+                        f"raise SystemExit(main(['run', 'fast/paper_ex2_bend90', '-q', '--mode', 'steady', "
+                        f"'-o', r'{tmp_path}']))\n", tmp_path)
+    assert p.returncode in (0, 1), p.stderr
 
 
 def test_run_scenario_from_python_draws_its_figures_in_the_helper(tmp_path):
     """The Python entry point forks the helper before its pre-run checks import Exudyn, as the command
     does: a script calling ``run_scenario`` once gets its figures drawn beside the solve."""
-    script = textwrap.dedent(f"""
-        from exucable.output import figure_process as fp
-        write = fp.Figures.write
-        def spy(self, *a, **k):
-            print("helper", self.helper_running, repr(self.helper_reason))
-            return write(self, *a, **k)
-        fp.Figures.write = spy
-        from exucable.run import run_scenario
-        run_scenario("fast/paper_ex2_bend90", r"{tmp_path}", mode="steady")
-    """)
-    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300,
-                       env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    p = _helper_used_by("from exucable.run import run_scenario\n"
+                        f"run_scenario('fast/paper_ex2_bend90', r'{tmp_path}', mode='steady')\n", tmp_path)
     assert p.returncode == 0, p.stderr
-    assert "helper True ''" in p.stdout, p.stdout + p.stderr
-    assert {"pull_force.png", "tension_profile.png", "pressure.png"} <= {f.name for f in tmp_path.iterdir()}
-
 
 
 def test_a_long_title_is_wrapped_and_not_clipped():
