@@ -111,6 +111,24 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
     return info, bends, prof
 
 
+def _with_final_contact(model, h: dict) -> dict:
+    """``h`` with the contact columns (``max_penetration_m``, ``max_axis_offset_m`` and its place) of
+    the model's current state in its last row, NaN before it: a steady solve's history records the
+    forces of its pseudo-time steps only, and its last row is the converged state."""
+    from .model.recorder import History, record_state
+
+    last = History()
+    record_state(model, float(h["time_s"][-1]), last,
+                 AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m))
+    rows = len(h["time_s"])
+    columns = {}
+    for key in ("max_penetration_m", "max_axis_offset_m", "max_axis_offset_s_conduit_m"):
+        column = np.full(rows, np.nan)
+        column[-1] = getattr(last, key)[0]
+        columns[key] = column
+    return {**h, **columns}
+
+
 def _assess(model, out, st, h, pull_force_N):
     """Status and flags of a finished run (see :mod:`exucable.post.trust`)."""
     sc = model.scenario
@@ -316,7 +334,10 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         if first.layout is None:
             warnings.append(f"solver.start_from = \"steady\": the steady solve failed ({first.message}); "
                             "started from the rope instead")
-    status, flags = _assess(model, out, st, h, pull_force_N)
+    # a steady solve's pseudo-time steps record forces only: the trust checks of the wall (penetration,
+    # the axis beyond the wall) read the converged state's contact, or they would never run
+    trusted_h = _with_final_contact(model, h) if sp.mode == "steady" and out.status != "failed" and has_history else h
+    status, flags = _assess(model, out, st, trusted_h, pull_force_N)
     if not is_loaded(sc):
         warnings.append("no load acts on the cable (no gravity, pull.back_tension 0, no pull.force): its "
                         "rope reference is 0 N; what the run reports is the bending stiffness's share and "
