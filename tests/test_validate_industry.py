@@ -67,7 +67,7 @@ def test_several_cable_examples_are_skipped_with_the_reason(tmp_path):
     several = [x for x in load_industry_examples() if "three_cables" in x["scenario"]]
     assert several, "the shipped three-cable example (plan only) is expected in reference/industry_values.toml"
     iv = validate_industry(out_dir=tmp_path, examples=several[:1])
-    assert not iv.rows and "simulates one" in iv.skipped[0] and not iv.failures
+    assert not iv.rows and "--suite bundle" in iv.skipped[0] and not iv.failures
 
 
 @pytest.mark.slow
