@@ -129,6 +129,14 @@ def _with_final_contact(model, h: dict) -> dict:
     return {**h, **columns}
 
 
+def _solver_counts(out) -> dict:
+    """The summary's counts of a time integration or steady solve ``out`` (a SolveOutcome)."""
+    return {"simulated_time_s": out.end_time_s, "steps": out.steps, "newton_iterations": out.newton_iterations,
+            # all iterations, those of rejected step attempts included, per accepted step
+            "newton_iterations_per_step": out.newton_iterations / out.steps if out.steps else None,
+            "jacobian_updates": out.jacobian_updates, "wall_time_s": out.wall_time_s}
+
+
 def _assess(model, out, st, h, pull_force_N):
     """Status and flags of a finished run (see :mod:`exucable.post.trust`)."""
     sc = model.scenario
@@ -370,13 +378,7 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         max_tension_N=float(np.max(h["max_tension_N"][i0:])) if has_history else None,
         steady=st.steady,
         steady_from_s=st.from_s,
-        simulated_time_s=out.end_time_s,
-        steps=out.steps,
-        newton_iterations=out.newton_iterations,
-        # all iterations, those of rejected step attempts included, per accepted step
-        newton_iterations_per_step=out.newton_iterations / out.steps if out.steps else None,
-        jacobian_updates=out.jacobian_updates,
-        wall_time_s=out.wall_time_s,
+        **_solver_counts(out),
         build_time_s=build_s,
         kernel_time_s=model.coupling.kernel_time_s if model.coupling is not None else 0.0,
         # one check point's normal force over its share of the element: depends on the mesh and
@@ -642,12 +644,7 @@ def _solve_bundle_dynamic(sc, quiet: bool, steady_stop, refine: float) -> RunRes
         bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
         steady=st.steady,
         steady_from_s=st.from_s,
-        simulated_time_s=out.end_time_s,
-        steps=out.steps,
-        newton_iterations=out.newton_iterations,
-        newton_iterations_per_step=out.newton_iterations / out.steps if out.steps else None,
-        jacobian_updates=out.jacobian_updates,
-        wall_time_s=out.wall_time_s,
+        **_solver_counts(out),
         build_time_s=build_s,
         kernel_time_s=model.coupling.kernel_time_s + model.between_coupling.kernel_time_s,
         mesh=model.mesh.to_dict() if model.mesh is not None else None,
