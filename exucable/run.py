@@ -606,11 +606,14 @@ def _solve_bundle_dynamic(sc, quiet: bool, steady_stop, refine: float) -> RunRes
     total = np.sum([cables[k] for k in cables if k != "x_m"], axis=0)
     panels = _bundle_panels(sc, model, report, flags, out.status != "failed")
     bundle_flags = [f for f in flags if f["flag"] in ("jam", "window_edge")]
-    if bundle_flags and status in ("ok", "steady"):
+    if any(f["flag"] == "jam" for f in flags) and status in ("ok", "steady", "not_steady"):
+        # wedged cables outrank a pull force that has not settled: a stopped pull's never does
+        status = "jam"
+    elif bundle_flags and status in ("ok", "steady"):
         status = bundle_flags[0]["flag"]
     message = out.message
     if flags and not message:
-        message = "; ".join(f["message"] for f in flags)
+        message = "; ".join(f["message"] for f in sorted(flags, key=lambda f: f["flag"] != status))
     warnings = list(model.mesh.warnings) if model.mesh is not None else []
     start = None
     if sp.start_from == "steady":
@@ -730,12 +733,16 @@ def _refuse_pulling_the_cable_out(sc) -> None:
     """Refuse a velocity-controlled dynamic pull whose drive would pull the whole cable out of its
     conduit before ``solver.end_time``: nothing inside is left to pull, and the references at the
     cable's extent do not exist. Refused before the run, so no result is lost afterwards."""
-    from .model.rig import ramped_displacement
+    from .model.rig import pulled_distance_m
 
     sp = sc.solver
     if sp.mode != "dynamic" or sc.pull.force_N is not None:
         return
     v, ramp, length = sc.pull.speed_m_per_s, sc.pull.ramp_time_s, sc.cable_length_m
+
+    def ramped_displacement(t, v, ramp):
+        return pulled_distance_m(t, v, ramp, sc.pull.stop_time_s, sc.pull.hold_time_s)
+
     pulled_m = ramped_displacement(sp.end_time_s, v, ramp)
     if pulled_m < length:
         return
@@ -752,14 +759,16 @@ def window_references(scenario, model, window_time_s) -> dict:
     """Both flexible references (:mod:`exucable.quasistatic.extent`) for the cable's extent at the mean
     time of the averaging window ``window_time_s`` [s] of a velocity-controlled pull; ``{}`` for a
     force-controlled one (its references are the model's centreline rope)."""
-    from .model.rig import ramped_displacement
+    from .model.rig import pulled_distance_m
 
     sc = scenario
     if sc.pull.force_N is not None or len(window_time_s) == 0:
         return {}
     t_mean = float(np.mean(window_time_s))
     lead_out = getattr(model.start, "lead_out_m", 0.0)   # a steady start's lead-out (solver.start_from)
-    return extent_references(sc, model, lead_out + ramped_displacement(t_mean, sc.pull.speed_m_per_s, sc.pull.ramp_time_s))
+    p = sc.pull
+    return extent_references(sc, model, lead_out + pulled_distance_m(t_mean, p.speed_m_per_s, p.ramp_time_s,
+                                                                     p.stop_time_s, p.hold_time_s))
 
 
 def extent_references(scenario, model, pulled_out_m: float) -> dict:

@@ -202,3 +202,123 @@ def test_laid_as_the_keystone_the_steady_bundle_does_not_stay_wedged(monkeypatch
     assert straight["arrangement"] == "cradled" and "side_by_side" not in straight["arrangements_seen"]
     formula = 3 * res.model.rope.pull_force_N
     assert res.pull_force_N == pytest.approx(formula, rel=0.05)
+
+
+# -- a stopped pull: static friction across the duct holds the keystone (dynamic mode)
+
+def test_stopping_pull_schedule():
+    """The eye's schedule: the speed factor is the ramp up, down at the stop and up again after the
+    hold; the distance is its integral (trapezoid on 20 001 points, to 1e-6 of the distance), and
+    without a stop both are the plain ramp's."""
+    from exucable.model.rig import pull_speed_factor, pulled_distance_m, ramped_displacement, smooth_ramp
+
+    tau, stop, hold, V = 0.2, 0.5, 0.3, 0.1
+    t = np.linspace(0.0, 1.5, 20001)
+    f = np.array([pull_speed_factor(x, tau, stop, hold) for x in t])
+    x = np.array([pulled_distance_m(x, V, tau, stop, hold) for x in t])
+    assert f[t <= 0.0][0] == 0.0 and np.all(f[(t >= tau) & (t <= stop)] == 1.0)
+    assert np.all(f[(t >= stop + tau) & (t <= stop + hold)] == 0.0) and np.all(f[t >= stop + hold + tau] == 1.0)
+    integral = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(t))]) * V
+    np.testing.assert_allclose(x, integral, atol=1e-6 * x[-1])
+    # standing still from the start: no motion until the hold ends
+    assert pulled_distance_m(0.3, V, tau, 0.0, 0.4) == 0.0 and pull_speed_factor(0.3, tau, 0.0, 0.4) == 0.0
+    assert pulled_distance_m(0.7, V, 0.0, 0.0, None) == 0.0
+    for y in (0.05, 0.3, 1.0):
+        assert pull_speed_factor(y, tau) == smooth_ramp(y, tau)
+        assert pulled_distance_m(y, V, tau) == ramped_displacement(y, V, tau)
+
+
+@pytest.mark.parametrize("keys, key", [
+    ({"pull.stop_time": None, "pull.hold_time": 0.2}, "pull.hold_time"),
+    ({"pull.stop_time": 0.0, "solver.mode": "steady"}, "pull.stop_time"),
+    ({"pull.stop_time": 0.0, "solver.mode": "dynamic", "solver.exit_span_damping": 10.0}, "pull.stop_time")])
+def test_a_stop_the_model_cannot_run_is_refused_naming_the_key(keys, key):
+    from exucable.errors import ScenarioError
+
+    with pytest.raises(ScenarioError) as err:
+        stopped_keystone(2.98, 0.5).replace(**keys)
+    assert err.value.key == key
+
+
+def stopped_keystone(ratio, static_friction, psi_deg=None):
+    """Three cables laid as the keystone across a 2 m horizontal duct with gravity, the pull standing
+    still from the start (``pull.stop_time = 0``) and the weight and the back tension ramped in over
+    0.2 s (a load put on at once knocks the cables off the wall faster than the Stribeck velocity,
+    and then only the kinetic μ 0.3 acts); 8 elements of 0.25 m, ε = 0.1 mm/s, 0.35 s."""
+    return xc.Scenario(route=xc.Route(inner_radius=ratio * D_CABLE / 2).straight(2.0),
+                       cable=xc.Cable(radius=D_CABLE / 2, density=2000.0, youngs_modulus=2e8, bending_stiffness=1.0,
+                                      count=3, arrangement="cradled", elements=8),
+                       contact=xc.Contact(friction=0.3, static_friction=static_friction, check_points_per_element=8,
+                                          friction_regularisation_velocity=1e-4),
+                       pull=xc.Pull(speed=0.1, back_tension=30.0, stop_time=0.0, ramp_time=0.2),
+                       gravity=xc.Gravity(g=9.81), solver=xc.Solver(mode="dynamic", end_time=0.35))
+
+
+def lay_keystone(monkeypatch, psi_deg):
+    """Lay the cables as the keystone at the outer cables' angle ``psi_deg`` [deg] from the bottom,
+    exactly: the start's 5 % gap (laid as larger circles) would lift the middle cable ~8 mm at D/d
+    2.98 (the keystone's shape is steep near D/d 3) and it would fall onto the others."""
+    import exucable.model.bundle as bundle_model
+
+    def offsets(count, arrangement, inner_radius_m, cable_radius_m):
+        return keystone(2.0 * inner_radius_m, D_CABLE, math.radians(psi_deg)).positions_m[0]
+
+    monkeypatch.setattr(bundle_model, "arrangement_offsets", offsets)
+
+
+def middle_cable_wedge_factor(res) -> float:
+    """The middle cable's mean contact force per length with each outer one over its weight per
+    length [-] in the duct's middle half, 0.5-1.5 m (a bending length √(EJ/T) ≈ 0.3 m and more away
+    from the trailing end and from the eye, which holds the leading ends as laid)."""
+    model = res.model
+    kernel = model.between
+    q_all = np.concatenate([q.reshape(-1) for q in model.cable_coordinates()])
+    c = kernel.contacts(q_all)
+    cable, point = c["index"][:, 0] // kernel.n_points, c["index"][:, 0] % kernel.n_points
+    x_pts, _ = kernel.point_forces_N(q_all)
+    s = np.array([np.interp(x_pts[j], model.layout.cables[i].node_x_m, model.layout.cables[i].node_s_m)
+                  for i, j in zip(cable, point)])
+    line = (kernel.weight[point] * kernel.law.stiffness * c["penetration_m"] ** kernel.law.exponent
+            / (kernel.element_length_m[point // kernel.n_k] / kernel.n_k))
+    w = model.scenario.cable.mass_per_length_kg_per_m * 9.81
+    mid = (s >= 0.5) & (s <= 1.5) & ((cable == 1) | (c["index"][:, 1] // kernel.n_points == 1))
+    return float(np.sum(line[mid]) / np.count_nonzero(mid) / w)
+
+
+def test_a_stopped_keystone_in_the_band_stands_and_is_flagged_jam(monkeypatch):
+    """D/d 2.98, μ_s 0.5, μ 0.3: the keystone needs a wall friction of 0.394 at ψ 86.5° (the least
+    across the duct, :func:`keystone_friction_needed`), so static friction holds it and kinetic would
+    not. Laid there with the pull standing still, it stands through the 0.35 s (the outer cables creep
+    down the wall at about the regularisation speed, well under a millimetre): every plane reads side
+    by side, the run's status is ``jam`` with the place, D/d and the fix. The middle cable's contact
+    force per length is the keystone's G = p d/(2h) at the simulated outer cables' angle, within
+    10 % (Hertz penetrations and the chord's sag move the contact by micrometres where h is 4.6 mm),
+    far above the cradle's 2d/(D − d) = 1.01 and the brief's 1.6."""
+    lay_keystone(monkeypatch, 86.5)
+    res = xc.run(stopped_keystone(2.98, 0.5))
+    b = res.summary.bundle
+    assert res.status == "jam" and b["jam"] is True
+    (straight,) = b["sections"]
+    assert straight["arrangements_seen"] == {"side_by_side": 9}
+    assert res.summary.message.startswith("jam: three cables wedged side by side across the duct at s = ")
+    assert "D/d = 2.98" in res.summary.message and "conduit.inner_radius" in res.summary.message
+    offs = np.array(b["cross_sections"][0]["offsets_m"])
+    psi = math.atan2(-offs[0, 0], -offs[0, 1])
+    assert 85.0 < math.degrees(psi) < 87.0
+    G = keystone(2.98 * D_CABLE, D_CABLE, psi).contact_force_per_load[0]
+    assert middle_cable_wedge_factor(res) == pytest.approx(G, rel=0.10)
+
+
+@pytest.mark.parametrize("ratio, psi_deg, static_friction", [(2.9, 75.0, 0.5), (2.98, 86.5, None)])
+def test_a_keystone_friction_cannot_hold_drops_to_the_triangle_and_stays_ok(monkeypatch, ratio, psi_deg,
+                                                                           static_friction):
+    """Neighbours of the jam: at D/d 2.9 the keystone across the duct needs μ 0.765 (> μ_s 0.5), and
+    at 2.98 without static friction 0.394 (> μ 0.3): laid the same way and held still, the outer
+    cables slide down the wall until they touch, the middle one rests on them (triangular in every
+    plane), no jam, and the run is not flagged ``jam``."""
+    lay_keystone(monkeypatch, psi_deg)
+    res = xc.run(stopped_keystone(ratio, static_friction))
+    b = res.summary.bundle
+    assert b["jam"] is False and res.status != "jam"
+    (straight,) = b["sections"]
+    assert straight["arrangements_seen"] == {"triangular": 9}

@@ -9,6 +9,8 @@ SystemContainer for ``exucable run``.
 
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -458,6 +460,10 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
                          f"({centre.length_m:.6g} m); shorten it or extend the route")
     c = sc.cable
     layout = start.cable
+    if sc.pull.stop_time_s == 0.0 and sc.solver.mode != "steady":
+        # a pull standing still from the start: the cable starts at rest, not sliding
+        layout = dataclasses.replace(layout, velocity_m_per_s=np.zeros_like(layout.velocity_m_per_s),
+                                     slope_rate_1_per_s=np.zeros_like(layout.slope_rate_1_per_s))
     # Steady mode drops the cable's Kelvin–Voigt damping: it acts on the nodal rates, which a static
     # solve never updates (they would stay the start's), and it exists to damp vibrations; in steady
     # flow its axial force would be τ·V·∂N/∂x (τ·V = 1e-4 m at 1 ms, 0.1 m/s), negligible.
@@ -508,7 +514,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
     h.trailing_end = trailing if isinstance(trailing, str) else "joined"
 
     if leading == "rig":
-        h.lead_drive = add_drive(mbs, lead_node, t_exit, rig_speed, ramp_time)
+        h.lead_drive = add_drive(mbs, lead_node, t_exit, rig_speed, ramp_time, sc.pull.stop_time_s, sc.pull.hold_time_s)
     elif leading == "force":
         h.applied_pull_force_N = sc.pull.force_N
         end_force(lead_node, sc.pull.force_N * t_exit)

@@ -124,9 +124,9 @@ def check_bundle_supported(scenario) -> None:
         raise ModelError("solver.pretension", "several cables start from the rope solution; set it to true")
     if sc.contact.surface != "smooth":
         raise ModelError("contact.surface", 'several cables need the smooth wall; set contact.surface = "smooth"')
-    if sc.contact.static_friction is not None:
+    if sc.contact.static_friction is not None and sc.solver.mode == "steady":
         raise ModelError("contact.static_friction", "several cables slide steadily: static friction does not act; "
-                         "remove contact.static_friction")
+                         'remove contact.static_friction (it acts in solver.mode = "dynamic")')
 
 
 def _cross_section_frame(centreline, s_m):

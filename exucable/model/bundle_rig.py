@@ -32,7 +32,7 @@ from ..post.trust import cable_sample_points
 from .bundle import BundleLayout, BundleModel
 from .generic import add_user_force_object
 from .layout import InitialLayout, sliding_layout
-from .rig import ramped_displacement
+from .rig import pulled_distance_m
 
 __all__ = ["BundleDynamicModel", "build_bundle_dynamic_model", "solved_bundle_layouts", "PairContactCoupling"]
 
@@ -213,7 +213,8 @@ class BundleDynamicModel:
     def pulled_m(self, t: float | None = None) -> float:
         """How far the eye has moved along the pull since the start at time ``t`` [s] (now) [m]."""
         t = float(self.mbs.systemData.GetTime()) if t is None else float(t)
-        return ramped_displacement(t, self.scenario.pull.speed_m_per_s, self.scenario.pull.ramp_time_s)
+        p = self.scenario.pull
+        return pulled_distance_m(t, p.speed_m_per_s, p.ramp_time_s, p.stop_time_s, p.hold_time_s)
 
     @property
     def layout(self) -> BundleLayout:
@@ -358,7 +359,8 @@ def build_bundle_dynamic_model(scenario, refine: float = 1.0, start: BundleModel
     check_bundle_supported(sc)
     n = sc.cable.count
     if start is None:
-        start = build_bundle_model(sc.replace(**{"solver.mode": "steady"}), refine=refine)
+        start = build_bundle_model(sc.replace(**{"solver.mode": "steady", "contact.static_friction": None,
+                                                 "pull.stop_time": None, "pull.hold_time": None}), refine=refine)
     cables = list(layouts) if layouts is not None else list(start.layout.cables)
     if len(cables) != n or any(c.n_elements != start.layout.cables[0].n_elements for c in cables):
         raise ValueError("internal: the start's layouts do not match the bundle's cables and mesh")

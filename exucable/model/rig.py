@@ -19,7 +19,7 @@ from exudyn.itemInterface import (CoordinateConstraint, LoadForceVector, MarkerN
                                   ObjectConnectorCoordinateVector)
 
 __all__ = ["Drive", "Guide", "add_guide", "add_reel", "TangentialDrive", "add_drive", "add_tangential_drive", "add_end_force",
-           "smooth_ramp", "ramped_displacement", "drive_force_vector_N"]
+           "smooth_ramp", "ramped_displacement", "pull_speed_factor", "pulled_distance_m", "drive_force_vector_N"]
 
 
 def smooth_ramp(t: float, ramp_time_s: float) -> float:
@@ -40,6 +40,42 @@ def ramped_displacement(t: float, speed_m_per_s: float, ramp_time_s: float) -> f
         return speed_m_per_s * (t - 0.5 * ramp_time_s)
     tau = t / ramp_time_s
     return speed_m_per_s * ramp_time_s * (tau ** 3 - 0.5 * tau ** 4)
+
+
+def _after(t: float, ramp_time_s: float) -> float:
+    """:func:`smooth_ramp` started at time 0, 0 before it."""
+    return 0.0 if t < 0.0 else smooth_ramp(t, ramp_time_s)
+
+
+def _moved_after(t: float, ramp_time_s: float) -> float:
+    """:func:`ramped_displacement` at unit speed started at time 0, 0 before it [m per m/s]."""
+    return 0.0 if t <= 0.0 else ramped_displacement(t, 1.0, ramp_time_s)
+
+
+def pull_speed_factor(t: float, ramp_time_s: float, stop_time_s: float | None = None,
+                      hold_time_s: float | None = None) -> float:
+    """The eye's speed over the pull speed at time ``t`` [s], a stopping pull's schedule [-]: the
+    ramp up from 0, the ramp down from ``stop_time_s`` and, after ``hold_time_s`` standing still,
+    the ramp up again, each the C¹ :func:`smooth_ramp` over ``ramp_time_s`` (a step when 0). No
+    stop (None): :func:`smooth_ramp`. A stop at 0 is a pull standing still from the start."""
+    f = _after(t, ramp_time_s)
+    if stop_time_s is not None:
+        f -= _after(t - stop_time_s, ramp_time_s)
+        if hold_time_s is not None:
+            f += _after(t - stop_time_s - hold_time_s, ramp_time_s)
+    return f
+
+
+def pulled_distance_m(t: float, speed_m_per_s: float, ramp_time_s: float, stop_time_s: float | None = None,
+                      hold_time_s: float | None = None) -> float:
+    """How far the eye has moved by time ``t`` [s] at ``speed_m_per_s`` [m/s] on the schedule of
+    :func:`pull_speed_factor` [m] (its integral)."""
+    x = _moved_after(t, ramp_time_s)
+    if stop_time_s is not None:
+        x -= _moved_after(t - stop_time_s, ramp_time_s)
+        if hold_time_s is not None:
+            x += _moved_after(t - stop_time_s - hold_time_s, ramp_time_s)
+    return speed_m_per_s * x
 
 
 @dataclass(frozen=True)
@@ -70,9 +106,11 @@ def drive_force_vector_N(mbs, drive, static: bool = False) -> np.ndarray:
     return flip * drive.sign * lam
 
 
-def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: float = 0.0) -> Drive:
+def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: float = 0.0,
+              stop_time_s: float | None = None, hold_time_s: float | None = None) -> Drive:
     """Drive ``node``'s position along unit ``direction`` at ``speed_m_per_s`` (ramped over
-    ``ramp_time_s``), holding it on that line. Returns the :class:`Drive`."""
+    ``ramp_time_s``; stopping at ``stop_time_s`` and going on after ``hold_time_s``,
+    :func:`pull_speed_factor`), holding it on that line. Returns the :class:`Drive`."""
     d = np.asarray(direction, dtype=float)
     d = d / np.linalg.norm(d)
     # a ground coordinate to constrain against (one per drive keeps drives independent)
@@ -83,8 +121,10 @@ def add_drive(mbs, node: int, direction, speed_m_per_s: float, ramp_time_s: floa
         dk = float(d[k])
         cons.append(mbs.AddObject(CoordinateConstraint(
             markerNumbers=[mg, m],
-            offsetUserFunction=lambda mbs, t, i, off, dk=dk: dk * ramped_displacement(t, speed_m_per_s, ramp_time_s),
-            offsetUserFunction_t=lambda mbs, t, i, off, dk=dk: dk * speed_m_per_s * smooth_ramp(t, ramp_time_s),
+            offsetUserFunction=lambda mbs, t, i, off, dk=dk: dk * pulled_distance_m(t, speed_m_per_s, ramp_time_s,
+                                                                                  stop_time_s, hold_time_s),
+            offsetUserFunction_t=lambda mbs, t, i, off, dk=dk: dk * speed_m_per_s * pull_speed_factor(
+                t, ramp_time_s, stop_time_s, hold_time_s),
             visualization={"show": False, "drawSize": -1.0, "color": [-1.0, -1.0, -1.0, -1.0]},
         )))
     return Drive(constraints=tuple(cons), direction=d)

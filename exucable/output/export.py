@@ -114,6 +114,10 @@ def problem_description(model) -> dict:
         "speed_m_per_s": sc.pull.speed_m_per_s,
         "ramp_time_s": sc.pull.ramp_time_s,
         "ramp": "3 tau^2 - 2 tau^3, tau = t / ramp_time_s (1 when ramp_time_s = 0)",
+        "stop_time_s": sc.pull.stop_time_s,
+        "hold_time_s": sc.pull.hold_time_s,
+        "schedule": ("the leading node's speed is speed_m_per_s * (ramp(t) - ramp(t - stop_time_s) + "
+                     "ramp(t - stop_time_s - hold_time_s)), each ramp 0 before its start; a null time drops its terms"),
         "lead": ("position of the leading node held on the exit tangent line, moving along it at "
                  "speed_m_per_s * ramp" if model.lead_drive is not None else
                  "force applied_pull_force_N * ramp * exit_tangent on the leading node"),

@@ -253,6 +253,13 @@ FIELDS: tuple[Field, ...] = (
            "`back_tension`", le=1.0e8, why="up to 100 MN, beyond any cable's strength"),
     F("pull.ramp_time", "ramp_time_s", "float", "s", 0.0, ge=0.0, ours=True,
       rule="≥ 0: time over which speed/loads ramp up from the start state", le=1.0e6, why="keeps the run's size finite"),
+    F("pull.stop_time", "stop_time_s", "float", "s", None, ge=0.0, ours=True, default_doc="none",
+      rule="≥ 0, dynamic mode, velocity-controlled pull: the eye stops here (slowing over `ramp_time`) and stands "
+           "still, so static friction (`contact.static_friction`) can hold the cables across the duct (a jam); 0: "
+           "standing still from the start, the cables laid at rest", le=1.0e6, why="keeps the run's size finite"),
+    F("pull.hold_time", "hold_time_s", "float", "s", None, gt=0.0, ours=True, default_doc="none",
+      rule="> 0, with `stop_time`: the eye stands still this long, then pulls on (over `ramp_time`); none: still to "
+           "the end", le=1.0e6, why="keeps the run's size finite"),
     F("pull.feed_from_reel", "feed_from_reel", "bool", "", False, ours=True,
       rule="`exucable plan`: also the pull-in history (tension at the rig vs pulled length), with `back_tension` "
            "as the reel's back tension"),

@@ -510,6 +510,10 @@ class PullSpec(_Spec):
         Prescribed pulling force at the pulled end [N] (force-controlled pull), or None.
     ramp_time_s : float
         Time over which speed and loads ramp up from the start state [s].
+    stop_time_s : float or None
+        Time at which the eye stops (dynamic mode) [s], or None (never).
+    hold_time_s : float or None
+        How long it then stands still before pulling on [s], or None (to the end).
     feed_from_reel : bool
         ``exucable plan``: also compute the pull-in history.
     """
@@ -521,9 +525,16 @@ class PullSpec(_Spec):
     back_tension_N: float = _default("pull.back_tension")
     force_N: float | None = _default("pull.force")
     ramp_time_s: float = _default("pull.ramp_time")
+    stop_time_s: float | None = _default("pull.stop_time")
+    hold_time_s: float | None = _default("pull.hold_time")
     feed_from_reel: bool = _default("pull.feed_from_reel")
 
     def _check(self) -> None:
+        if self.hold_time_s is not None and self.stop_time_s is None:
+            raise ScenarioError("pull.hold_time", "holds a stopped pull: give pull.stop_time too, or remove it")
+        if self.stop_time_s is not None and self.force_N is not None:
+            raise ScenarioError("pull.stop_time", "stops the speed rig; a force-controlled pull (pull.force) has none: "
+                                                  "remove one of them")
         if self.force_N is not None and self.back_tension_N != 0.0:
             raise ScenarioError(
                 "pull.force",
@@ -980,6 +991,13 @@ class Scenario:
             object.__setattr__(solver, "mode", mode)
             object.__setattr__(solver, "_mode_rule", rule)
             object.__setattr__(self, "solver", solver)
+        if self.pull.stop_time_s is not None and self.solver.mode == "steady":
+            why = "" if "mode" not in self.solver.derived_keys else f" (solver.mode {self.solver.mode_rule})"
+            raise ScenarioError("pull.stop_time", f"a pull that stops is a transient, steady mode has none{why}: set "
+                                                  "solver.mode = \"dynamic\" or remove pull.stop_time")
+        if self.pull.stop_time_s is not None and self.solver.exit_span_damping_1_per_s > 0.0:
+            raise ScenarioError("pull.stop_time", "solver.exit_span_damping damps toward the flow at the pull speed, "
+                                                  "which a stopped pull does not have: remove one of them")
         if self.solver.mode == "dynamic" and self.solver.end_time_s is None:
             why = "" if "mode" not in self.solver.derived_keys else f" (solver.mode {self.solver.mode_rule})"
             steady = ", or set solver.mode = \"steady\" (no end_time)" if self.solver.pretension else ""

@@ -218,7 +218,9 @@ def bundle_steady_start(scenario, refine: float = 1.0, solve: bool = True) -> Bu
     from .steady import SteadySettings, solve_steady
 
     t0 = time.perf_counter()
-    model = build_bundle_model(scenario.replace(**{"solver.mode": "steady"}), refine=refine)
+    # steady sliding has no static friction and no stop: the start leaves them out
+    model = build_bundle_model(scenario.replace(**{"solver.mode": "steady", "contact.static_friction": None,
+                                                   "pull.stop_time": None, "pull.hold_time": None}), refine=refine)
     if not solve:
         return BundleSteadyStart(model, None, float("nan"), "", time.perf_counter() - t0)
     out = solve_steady(model, settings=SteadySettings.from_solver(model.scenario.solver))
