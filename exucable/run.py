@@ -707,7 +707,9 @@ def _jam_flag(sc, report: dict) -> dict:
             "message": f"jam: three cables wedged side by side across the duct at s = {report['jam_s_conduit_m']:.4g} m "
                        f"({where['kind']} {where['section']}), D/d = {ratio:.3g} ({inside} the calculators' jam range "
                        f"{lo:g}-{hi:g}); fix: a duct with D/d outside {lo:g}-{hi:g} (conduit.inner_radius), or the "
-                       "cables pulled as a bound trefoil"}
+                       "cables pulled as a bound trefoil"
+                       + (", or no stop there (pull.stop_time: the pull stands still, and static friction across the "
+                          "duct holds the wedge)" if sc.pull.stop_time_s is not None else "")}
 
 
 def _steady_on_the_rule(sc) -> bool:

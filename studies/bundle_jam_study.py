@@ -20,11 +20,23 @@ Per case, all measured in this one run:
   d/(2h) in the keystone across the duct (:mod:`exucable.quasistatic.bundle_jam`), which grows
   without bound toward D/d = 3.
 
+Then the jam itself, in the dynamic mode with the pull standing still (``pull.stop_time = 0``, the
+weight and back tension ramped in over 0.2 s): three cables laid as the keystone across a 2 m
+horizontal duct with gravity at the angle that needs the least wall friction
+(:func:`~exucable.quasistatic.bundle_jam.least_friction_keystone`), with the kinetic μ 0.3 alone and
+with a static μ_s 0.5 (Stribeck, v_s 1 cm/s; regularisation ε 0.1 mm/s): does it stand (the run's
+status ``jam``) where the statics say the friction holds it, and drop into the triangle where not?
+Per case the status, the arrangement, the outer cables' final angle and the middle cable's contact
+force per length over its weight against the keystone's G/p at that angle. And one held keystone
+pulled on again after 0.3 s (``pull.hold_time``): the restart force's peak against the pull once it
+has dropped through.
+
 Beside it, from the rigid-circle statics of the keystone (no Exudyn): the least wall friction that
 holds a keystone across the duct, and the D/d band where a friction μ_s holds one, in a round duct
 and with a bend's 5 % ovality.
 
     nice .venv/bin/python studies/bundle_jam_study.py [--ratios 2.6 2.9 3.1 3.4] [--up-ratios 2.9] [--keystone-ratios 2.9 3.05]
+        [--stopped-ratios 2.9 2.95 2.97 2.98 2.99 3.05] [--restart-ratio 2.98]
         [--record reference/bundle_jam_study.json] [--figure reference/bundle_jam.png] [--from-json FILE]
 
 The record and its reading: reference/README.md, "Three cables through the jam range".
@@ -47,7 +59,7 @@ from exucable.io import atomic_write_text
 import exucable.model.bundle as bundle_model
 from exucable.model.bundle import build_bundle_model, bundle_report, bundle_sections
 from exucable.quasistatic.bundle_jam import (frictionless_keystone_psi_rad, keystone, keystone_friction_needed,
-                                             wedge_band_d_over_D)
+                                             least_friction_keystone, wedge_band_d_over_D)
 from exucable.solve.steady import solve_steady
 
 D_CABLE, RADIUS, T0, STRAIGHT, MU, G = 0.03, 2.0, 100.0, 0.5, 0.3, 9.81
@@ -166,6 +178,90 @@ def one_case(arrangement, ratio, cable_friction, turn) -> dict:
     return row
 
 
+STOPPED_LENGTH, STOP_RAMP, STOP_END, MU_S = 2.0, 0.2, 0.35, 0.5
+
+
+@contextlib.contextmanager
+def laid_keystone(psi_rad):
+    """Lay the cables exactly as the keystone at the outer cables' angle ``psi_rad``: without the
+    start's 5 % gap (laid as larger circles), which near D/d 3 lifts the middle cable millimetres
+    off the others and drops it on them."""
+    original = bundle_model.arrangement_offsets
+
+    def offsets(count, arrangement, inner_radius_m, cable_radius_m):
+        return keystone(2.0 * inner_radius_m, D_CABLE, psi_rad).positions_m[0]
+
+    bundle_model.arrangement_offsets = offsets
+    try:
+        yield
+    finally:
+        bundle_model.arrangement_offsets = original
+
+
+def stopped_scenario(ratio, static_friction, hold_s=None, end_s=STOP_END):
+    """The keystone in a 2 m horizontal duct with gravity, the pull standing still from the start
+    (pulling on after ``hold_s`` if given), loads ramped in over 0.2 s, 8 elements."""
+    return xc.Scenario(route=xc.Route(inner_radius=ratio * D_CABLE / 2).straight(STOPPED_LENGTH),
+                       cable=xc.Cable(radius=D_CABLE / 2, density=2000.0, youngs_modulus=2e8, bending_stiffness=1.0,
+                                      count=3, arrangement="cradled", elements=8),
+                       contact=xc.Contact(friction=MU, static_friction=static_friction, check_points_per_element=8,
+                                          friction_regularisation_velocity=1e-4),
+                       pull=xc.Pull(speed=0.1, back_tension=3 * T0 / 10, stop_time=0.0, hold_time=hold_s,
+                                    ramp_time=STOP_RAMP),
+                       gravity=xc.Gravity(g=G), solver=xc.Solver(mode="dynamic", end_time=end_s))
+
+
+def middle_contact_factor(model) -> float:
+    """The middle cable's mean contact force per length with the outer ones over its weight per length
+    [-], in the duct's middle half (a bending length and more from either end)."""
+    kernel = model.between
+    q_all = np.concatenate([q.reshape(-1) for q in model.cable_coordinates()])
+    c = kernel.contacts(q_all)
+    if len(c["penetration_m"]) == 0:
+        return 0.0
+    cable, point = c["index"][:, 0] // kernel.n_points, c["index"][:, 0] % kernel.n_points
+    x_pts, _ = kernel.point_forces_N(q_all)
+    s = np.array([np.interp(x_pts[j], model.layout.cables[i].node_x_m, model.layout.cables[i].node_s_m)
+                  for i, j in zip(cable, point)])
+    line = (kernel.weight[point] * kernel.law.stiffness * c["penetration_m"] ** kernel.law.exponent
+            / (kernel.element_length_m[point // kernel.n_k] / kernel.n_k))
+    mid = ((s >= 0.25 * STOPPED_LENGTH) & (s <= 0.75 * STOPPED_LENGTH)
+           & ((cable == 1) | (c["index"][:, 1] // kernel.n_points == 1)))
+    w = model.scenario.cable.mass_per_length_kg_per_m * G
+    return float(np.mean(line[mid]) / w) if mid.any() else 0.0
+
+
+def stopped_case(ratio, static_friction, hold_s=None, end_s=STOP_END) -> dict:
+    """One laid keystone held still (and pulled on after ``hold_s``): statics' verdict beside the run's."""
+    psi, need = least_friction_keystone(ratio * D_CABLE, D_CABLE)
+    if not math.isfinite(need):
+        psi = frictionless_keystone_psi_rad(ratio * D_CABLE, D_CABLE)
+    wall_mu = MU if static_friction is None else static_friction
+    row = {"ratio": ratio, "static_friction": static_friction, "hold_s": hold_s, "psi_laid_deg": math.degrees(psi),
+           "friction_needed": need, "statics_holds": bool(need <= wall_mu)}
+    t0 = time.process_time()
+    with laid_keystone(psi):
+        res = xc.run(stopped_scenario(ratio, static_friction, hold_s, end_s))
+    b = res.summary.bundle
+    offs = np.array(b["cross_sections"][0]["offsets_m"]) if b["cross_sections"] else None
+    psi_end = math.degrees(math.atan2(-offs[0, 0], -offs[0, 1])) if offs is not None else float("nan")
+    G_statics = None
+    if offs is not None and b["jam"]:
+        G_statics = float(keystone(ratio * D_CABLE, D_CABLE, math.radians(psi_end)).contact_force_per_load[0])
+    h = res.history
+    t, F = np.asarray(h.time_s), np.asarray(h.pull_force_N)
+    row.update(status=res.status, jam=b["jam"], cpu_s=time.process_time() - t0,
+               arrangements_seen=b["sections"][0]["arrangements_seen"] if b["sections"] else {},
+               psi_end_deg=psi_end, contact_factor=middle_contact_factor(res.model), keystone_G_per_p=G_statics,
+               message=res.summary.message)
+    if hold_s is not None:
+        after = t >= hold_s
+        last = t >= t[-1] - 0.1
+        row.update(restart_peak_N=float(np.max(F[after])), restart_peak_s=float(t[after][np.argmax(F[after])]),
+                   held_pull_N=float(F[np.searchsorted(t, hold_s) - 1]), final_pull_N=float(np.mean(F[last])))
+    return row
+
+
 def rigid_wedge_factors(ratio) -> dict:
     """The rigid circles' contact force over the lateral load [-]: cradle 2x, keystone across d/(2h)."""
     x = 1.0 / (ratio - 1.0)
@@ -223,13 +319,21 @@ def figure(record, path):
         if lo is not None:
             axes[2].axvspan(lo, hi, color=c, alpha=0.12, label=f"μ_s {mu_s:g}, 5 % ovality: {lo:.2f}-{hi:.2f}")
     axes[2].axvspan(2.8, 3.2, fill=False, hatch="//", ec="0.5", label="NEC jam range 2.8-3.2")
+    stopped = [r for r in record.get("stopped", []) if r.get("hold_s") is None]
+    for held, marker, text in ((True, "*", "simulated, pull stopped: keystone stands (jam)"),
+                               (False, "x", "simulated, pull stopped: drops to the triangle")):
+        sel = [r for r in stopped if r["jam"] == held]
+        if sel:
+            axes[2].plot([r["ratio"] for r in sel], [MU if r["static_friction"] is None else r["static_friction"]
+                                                     for r in sel], marker, color="k", ms=10 if held else 8,
+                         ls="none", label=text)
     axes[2].set_ylim(0, 1.5)
     axes[0].set_ylabel("bundle's pull / calculators' 3·rope(μ w_c) [-]")
     axes[0].set_title("pull out of a 90° bend, R 2 m, gravity")
     axes[1].set_ylabel("cable-cable force / lateral load, per length [-]")
     axes[1].set_title("wedge factor: simulated (largest) vs rigid circles")
     axes[2].set_ylabel("friction coefficient in the cross-section [-]")
-    axes[2].set_title("keystone statics: when friction holds a wedge")
+    axes[2].set_title("keystone statics: when friction holds a wedge\n(markers: the wall's μ of a simulated stop)")
     for ax in axes:
         ax.set_xlabel("D/d [-]")
         ax.grid(True, alpha=0.3)
@@ -253,6 +357,19 @@ def print_record(record) -> None:
         arr = " / ".join(s["arrangement"] + ("(JAM)" if s["jam"] else "") for s in r["sections"])
         print(head + f" {r['pull_force_N']:8.2f} {r['pull_vs_formula']:9.4f} {r['wedge_factor']:6.3f} {r['cpu_s']:7.1f}  "
               f"{arr}; " + " ".join(f"{x:.1f}" for x in r["shares_N"]))
+    if record.get("stopped"):
+        print("\nkeystone laid, pull standing still (dynamic, 2 m straight, gravity): D/d, wall μ, friction the statics "
+              "need, laid -> final angle, status, arrangement, middle cable's contact force / weight (keystone G/p)")
+        for r in record["stopped"]:
+            mu = MU if r["static_friction"] is None else r["static_friction"]
+            kg = "-" if r["keystone_G_per_p"] is None else f"{r['keystone_G_per_p']:.3f}"
+            line = (f"  {r['ratio']:5.2f}  μ {'' if r['static_friction'] is None else 's '}{mu:.2g}  needs {r['friction_needed']:.3f} "
+                    f"({'holds' if r['statics_holds'] else 'drops'})  ψ {r['psi_laid_deg']:.1f} -> {r['psi_end_deg']:.1f}°  "
+                    f"{r['status']:>10}  {'/'.join(r['arrangements_seen'])}  {r['contact_factor']:.3f} ({kg})  CPU {r['cpu_s']:.1f} s")
+            if r.get("hold_s") is not None:
+                line += (f"\n      pulled on after {r['hold_s']:g} s: held {r['held_pull_N']:.2f} N, restart peak "
+                         f"{r['restart_peak_N']:.2f} N at {r['restart_peak_s']:.3f} s, then {r['final_pull_N']:.2f} N")
+            print(line)
     print("\nrigid circles: D/d, least wall friction holding a keystone across the duct, wedge factors "
           "(cradle 2x, keystone across d/(2h))")
     for r in record["statics"]:
@@ -276,6 +393,10 @@ def main(argv=None) -> int:
                    help="D/d of the cradled up-bend cases (a failing solve spends its minute of CPU)")
     p.add_argument("--keystone-ratios", type=float, nargs="*", default=[2.9, 3.05],
                    help="D/d of the keystone starts in a straight with gravity")
+    p.add_argument("--stopped-ratios", type=float, nargs="*", default=[2.9, 2.95, 2.97, 2.98, 2.99, 3.05],
+                   help="D/d of the keystones laid with the pull standing still (dynamic), μ 0.3 and μ_s 0.5 each")
+    p.add_argument("--restart-ratio", type=float, nargs="*", default=[2.98],
+                   help="D/d of a held keystone (μ_s 0.5) pulled on after 0.3 s")
     p.add_argument("--record", help="write the record here (JSON)")
     p.add_argument("--figure", help="write the figure here (PNG)")
     p.add_argument("--from-json", help="print (and draw) a stored record instead of running")
@@ -287,6 +408,7 @@ def main(argv=None) -> int:
         if args.quick:
             args.ratios, args.arrangements, args.cable_friction = [2.9], ["cradled"], [0.0]
             args.up_ratios, args.keystone_ratios = [], []
+            args.stopped_ratios, args.restart_ratio = [2.98], []
         cases = []
         for arrangement, ratio, mu_c, turn in case_plan(args):
             cases.append(one_case(arrangement, ratio, mu_c, turn))
@@ -294,7 +416,15 @@ def main(argv=None) -> int:
         statics = statics_table([2.5, 2.6, 2.8, 2.9, 2.95, 2.97, 2.98, 2.99, 2.995])
         bands = [{"friction": mu, "round": list(wedge_band_d_over_D(mu)), "oval": list(wedge_band_d_over_D(mu, 0.05))}
                  for mu in (0.3, 0.5, 1.0)]
-        record = {"cases": cases, "statics": statics, "bands": bands}
+        stopped = []
+        for ratio in args.stopped_ratios:
+            for mu_s in ((MU_S,) if args.quick else (None, MU_S)):
+                stopped.append(stopped_case(ratio, mu_s))
+                print(f"  done: keystone held still, D/d {ratio:g}, μ_s {mu_s}: {stopped[-1]['status']}", flush=True)
+        for ratio in args.restart_ratio:
+            stopped.append(stopped_case(ratio, MU_S, hold_s=0.3, end_s=0.8))
+            print(f"  done: keystone held 0.3 s and pulled on, D/d {ratio:g}: {stopped[-1]['status']}", flush=True)
+        record = {"cases": cases, "statics": statics, "bands": bands, "stopped": stopped}
         if args.record:
             atomic_write_text(Path(args.record), json.dumps(record, indent=1) + "\n")
     print_record(record)

@@ -5,7 +5,10 @@ The keystone's closed forms are checked against the vector balance of each circl
 check of the algebra), the frictionless case against the triangle it must fall into, and the band
 against NFPA 70 Ch. 9 Table 1 Note 2's 2.8-3.2 with the calculators' 5 % bend ovality. The simulated
 case: three cradled cables at D/d = 2.9 (inside the NEC range) round a 90° bend with gravity slide
-through it cradled, unflagged, with cable-cable forces the rigid cradle's, not a keystone's.
+through it cradled, unflagged, with cable-cable forces the rigid cradle's, not a keystone's. The
+simulated jam: the dynamic model with the pull standing still (pull.stop_time) and static friction on
+the wall holds a keystone where the statics say μ_s suffices (status jam, its contact forces the
+keystone's G/p), and drops one where the friction falls short into the triangle (no jam).
 """
 
 from __future__ import annotations
@@ -226,6 +229,30 @@ def test_stopping_pull_schedule():
     for y in (0.05, 0.3, 1.0):
         assert pull_speed_factor(y, tau) == smooth_ramp(y, tau)
         assert pulled_distance_m(y, V, tau) == ramped_displacement(y, V, tau)
+
+
+def test_a_stopped_single_cable_eye_follows_the_schedule():
+    """One cable on a 1 m straight with gravity, pulled at 0.1 m/s, stopping at 0.15 s for 0.15 s
+    (ramps 0.05 s): at the end the leading node has moved along the exit tangent by the schedule's
+    distance (to 1e-9 m: the drive's position constraint), and while the eye stands still the
+    pull force, held by static friction, changes by less than 1 % of itself."""
+    from exucable.model.rig import pulled_distance_m
+
+    sc = xc.Scenario(route=xc.Route(inner_radius=3.5e-3).straight(1.0),
+                     cable=xc.Cable(radius=2.5e-3, density=1000.0, youngs_modulus=1e9, elements=4),
+                     contact=xc.Contact(friction=0.2, static_friction=0.3),
+                     pull=xc.Pull(speed=0.1, back_tension=20.0, stop_time=0.15, hold_time=0.15, ramp_time=0.05),
+                     gravity=xc.Gravity(g=9.81), solver=xc.Solver(mode="dynamic", end_time=0.4, steady_stop=False))
+    res = xc.run(sc)
+    model = res.model
+    q, _ = model.coordinates()
+    start = model.layout.coordinates
+    moved = float((q[-1, :3] - start[-1, :3]) @ model.lead_drive.direction)
+    assert moved == pytest.approx(pulled_distance_m(0.4, 0.1, 0.05, 0.15, 0.15), abs=1e-9)
+    assert pulled_distance_m(0.4, 0.1, 0.05, 0.15, 0.15) == pytest.approx(0.1 * (0.4 - 0.025 - 0.15), rel=1e-12)
+    t, F = np.asarray(res.history.time_s), np.asarray(res.history.pull_force_N)
+    still = (t >= 0.22) & (t <= 0.30)
+    assert np.ptp(F[still]) < 0.01 * np.mean(F[still])
 
 
 @pytest.mark.parametrize("keys, key", [

@@ -34,6 +34,11 @@ friction force F along the wall (toward larger ψ, i.e. against a sliding down t
   diameter across the bundle by that factor, so the nominal band widens to 2.83-3.22: NFPA 70's
   2.8-3.2.
 
+The dynamic model with the pull standing still (``pull.stop_time``) and a static friction
+(``contact.static_friction``) on the wall reproduces this band: a keystone laid at
+:func:`least_friction_keystone`'s angle stands where μ_s exceeds the friction it needs and drops into
+the triangle where it does not (tests/test_bundle_jam.py, studies/bundle_jam_study.py).
+
 Why the steady sliding model cannot show the keystone: a sliding cable's Coulomb friction acts
 along its slip, along the duct, so its part in the cross-section is μN times the slope of the cable's
 path across the duct (zero in a settled bundle): in steady sliding F = 0, the first case above.
@@ -48,8 +53,8 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["BEND_OVALITY", "Keystone", "keystone", "keystone_friction_needed", "frictionless_keystone_psi_rad",
-           "wedge_band_d_over_D"]
+__all__ = ["BEND_OVALITY", "Keystone", "keystone", "keystone_friction_needed", "least_friction_keystone",
+           "frictionless_keystone_psi_rad", "wedge_band_d_over_D"]
 
 #: Relative stretch of a bend's diameter across the bundle, either way [-]: the 5 % of the
 #: calculators' jam ratio 1.05·D/d (Cableizer JR_p, :func:`exucable.quasistatic.engineering.jam_ratio`).
@@ -119,15 +124,11 @@ def keystone(duct_inner_diameter_m: float, cable_diameter_m: float, psi_rad) -> 
                     positions_m=pos)
 
 
-def keystone_friction_needed(duct_inner_diameter_m: float, cable_diameter_m: float,
-                             across_deg: float = 150.0) -> float:
-    """The least wall friction coefficient F/N [-] at which a keystone *across the duct* stands: the
-    minimum over the outer cables' angles ψ with 2ψ within ``across_deg`` [deg] of 360 − ``across_deg``
-    (seen from the duct's axis they are at least that far apart, as
-    :data:`exucable.post.bundle.ACROSS_DEG` classifies a wedge), found on a grid of 0.01°.
-
-    ``inf`` where no such keystone fits (D/d above 1 + 2/sin(``across_deg``/2), 3.07 at 150°). Spread less, the keystone is the triangle pushed apart: it needs less friction (≈ 0.4) but
-    multiplies no force (G/p → 1/√3)."""
+def least_friction_keystone(duct_inner_diameter_m: float, cable_diameter_m: float,
+                            across_deg: float = 150.0) -> tuple[float, float]:
+    """The keystone across the duct that needs the least wall friction: (its outer cables' angle ψ
+    [rad], that friction F/N [-]), the minimum of :func:`keystone_friction_needed`; (nan, inf) where
+    none fits. Where friction ≥ that holds a keystone, laid at this ψ it stands."""
     rho = _rho(duct_inner_diameter_m, cable_diameter_m)
     d = float(cable_diameter_m)
     lo = max(math.radians(0.5 * across_deg), math.asin(min(1.0, 0.5 * d / rho)))
@@ -137,9 +138,23 @@ def keystone_friction_needed(duct_inner_diameter_m: float, cable_diameter_m: flo
     h = np.sqrt(np.maximum(d * d - half * half, 0.0))
     fits = (half <= d) & (h > 0.0) & (np.abs(-rho * np.cos(psi) + h) <= rho)
     if not fits.any():
-        return math.inf
+        return float("nan"), math.inf
     k = keystone(duct_inner_diameter_m, cable_diameter_m, psi[fits])
-    return float(np.min(np.abs(k.wall_friction_per_load) / k.wall_force_per_load))
+    need = np.abs(k.wall_friction_per_load) / k.wall_force_per_load
+    i = int(np.argmin(need))
+    return float(psi[fits][i]), float(need[i])
+
+
+def keystone_friction_needed(duct_inner_diameter_m: float, cable_diameter_m: float,
+                             across_deg: float = 150.0) -> float:
+    """The least wall friction coefficient F/N [-] at which a keystone *across the duct* stands: the
+    minimum over the outer cables' angles ψ with 2ψ within ``across_deg`` [deg] of 360 − ``across_deg``
+    (seen from the duct's axis they are at least that far apart, as
+    :data:`exucable.post.bundle.ACROSS_DEG` classifies a wedge), found on a grid of 0.01°.
+
+    ``inf`` where no such keystone fits (D/d above 1 + 2/sin(``across_deg``/2), 3.07 at 150°). Spread less, the keystone is the triangle pushed apart: it needs less friction (≈ 0.4) but
+    multiplies no force (G/p → 1/√3)."""
+    return least_friction_keystone(duct_inner_diameter_m, cable_diameter_m, across_deg)[1]
 
 
 def frictionless_keystone_psi_rad(duct_inner_diameter_m: float, cable_diameter_m: float) -> float | None:
