@@ -285,7 +285,7 @@ def figure(record, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    fig, axes = plt.subplots(1, 4, figsize=(18, 4.4))
     styles = {("cradled", 0.0): ("o", "C0"), ("cradled", 0.3): ("o", "C1"),
               ("triangular", 0.0): ("s", "C2"), ("triangular", 0.3): ("s", "C3")}
     rows = [r for r in record["cases"] if r["status"] != "refused"]
@@ -311,7 +311,7 @@ def figure(record, path):
     ks = [keystone(r, 1.0, math.pi / 2).contact_force_per_load[0] if 2.415 <= r < 3.0 else np.nan for r in grid]
     axes[1].plot(grid, ks, "k--", lw=1, label="keystone across the duct, d/(2h)")
     axes[1].plot(grid, 2.0 / (grid - 1.0), "k:", lw=1, label="cradle, 2x")
-    axes[1].set_ylim(0, 6)
+    axes[1].set_ylim(0, 9)
     need = [keystone_friction_needed(r, 1.0) for r in grid]
     axes[2].plot(grid, need, "k-", label="least wall friction holding a keystone across")
     for mu_s, c in ((0.3, "C0"), (0.5, "C1"), (1.0, "C2")):
@@ -320,24 +320,35 @@ def figure(record, path):
             axes[2].axvspan(lo, hi, color=c, alpha=0.12, label=f"μ_s {mu_s:g}, 5 % ovality: {lo:.2f}-{hi:.2f}")
     axes[2].axvspan(2.8, 3.2, fill=False, hatch="//", ec="0.5", label="NEC jam range 2.8-3.2")
     stopped = [r for r in record.get("stopped", []) if r.get("hold_s") is None]
-    for held, marker, text in ((True, "*", "simulated, pull stopped: keystone stands (jam)"),
-                               (False, "x", "simulated, pull stopped: drops to the triangle")):
+    zoom = np.linspace(2.88, 3.08, 401)
+    axes[3].plot(zoom, [keystone_friction_needed(r, 1.0) for r in zoom], "k-",
+                 label="statics: least wall friction holding a keystone across")
+    for held, marker, text in ((True, "*", "simulated, pull stopped: keystone stands (status jam)"),
+                               (False, "x", "simulated, pull stopped: drops to the triangle (no jam)")):
         sel = [r for r in stopped if r["jam"] == held]
         if sel:
-            axes[2].plot([r["ratio"] for r in sel], [MU if r["static_friction"] is None else r["static_friction"]
-                                                     for r in sel], marker, color="k", ms=10 if held else 8,
-                         ls="none", label=text)
+            axes[3].plot([r["ratio"] for r in sel], [MU if r["static_friction"] is None else r["static_friction"]
+                                                     for r in sel], marker, color="C3" if held else "C0",
+                         ms=12 if held else 9, ls="none", label=text)
+    held = [r for r in stopped if r["jam"] and r["static_friction"] is not None]
+    if held:
+        axes[1].plot([r["ratio"] for r in held], [r["contact_factor"] for r in held], "*", color="C3", ms=10,
+                     label="keystone held still (dynamic, μ_s 0.5): middle cable's contact / weight")
+    axes[3].set_xlim(2.88, 3.08)
+    axes[3].set_ylim(0, 1.0)
+    axes[3].set_ylabel("wall friction coefficient [-] (μ 0.3, or μ_s 0.5)")
+    axes[3].set_title("keystone laid, pull standing still:\nsimulated vs statics")
     axes[2].set_ylim(0, 1.5)
     axes[0].set_ylabel("bundle's pull / calculators' 3·rope(μ w_c) [-]")
     axes[0].set_title("pull out of a 90° bend, R 2 m, gravity")
     axes[1].set_ylabel("cable-cable force / lateral load, per length [-]")
     axes[1].set_title("wedge factor: simulated (largest) vs rigid circles")
     axes[2].set_ylabel("friction coefficient in the cross-section [-]")
-    axes[2].set_title("keystone statics: when friction holds a wedge\n(markers: the wall's μ of a simulated stop)")
+    axes[2].set_title("keystone statics: when friction holds a wedge")
     for ax in axes:
         ax.set_xlabel("D/d [-]")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=6)
+        ax.legend(fontsize=6, loc="upper left" if ax is axes[1] else "best")
     axes[0].axhline(1.0, color="k", lw=0.5)
     fig.tight_layout()
     path = Path(path)
