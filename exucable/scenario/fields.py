@@ -335,6 +335,13 @@ FIELDS: tuple[Field, ...] = (
       rule="≥ 0; steady mode and `solver.start_from = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "
            "reaches after pulling that far: `exucable validate` sets it to the dynamic run's "
            "`reference_pulled_out_m` to compare both modes in the same state)", le=1.0e4, why="keeps the run's size finite"),
+    F("solver.cable_element", "cable_element", "choice", "", "exudyn", choices=("exudyn", "compiled"), ours=True,
+      rule="steady mode: who assembles the ANCF cable's elastic forces and their Jacobian: `\"exudyn\"`, Exudyn's "
+           "`ObjectANCFCable` objects; `\"compiled\"`, exucable's compiled copy of the same element "
+           "(`exucable/contact/ancf_cable.py`, checked against Exudyn's to 1e-12) inside the contact's user "
+           "function, with the weight as its consistent nodal load; Exudyn keeps the nodes, end loads, rig, "
+           "static solver and factorisation. The same pulling force to round-off; the summary's `cable_element` "
+           "says which ran. Dynamic mode always uses Exudyn's element"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
       rule="array of times in [0, `solver.end_time`]: the whole state is written at each "
