@@ -208,3 +208,25 @@ def test_the_pulling_force_does_not_depend_on_who_assembles_the_cable(name):
     assert a["status"] == b["status"] == "ok"
     assert abs(b["pull_force_N"] / a["pull_force_N"] - 1) < 1e-8
     assert b["newton_iterations"] == a["newton_iterations"]
+    # the summary says which element assembled the cable
+    assert (a["cable_element"], b["cable_element"]) == ("exudyn", "compiled")
+
+
+def test_compiled_is_the_steady_default_and_dynamic_mode_keeps_exudyns_element():
+    from exucable.data import data_path
+    from exucable.model.build import build_model
+    from exucable.scenario.specs import load_scenario
+
+    given = load_scenario(data_path("scenarios", "fast", "paper_ex2_bend90.toml"))
+    assert given.solver.cable_element == "compiled"
+    dynamic = build_model(given.replace(**{"solver.mode": "dynamic"}))
+    assert dynamic.cable_forces is None and len(dynamic.cable.elements) == dynamic.cable.n_elements
+    steady = build_model(given.replace(**{"solver.mode": "steady"}))
+    assert steady.cable_forces is not None and steady.cable.elements == ()
+    # the plugin face: a user's own system gets Exudyn's elements unless asked otherwise
+    from exucable.model.build import add_cable_in_conduit
+
+    SC = exu.SystemContainer()
+    mbs = SC.AddSystem()
+    h = add_cable_in_conduit(mbs, given.replace(**{"solver.mode": "steady"}))
+    assert h.cable_forces is None and len(h.cable.elements) == h.cable.n_elements

@@ -410,7 +410,8 @@ def _scenario_from(scenario, parts: dict):
 
 def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | ReelOnto | None = None,
                          trailing: str | JoinToMarker | None = None, with_contact: bool = True,
-                         start: InitialLayout | None = None, **parts) -> CableInConduit:
+                         start: InitialLayout | None = None, cable_element: str = "exudyn",
+                         **parts) -> CableInConduit:
     """Add a cable pulled through a conduit to the user's own Exudyn system, without assembling it.
 
     Adds the ANCF cable (paper Sect. 2.2) pre-tensioned in the conduit (:func:`initial_layout`),
@@ -435,6 +436,10 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         False: no conduit wall (a free cable, for tests).
     start : InitialLayout, optional
         A start state computed before (default: ``initial_layout(scenario, with_contact)``).
+    cable_element : {"exudyn", "compiled"}
+        Exudyn's ``ObjectANCFCable`` objects (default: the user's system gets Exudyn's elements), or,
+        for a steady-mode scenario with contact, exucable's compiled copy in the contact's user
+        function (what :func:`build_model` does with ``solver.cable_element``).
 
     Returns
     -------
@@ -479,7 +484,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         integration=c.integration,
     )
     # steady mode may assemble the cable's elastic forces itself, in the contact's user function
-    compiled = sc.solver.mode == "steady" and sc.solver.cable_element == "compiled" and with_contact
+    compiled = sc.solver.mode == "steady" and cable_element == "compiled" and with_contact
     cable = add_cable(mbs, layout.coordinates, layout.element_length_m, props, layout.velocities,
                       draw_radius_m=c.radius_m, with_elements=not compiled)
     lead_node, trail_node = cable.nodes[-1], cable.nodes[0]
@@ -610,7 +615,8 @@ def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
                                references=references)
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
-    h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start)
+    h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start,
+                             cable_element=scenario.solver.cable_element)
     model = Model(**{f: getattr(h, f) for f in h.__dataclass_fields__}, system_container=SC)
     model.recorder.cable = model
     mbs.Assemble()
