@@ -50,9 +50,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 
-def _triplets_before(self, res, f_q, f_v):
-    """The contact Jacobian's triplets as the coupling built them before (the baseline)."""
+def _triplets_before(self, res, f_q, f_v, elastic_blocks=None):
+    """The contact Jacobian's triplets as the coupling built them before (the baseline; the models
+    here have Exudyn's cable elements, so no compiled element's blocks)."""
     import numpy as np
+
+    assert elastic_blocks is None
 
     if not hasattr(self, "_before_rows"):
         self._before_rows = self._triplets[:, 0].copy()
