@@ -50,6 +50,7 @@ def _exudyn_lhs_and_jacobian(L, q, integration):
                                       useReducedOrderIntegration=INTEGRATION[integration]))
     mbs.Assemble()
     s = exu.SimulationSettings()
+    s.solution.file.write = False   # no solution/ file in the working directory
     s.linearSolver.solverType = exu.LinearSolverType.EXUdense
     s.staticSolver.verboseMode = 0
     solver = exu.MainSolverStatic()
@@ -127,6 +128,7 @@ def test_weight_is_exudyns_mass_proportional_load():
         mbs.AddLoad(LoadMassProportional(markerNumber=mbs.AddMarker(MarkerBodyMass(bodyNumber=e)), loadVector=list(g)))
     mbs.Assemble()
     s = exu.SimulationSettings()
+    s.solution.file.write = False   # no solution/ file in the working directory
     s.staticSolver.verboseMode = 0
     solver = exu.MainSolverStatic()
     solver.InitializeSolver(mbs, s)
@@ -162,6 +164,7 @@ def _system_rhs_and_jacobian(model, gravity_scale: float):
     a gravity scale (the steady solve's load continuation)."""
     model.load_scale.apply(model.mbs, gravity=gravity_scale, end_force=1.0)
     s = exu.SimulationSettings()
+    s.solution.file.write = False   # no solution/ file in the working directory
     s.linearSolver.solverType = exu.LinearSolverType.EXUdense
     s.staticSolver.verboseMode = 0
     solver = exu.MainSolverStatic()
