@@ -82,11 +82,15 @@ def route_path(length_m: float) -> list[dict]:
     return path
 
 
-def route_data(length_m: float) -> dict:
-    """The scenario (as a TOML-like dict) of a route of ``length_m`` [m], steady mode."""
+def route_data(length_m: float, cable_element: str | None = None) -> dict:
+    """The scenario (as a TOML-like dict) of a route of ``length_m`` [m], steady mode;
+    ``cable_element``: ``[solver] cable_element`` (None: the default)."""
     import math
 
     area = math.pi * CABLE_RADIUS_M ** 2
+    solver = {"mode": "steady", "end_time": 1.0}   # end_time: required, unused by a steady solve
+    if cable_element is not None:
+        solver["cable_element"] = cable_element
     return {
         "name": f"long-route-{length_m:g}m",
         "cable": {"radius": CABLE_RADIUS_M, "mass_per_length": MASS_PER_LENGTH_KG_PER_M,
@@ -95,7 +99,7 @@ def route_data(length_m: float) -> dict:
         "contact": {"friction": 0.2},
         "pull": {"speed": 0.1, "back_tension": 500.0},
         "gravity": {"g": 9.81},
-        "solver": {"mode": "steady", "end_time": 1.0},   # end_time: required, unused by a steady solve
+        "solver": solver,
     }
 
 
@@ -145,7 +149,7 @@ class _Timed:
         setattr(module, name, timed)
 
 
-def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
+def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_element: str | None = None) -> dict:
     """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints).
 
     Stages: import, parse, build (every model built, the rope references included), of it the
@@ -167,7 +171,7 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
     if cold:
         start.nested_start = lambda fine, coarse: None     # run.py imports it at call time
     clock.lap("import_s")
-    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    sc = parse_scenario(route_data(length_m, cable_element), ROOT, default_name="route")
     clock.lap("parse_s")
     # run_scenario and the error bar import these at call time: the timed copies are the ones called
     timed = _Timed()
@@ -216,14 +220,15 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
             "cpu_s": cpu, "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **wall}
 
 
-def in_child(length_m: float, figures: bool, cold: bool = False, tree: str | None = None) -> dict:
+def in_child(length_m: float, figures: bool, cold: bool = False, tree: str | None = None,
+             cable_element: str | None = None) -> dict:
     """:func:`one_case` in a fresh process; adds the whole process's wall time ``process_s``.
     ``cold``: the solved mesh from the rope start (``--compare-cold``); ``tree``: an exucable source tree
     whose package the child imports instead of the installed one."""
     import os
 
     cmd = ([sys.executable, __file__, "--case", f"{length_m:g}"] + ([] if figures else ["--no-figures"])
-           + (["--cold"] if cold else []))
+           + (["--cold"] if cold else []) + (["--cable-element", cable_element] if cable_element else []))
     env = None
     if tree is not None:
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(tree).resolve())]
@@ -298,6 +303,16 @@ def compare(b: dict, a: dict) -> str:
     return (f"{'':9s}CPU after/before: {ratios}; change of the pulling force {rel('pull_force_N')}, "
             f"of the rope with clearance's {rel('rope_clearance_pull_force_N')}; Newton "
             f"{b['newton_iterations']}/{b['error_bar_newton_iterations']} -> {a['newton_iterations']}/{a['error_bar_newton_iterations']}")
+
+
+def per_iteration(b: dict, a: dict) -> str:
+    """One line: CPU per Newton iteration of both steady solves, exudyn's element (b) and the compiled one (a)."""
+    def each(r):
+        n = r["newton_iterations"] + r["error_bar_newton_iterations"]
+        return 1e3 * (r["cpu_s"]["solve_s"] + r["cpu_s"]["error_bar_s"]) / max(n, 1), n
+    (x, nx), (y, ny) = each(b), each(a)
+    return (f"{'':9s}CPU per Newton iteration (solve and error bar): exudyn {x:.1f} ms ({nx} iterations), "
+            f"compiled {y:.1f} ms ({ny}), ratio {y / x:.2f}")
 
 
 def profile(length_m: float, top: int = 25) -> None:
@@ -461,21 +476,35 @@ def main() -> None:
     ap.add_argument("--before", metavar="TREE",
                     help="an exucable source tree to compare with (e.g. `git archive <commit> | tar -x -C TREE`): "
                          "each length runs with it and then with the installed package, interleaved")
+    ap.add_argument("--cable-element", choices=("exudyn", "compiled"),
+                    help="[solver] cable_element of the runs (default: the scenario default)")
+    ap.add_argument("--compare-elements", action="store_true",
+                    help="each length with cable_element = \"exudyn\" and then \"compiled\", in processes of their "
+                         "own one after the other, and their CPU ratios and pulling forces side by side")
     ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.case:
-        print(json.dumps(one_case(float(args.case), figures=not args.no_figures, cold=args.cold)))
+        print(json.dumps(one_case(float(args.case), figures=not args.no_figures, cold=args.cold,
+                                  cable_element=args.cable_element)))
         return
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
     rows, pairs = [], []
     for L in lengths:
-        if args.before:
-            b = in_child(L, figures=not args.no_figures, tree=args.before)
-            print("before: " + report(b), flush=True)
-        r = in_child(L, figures=not args.no_figures)
-        print(("after:  " if args.before else "") + report(r), flush=True)
-        if args.before:
-            print(compare(b, r), flush=True)
+        if args.compare_elements:
+            b = in_child(L, figures=not args.no_figures, cable_element="exudyn")
+            print("exudyn:   " + report(b), flush=True)
+            r = in_child(L, figures=not args.no_figures, cable_element="compiled")
+            print("compiled: " + report(r), flush=True)
+            print(compare(b, r).replace("after/before", "compiled/exudyn"), flush=True)
+            print(per_iteration(b, r), flush=True)
+        else:
+            if args.before:
+                b = in_child(L, figures=not args.no_figures, tree=args.before, cable_element=args.cable_element)
+                print("before: " + report(b), flush=True)
+            r = in_child(L, figures=not args.no_figures, cable_element=args.cable_element)
+            print(("after:  " if args.before else "") + report(r), flush=True)
+            if args.before:
+                print(compare(b, r), flush=True)
         if args.compare_cold:
             c = in_child(L, figures=not args.no_figures, cold=True)
             print(report(c), flush=True)
