@@ -197,12 +197,14 @@ def graded_node_grid_m(centreline, s_from_m: float, s_to_m: float, clearance_m: 
     h_far = max(scale * _FAR_SPACING_M, h_bend)
     if centreline.length_m <= _MAX_NODES * _SPACING_M or not curved or h_far <= h_bend:
         return np.linspace(s_from_m, s_to_m, n_uniform + 1)
-    # the spacing on a sample grid fine enough to integrate it (a tenth of the bends' spacing)
-    x = np.linspace(s_from_m, s_to_m, int(np.ceil(10.0 * length / h_bend)) + 1)
-    dist = np.full(x.shape, np.inf)
-    for a, b in curved:
-        dist = np.minimum(dist, np.maximum(np.maximum(a - x, x - b), 0.0))
-    h = np.minimum(h_bend + _GRADING * dist, h_far)
+    # the spacing on a sample grid fine enough to integrate it (half the bends' spacing); the distance
+    # to the nearest curved piece from the one before and the one after each sample (pieces in order)
+    x = np.linspace(s_from_m, s_to_m, int(np.ceil(2.0 * length / h_bend)) + 1)
+    starts, ends = np.array(curved).T
+    after = np.searchsorted(starts, x, side="right")        # the first curved piece starting past x
+    before_dist = np.where(after > 0, np.maximum(x - ends[np.maximum(after - 1, 0)], 0.0), np.inf)
+    after_dist = np.where(after < len(starts), starts[np.minimum(after, len(starts) - 1)] - x, np.inf)
+    h = np.minimum(h_bend + _GRADING * np.minimum(before_dist, after_dist), h_far)
     inv = 1.0 / h
     count = np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(x))])
     n_seg = max(int(np.ceil(count[-1] - 1e-9)), 4)
