@@ -174,7 +174,9 @@ def default_node_spacing_m(centreline, clearance_m: float) -> float:
     A hundredth of the tightest bend radius (each node turns 0.01 rad; the discrete capstan's
     error is O((μ·0.01)³) per node) and at most 2 cm (free spans across 10 mm clearances are
     metres long), or on routes over 400 m at most a ``_MAX_NODES``-th of the route (20 000 nodes);
-    at least 400 nodes over the route. The measured effect of the cap is at ``_MAX_NODES``.
+    at least 400 nodes over the route. The measured effect of the cap is at ``_MAX_NODES``. On
+    routes over 400 m it is the spacing on the bends of the graded default chain
+    (:func:`graded_node_grid_m`).
     """
     L = centreline.length_m
     h = min(0.01 * centreline.min_bend_radius_m, max(_SPACING_M, L / _MAX_NODES), L / 400.0)
@@ -457,8 +459,9 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     cable_length_m : float, optional
         Length of conduit the cable occupies, from the leading end [m]; default the whole conduit.
     node_spacing_m : float, optional
-        Spacing of the chain's nodes along the conduit [m]; default :func:`default_node_spacing_m`.
-        The answer converges as the spacing squared.
+        Uniform spacing of the chain's nodes along the conduit [m]; default the chain of
+        :func:`graded_node_grid_m` (:func:`default_node_spacing_m` on routes of 400 m or less, graded
+        away from the bends on longer ones). The answer converges as the spacing squared.
     rtol : float
         Relative change of the tensions (and of the shape, in units of the clearance) at which the
         fixed point stops.
