@@ -207,6 +207,13 @@ def test_long_routes_grade_the_chain_away_from_the_bends():
     s = graded_node_grid_m(short, 0.0, short.length_m, 0.008)
     seg = np.diff(s)
     assert np.ptp(seg) < 1e-9 * seg[0] and default_node_spacing_m(short, 0.008) * (1 - 1e-3) < seg[0] <= default_node_spacing_m(short, 0.008)
+    # ... and solves the same chain as one asked for with that spacing, bit for bit
+    default = solve_rope_with_clearance(short, 0.008, 0.5, W, 100.0)
+    asked = solve_rope_with_clearance(short, 0.008, 0.5, W, 100.0,
+                                      node_spacing_m=default_node_spacing_m(short, 0.008))
+    assert default.pull_force_N == asked.pull_force_N
+    np.testing.assert_array_equal(default.offset_m, asked.offset_m)
+    np.testing.assert_array_equal(default.sidewall_pressure_N_per_m, asked.sidewall_pressure_N_per_m)
     centre = _long_route(3000.0, 3.0)
     h_bend = default_node_spacing_m(centre, 0.008)
     s = graded_node_grid_m(centre, 10.0, centre.length_m, 0.008)

@@ -194,7 +194,7 @@ def graded_node_grid_m(centreline, s_from_m: float, s_to_m: float, clearance_m: 
     """
     length = s_to_m - s_from_m
     h_bend = scale * default_node_spacing_m(centreline, clearance_m)
-    n_uniform = max(int(np.ceil(length / h_bend - 1e-9)), 4)
+    n_uniform = max(int(np.ceil(length / h_bend)), 4)
     curved = [(a, b) for a, b in centreline.curved_ranges_m() if b > s_from_m and a < s_to_m]
     h_far = max(scale * _FAR_SPACING_M, h_bend)
     if centreline.length_m <= _MAX_NODES * _SPACING_M or not curved or h_far <= h_bend:
@@ -505,10 +505,19 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     a = np.asarray(curve.tangent(s), dtype=float)
     frames = _frames(a)
     seg = np.diff(s)
-    hs = float(np.min(seg))           # the finest segment: it sets the wall's stiffness
+    uniform = bool(np.ptp(seg) <= 1e-9 * seg[0])
+    if uniform:
+        # a uniform chain's spacing, weights and coarser chain exactly as they always were
+        hs = length / n_seg
+        seg = np.full(n_seg, hs)
+        weight_length = np.full(n_seg + 1, hs)
+    else:
+        hs = float(np.min(seg))       # the finest segment: it sets the wall's stiffness
     share = np.zeros(n_seg + 1)       # the length of conduit each node stands for [m]
     share[:-1] += 0.5 * seg
     share[1:] += 0.5 * seg
+    if not uniform:
+        weight_length = share
 
     # start: capstan growth over the bends plus friction and lift of the weight (a rough upper guess)
     kappa = np.linalg.norm(np.asarray(curve.curvature_vector(s), dtype=float), axis=1)
@@ -527,7 +536,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     d[pressed] *= (c * (1.0 + _ON_WALL) / size[pressed])[:, None]
     d[~pressed] = 0.0
     G = np.zeros((n_seg + 1, 3))
-    G[:, 2] = -w * share
+    G[:, 2] = -w * weight_length
     newton = 0
     ramp = True
     if n_seg > (_COARSEN_REQUESTED_ABOVE if _coarsen_above is None else _coarsen_above):
@@ -536,7 +545,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
         # end moves about one node per step; on 1 km, 50 000 nodes, the fine chain needed ~110 steps).
         coarse = solve_rope_with_clearance(centreline, clearance_m, friction, weight_per_length_N_per_m,
                                            trailing_tension_N, direction, cable_length_m,
-                                           None if node_spacing_m is None else _COARSEN * hs, rtol,
+                                           _COARSEN * hs if uniform else None, rtol,
                                            _coarsen_above=_COARSEN_ABOVE, _grid_scale=_COARSEN * _grid_scale)
         s_c = coarse.s_conduit_m if direction == "forward" else L - coarse.s_conduit_m
         order = np.argsort(s_c)
