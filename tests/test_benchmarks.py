@@ -53,6 +53,7 @@ SCRIPTS = {
     "studies/bundle_bend_study.py": "p/formula",
     "studies/bundle_jam_study.py": "F/formula",
     "studies/bundle_physics_study.py": "| place | arrangement | D/d | μ_c |",
+    "studies/checkpoint_study.py": "| case | rule's count | factor | per element |",
     "studies/wall_compliance_study.py": "| case | c [mm] | K [N/m^1.5] | δ/c [-]",
 }
 
