@@ -7,30 +7,37 @@ medians of wall time and of CPU time (user + system of the process and its child
 by other jobs on a shared machine than wall time). The target is figures within +0.3 s of
 ``--no-plots`` in wall time, on a machine with a core free for the figures' helper process. "Beside
 the rest" is the figures' CPU time that did not add to the wall time (CPU cost less wall cost): the
-helper's import of matplotlib during the solve and its drawing in two processes at once.
+helper's import of matplotlib during the solve and its drawing in several processes at once.
 
-Part 2, in this process (skipped by ``--quick``): the parts of the figures' cost, in CPU seconds: the
-import of matplotlib's Figure and Agg canvas, then each figure drawn and written (first call, then
-the median of ``--repeat`` warm calls), from one solved result; then all figures drawn in one process
-and in two at once (:func:`exucable.output.figure_process.draw_in_two`, as the helper does), wall and
-CPU (both processes) [s], medians of ``--repeat``.
-
-Part 3 (skipped by ``--quick``; run before part 2, whose import it would spoil): the figures' critical path, from CPU times, which a saturated
-machine inflates less than wall times: this process runs the scenario with a helper started before
-(:class:`exucable.output.figure_process.Figures`) and without figures; this process's extra CPU, the
-helper's warm-up (beside the solve) and its drawing after the results arrived, and its fork's. On two
-free cores the figures add to the wall time about this process's extra CPU plus the longer of the
-two drawings, once the warm-up (about 0.6 s CPU) ends before the solve does (a fresh process's
+Part 2 (skipped by ``--quick``): the figures' critical path, from CPU times, which a saturated
+machine inflates less than wall times, per mode in a fresh child process: it runs the scenario with
+a helper started before (:class:`exucable.output.figure_process.Figures`) and without figures; its
+extra CPU, the helper's warm-up (beside the solve), the helper's own drawing after the results
+arrived and its forks' (their total and the longest). On two free cores the figures add to the wall
+time about the extra CPU plus the longer of the costliest drawing process and all the drawing CPU
+over two cores, once the warm-up (about 0.6 s CPU) ends before the solve does (a fresh process's
 imports, build and solve after the fork: part 1's ``--no-plots`` CPU, less ~0.4 s of imports before it).
 
+Part 3, in this process (skipped by ``--quick``): the parts of the figures' cost, in CPU seconds: the
+import of matplotlib's Figure and Agg canvas, then each figure drawn and written (first call, then
+the median of ``--repeat`` warm calls), from one solved result; then all figures drawn in one process
+and each in a process of its own at once (:func:`exucable.output.figure_process.draw_in_parallel`, as
+the helper does), wall and CPU (all processes) [s], medians of ``--repeat``.
+
+``--before TREE`` runs parts 1 and 2 also with the exucable package of the source tree TREE (``git
+archive <commit> | tar -x -C TREE``; copy ``exucable/contact/__pycache__`` into it with the sources'
+time stamps, ``touch -r``, or its kernels compile in its first run), interleaved with the installed
+one: a change's effect measured in one run.
+
     nice .venv/bin/python benchmarks/figure_cost.py               # ~1 min
-    nice .venv/bin/python benchmarks/figure_cost.py --repeat 9 --steady
+    nice .venv/bin/python benchmarks/figure_cost.py --repeat 9 --steady [--before TREE]
     nice .venv/bin/python benchmarks/figure_cost.py --quick       # one repeat, no breakdown
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
 import subprocess
@@ -44,45 +51,59 @@ SCENARIO = ROOT / "scenarios" / "fast" / "paper_ex2_bend90.toml"
 TARGET_S = 0.3
 
 
-def timed(cmd) -> tuple[float, float]:
+def timed(cmd, env=None) -> tuple[float, float]:
     """Whole-process wall time and CPU time (user + system, children included) [s] of ``cmd``."""
     c0, t0 = os.times(), time.perf_counter()
-    out = subprocess.run(cmd, capture_output=True, text=True)
+    out = subprocess.run(cmd, capture_output=True, text=True, env=env)
     dt, c1 = time.perf_counter() - t0, os.times()
     if out.returncode != 0:
         raise RuntimeError(f"{' '.join(map(str, cmd))} exited {out.returncode}:\n{out.stderr[-2000:]}")
     return dt, (c1.children_user - c0.children_user) + (c1.children_system - c0.children_system)
 
 
-def whole_process(repeat: int, modes: list[str]) -> None:
+def _env(tree: str | None) -> dict | None:
+    """The environment of a child that imports the exucable package of source tree ``tree``
+    instead of the installed one (None: the installed one)."""
+    if tree is None:
+        return None
+    return dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(tree).resolve())]
+                                                      + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+
+
+def whole_process(repeat: int, modes: list[str], before: str | None = None) -> None:
     exe = Path(sys.executable).with_name("exucable")
+    trees = {"before": before, "after": None} if before else {"": None}
     with tempfile.TemporaryDirectory() as tmp:
         cases = {}
         for mode in modes:
-            base = [str(exe), "run", str(SCENARIO), "-q", "--mode", mode]
-            cases[(mode, "--no-plots")] = base + ["-o", f"{tmp}/{mode}-a", "--no-plots"]
-            cases[(mode, "figures")] = base + ["-o", f"{tmp}/{mode}-b"]
-        for cmd in cases.values() if repeat > 1 else ():   # warm the disk, numba's and matplotlib's font caches
-            timed(cmd)
+            for label, tree in trees.items():
+                base = [str(exe), "run", str(SCENARIO), "-q", "--mode", mode]
+                cases[(mode, label, "--no-plots")] = (base + ["-o", f"{tmp}/{mode}{label}-a", "--no-plots"], _env(tree))
+                cases[(mode, label, "figures")] = (base + ["-o", f"{tmp}/{mode}{label}-b"], _env(tree))
+        for cmd, env in cases.values() if repeat > 1 else ():   # warm the disk, numba's and matplotlib's font caches
+            timed(cmd, env)
         load0 = os.getloadavg()[0]
         times = {k: [] for k in cases}
         for _ in range(repeat):
-            for k, cmd in cases.items():
-                times[k].append(timed(cmd))
+            for k, (cmd, env) in cases.items():
+                times[k].append(timed(cmd, env))
         print(f"# exucable run with and without figures: {SCENARIO.relative_to(ROOT)}, load average "
-              f"{load0:.1f} -> {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores, median of {repeat} interleaved runs\n")
+              f"{load0:.1f} -> {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores, median of {repeat} interleaved runs"
+              + (f"; 'before': the exucable package of {before}" if before else "") + "\n")
         print("| mode | figures | wall, median [s] | CPU, median [s] | figures' cost, wall / CPU [s] | of it beside the rest, CPU [s] | all runs, wall [s] |")
         print("|---|---|---|---|---|---|---|")
         for mode in modes:
-            base_w = statistics.median(w for w, _ in times[(mode, "--no-plots")])
-            base_c = statistics.median(c for _, c in times[(mode, "--no-plots")])
-            for what in ("--no-plots", "figures"):
-                v = times[(mode, what)]
-                w, c = statistics.median(x for x, _ in v), statistics.median(x for _, x in v)
-                cost = beside = ""
-                if what != "--no-plots":
-                    cost, beside = f"{w - base_w:+.2f} / {c - base_c:+.2f}", f"{(c - base_c) - (w - base_w):.2f}"
-                print(f"| {mode} | {what} | {w:.2f} | {c:.2f} | {cost} | {beside} | {', '.join(f'{x:.2f}' for x, _ in v)} |")
+            for label in trees:
+                base_w = statistics.median(w for w, _ in times[(mode, label, "--no-plots")])
+                base_c = statistics.median(c for _, c in times[(mode, label, "--no-plots")])
+                for what in ("--no-plots", "figures"):
+                    v = times[(mode, label, what)]
+                    w, c = statistics.median(x for x, _ in v), statistics.median(x for _, x in v)
+                    cost = beside = ""
+                    if what != "--no-plots":
+                        cost, beside = f"{w - base_w:+.2f} / {c - base_c:+.2f}", f"{(c - base_c) - (w - base_w):.2f}"
+                    print(f"| {mode}{' ' + label if label else ''} | {what} | {w:.2f} | {c:.2f} | {cost} | {beside} | "
+                          f"{', '.join(f'{x:.2f}' for x, _ in v)} |")
         print(f"\ntarget: figures within +{TARGET_S} s of --no-plots")
 
 
@@ -94,7 +115,7 @@ def breakdown(repeat: int) -> None:
     import matplotlib.backends.backend_agg  # noqa: F401
     import matplotlib.figure  # noqa: F401
     c_import = time.process_time() - c0
-    from exucable.output.figure_process import draw_figures, draw_in_two
+    from exucable.output.figure_process import draw_figures, draw_in_parallel
     from exucable.plots import results as plots
     figures = {"pull_force.png": plots.plot_pull_force, "tension_profile.png": plots.plot_tension_profile,
                "pressure.png": plots.plot_pressure}
@@ -124,7 +145,7 @@ def breakdown(repeat: int) -> None:
         print(f"| all three figures | {total_first:.3f} | {total_warm:.3f} | |")
         large(result, repeat, Path(tmp))
         print("\n| all figures drawn | wall, median [s] | CPU, median [s] |\n|---|---|---|")
-        for what, draw in (("in one process", draw_figures), ("in two processes at once", draw_in_two)):
+        for what, draw in (("in one process", draw_figures), ("each in a process of its own, at once", draw_in_parallel)):
             wall, cpu = [], []
             for _ in range(repeat):
                 c0, t0 = os.times(), time.perf_counter()
@@ -165,47 +186,83 @@ def large(result, repeat: int, tmp: Path) -> None:
         print(f"| {name} | {statistics.median(cpu):.3f} |")
 
 
-def critical_path(repeat: int) -> None:
-    """CPU seconds of the parts on the figures' critical path: this process's extra CPU with figures
-    (sending the results, writing beside the helper), the helper's warm-up and drawing, its fork's."""
+def critical_path(repeat: int, mode: str) -> dict:
+    """CPU seconds of the parts on the figures' critical path (medians of ``repeat``): this process's
+    extra CPU with figures (sending the results, writing beside the helper), the helper's warm-up
+    and its own drawing after the results arrived, the drawing of the processes it forked (their
+    total and the longest); and the estimate of the figures' wall cost on two free cores: the extra
+    CPU plus the longer of the costliest drawing process and all the drawing CPU over two cores."""
     from exucable.output.figure_process import Figures
     from exucable.run import run_scenario
-    rows = {k: [] for k in ("main", "warm_up_s", "draw_s", "second_process_draw_s", "estimate")}
+    keys = ("main", "warm_up_s", "draw_s", "forks_draw_s", "longest_fork_draw_s", "estimate")
+    rows = {k: [] for k in keys}
     with tempfile.TemporaryDirectory() as tmp:
-        run_scenario(SCENARIO, Path(tmp) / "warm", plots=False)       # this process's first run loads the kernels
+        run_scenario(SCENARIO, Path(tmp) / "warm", plots=False, mode=mode)   # this process's first run loads the kernels
         for k in range(repeat):
             c0 = time.process_time()
-            run_scenario(SCENARIO, Path(tmp) / f"none{k}", plots=False)
+            run_scenario(SCENARIO, Path(tmp) / f"none{k}", plots=False, mode=mode)
             none = time.process_time() - c0
             with Figures(helper=True) as figures:
                 c0 = time.process_time()
-                run_scenario(SCENARIO, Path(tmp) / f"fig{k}", plots=figures)
+                run_scenario(SCENARIO, Path(tmp) / f"fig{k}", plots=figures, mode=mode)
                 main = time.process_time() - c0 - none
-            cpu = figures.helper_cpu_s
+            cpu = dict(figures.helper_cpu_s)
+            if "second_process_draw_s" in cpu:          # a tree whose helper forked one process
+                cpu["forks_draw_s"] = cpu["longest_fork_draw_s"] = cpu.pop("second_process_draw_s")
             rows["main"].append(main)
-            for key in ("warm_up_s", "draw_s", "second_process_draw_s"):
-                rows[key].append(cpu.get(key, float("nan")))
-            rows["estimate"].append(max(main, 0.0) + max(cpu["draw_s"], cpu.get("second_process_draw_s", 0.0)))
-    med = {k: statistics.median(v) for k, v in rows.items()}
-    print(f"\n| figures' critical path (in-process run, median of {repeat}) | CPU [s] |\n|---|---|")
-    print(f"| this process's extra CPU with figures (sending, writing beside the helper) | {med['main']:+.3f} |")
-    print(f"| helper: matplotlib's import and warm-up, beside the solve | {med['warm_up_s']:.3f} |")
-    print(f"| helper: drawing its figures after the results arrived | {med['draw_s']:.3f} |")
-    print(f"| helper's fork: drawing its share (the pulling force's figure) at the same time | {med['second_process_draw_s']:.3f} |")
-    print(f"| figures' wall cost on two free cores, estimated: extra CPU + the longer drawing | {med['estimate']:.3f} |")
+            for key in keys[1:-1]:
+                rows[key].append(cpu.get(key, 0.0))
+            longest = max(cpu["draw_s"], cpu.get("longest_fork_draw_s", 0.0))
+            total = cpu["draw_s"] + cpu.get("forks_draw_s", 0.0)
+            rows["estimate"].append(max(main, 0.0) + max(longest, total / 2))
+    return {k: statistics.median(v) for k, v in rows.items()}
+
+
+CRITICAL_ROWS = (("main", "this process's extra CPU with figures (sending, writing beside the helper)"),
+                 ("warm_up_s", "helper: matplotlib's import and warm-up, beside the solve"),
+                 ("draw_s", "helper: drawing its own figures after the results arrived"),
+                 ("forks_draw_s", "the helper's forks: drawing the other figures at the same time, total"),
+                 ("longest_fork_draw_s", "the helper's forks: the longest one"),
+                 ("estimate", "figures' wall cost on two free cores, estimated: extra CPU + max(longest drawing, all drawing / 2)"))
+
+
+def critical_paths(repeat: int, modes: list[str], before: str | None) -> None:
+    """:func:`critical_path` of each mode in a fresh child process (its helper imports matplotlib
+    afresh), for the tree ``before`` too, interleaved."""
+    trees = {"before": before, "after": None} if before else {"": None}
+    got = {}
+    for mode in modes:
+        for label, tree in trees.items():
+            done = subprocess.run([sys.executable, __file__, "--critical-path", mode, "--repeat", str(repeat)],
+                                  capture_output=True, text=True, env=_env(tree))
+            if done.returncode != 0:
+                raise RuntimeError(f"critical path ({mode} {label}) failed:\n{done.stderr[-2000:]}")
+            got[(mode, label)] = json.loads(done.stdout.strip().splitlines()[-1])
+    cols = list(got)
+    print(f"\n| figures' critical path (in-process runs, CPU [s], median of {repeat}) | "
+          + " | ".join(f"{m}{' ' + lab if lab else ''}" for m, lab in cols) + " |")
+    print("|---|" + "---|" * len(cols))
+    for key, what in CRITICAL_ROWS:
+        print(f"| {what} | " + " | ".join(f"{got[c][key]:.3f}" for c in cols) + " |")
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="interleaved rounds (default 5)")
     ap.add_argument("--steady", action="store_true", help="also in steady mode")
+    ap.add_argument("--before", metavar="TREE", help="also with the exucable package of source tree TREE, interleaved")
+    ap.add_argument("--critical-path", metavar="MODE", help=argparse.SUPPRESS)   # a child of critical_paths
     ap.add_argument("--quick", action="store_true", help="smoke run: one round, no breakdown")
     args = ap.parse_args(argv)
+    if args.critical_path:
+        print(json.dumps(critical_path(args.repeat, args.critical_path)))
+        return 0
     if args.quick:
         args.repeat = 1
-    whole_process(args.repeat, ["dynamic", "steady"] if args.steady else ["dynamic"])
+    modes = ["dynamic", "steady"] if args.steady else ["dynamic"]
+    whole_process(args.repeat, modes, args.before)
     if not args.quick:
-        critical_path(args.repeat)          # first: its helper imports matplotlib afresh
+        critical_paths(args.repeat, modes, args.before)
         breakdown(args.repeat)
     return 0
 

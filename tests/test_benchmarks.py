@@ -22,6 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = {
     "benchmarks/bundle_route.py": "ratio bundle / one cable",
     "benchmarks/bundle_start.py": "CPU clearance / axis",
+    "benchmarks/cable_element.py": "| part (CPU per call, median) | exudyn [ms] | compiled [ms]",
     "benchmarks/contact_kernel.py": "ms/eval",
     "benchmarks/figure_cost.py": "| mode | figures | wall, median [s]",
     "benchmarks/fixed_cost.py": "| command | wall, median [s]",
@@ -53,6 +54,7 @@ SCRIPTS = {
     "studies/bundle_bend_study.py": "p/formula",
     "studies/bundle_jam_study.py": "F/formula",
     "studies/bundle_physics_study.py": "| place | arrangement | D/d | μ_c |",
+    "studies/checkpoint_study.py": "| case | rule's count | factor | per element |",
     "studies/wall_compliance_study.py": "| case | c [mm] | K [N/m^1.5] | δ/c [-]",
 }
 

@@ -117,20 +117,41 @@ def test_the_helper_is_forked_only_from_a_fresh_process():
 
 
 @needs_fork
-def test_two_processes_draw_the_same_files(tmp_path):
-    """draw_in_two (the helper's way) writes byte for byte what one process draws, listed in the same
-    order; the second process's share is drawn here if it fails."""
+def test_parallel_processes_draw_the_same_files(tmp_path):
+    """draw_in_parallel (the helper's way) writes byte for byte what one process draws, listed in the
+    same order."""
     from exucable.output import figure_process as fp
 
     one = fp.draw_figures(tmp_path / "one", _result())
-    two = fp.draw_in_two(tmp_path / "two", _result())
-    assert [p.name for p in two] == [p.name for p in one] == fp.figure_names(_result())
+    many = fp.draw_in_parallel(tmp_path / "many", _result())
+    assert [p.name for p in many] == [p.name for p in one] == fp.figure_names(_result())
     for p in one:
-        assert (tmp_path / "two" / p.name).read_bytes() == p.read_bytes(), p.name
+        assert (tmp_path / "many" / p.name).read_bytes() == p.read_bytes(), p.name
 
 
 @needs_fork
-def test_a_failing_second_process_costs_no_figure(tmp_path, monkeypatch):
+def test_each_figure_is_drawn_in_a_process_of_its_own(tmp_path, monkeypatch):
+    """On two or more cores the figures are drawn at once: HELPER_DRAWS here, each other in a fork."""
+    from exucable.output import figure_process as fp
+
+    if len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("one core: the figures are drawn here, one after the other")
+    here = os.getpid()
+    for name, draw in list(fp._DRAW.items()):
+        def noting_the_process(path, result, draw=draw):
+            draw(path, result)
+            Path(f"{path}.pid").write_text(str(os.getpid()))
+        monkeypatch.setitem(fp._DRAW, name, noting_the_process)
+    cpu = {}
+    paths = fp.draw_in_parallel(tmp_path, _result(), cpu)
+    pids = {p.name: int(Path(f"{p}.pid").read_text()) for p in paths}
+    assert len(pids) == 3 and len(set(pids.values())) == 3, pids
+    assert pids[fp.HELPER_DRAWS] == here
+    assert 0 < cpu["longest_fork_draw_s"] <= cpu["forks_draw_s"]
+
+
+@needs_fork
+def test_a_failing_drawing_process_costs_no_figure(tmp_path, monkeypatch):
     from exucable.output import figure_process as fp
 
     here, draw = os.getpid(), fp._DRAW["pull_force.png"]
@@ -141,7 +162,7 @@ def test_a_failing_second_process_costs_no_figure(tmp_path, monkeypatch):
         draw(path, result)
 
     monkeypatch.setitem(fp._DRAW, "pull_force.png", fails_in_the_fork)
-    paths = fp.draw_in_two(tmp_path, _result())
+    paths = fp.draw_in_parallel(tmp_path, _result())
     assert all(p.stat().st_size > 1000 for p in paths) and "pull_force.png" in {p.name for p in paths}
 
 

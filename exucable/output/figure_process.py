@@ -5,8 +5,8 @@ figure_cost.py``); in a fresh process both came after the solve and nearly doubl
 helper is forked when the run starts (``exucable run`` forks it first thing, before anything loads
 Exudyn or numba), imports matplotlib and loads its fonts while this process imports, builds and solves
 the model, then waits. Once the results are post-processed they are sent to it through a pipe; it
-draws and writes the figures (atomically, :func:`exucable.io.save_figure`), in two processes at once
-(:func:`draw_in_two`), while this process writes the data files and ``summary.json``;
+draws and writes the figures (atomically, :func:`exucable.io.save_figure`), each in a process of its
+own at once (:func:`draw_in_parallel`), while this process writes the data files and ``summary.json``;
 :meth:`Figures.write` returns once every figure is on disk. A helper given nothing to draw (bad input,
 an error) is killed at once; :class:`Figures` is a context manager, so an error or Ctrl-C stops it.
 
@@ -24,6 +24,7 @@ costs no import). Otherwise the figures are drawn in this process, as before.
 from __future__ import annotations
 
 import dataclasses
+import gc
 import multiprocessing
 import os
 import pickle
@@ -35,8 +36,8 @@ from pathlib import Path
 from ..plots.bundle import plot_cross_sections
 from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
 
-__all__ = ["Figures", "draw_figures", "draw_in_two", "figure_names", "helper_allowed", "HELPER_TIMEOUT_S",
-           "SECOND_PROCESS"]
+__all__ = ["Figures", "draw_figures", "draw_in_parallel", "figure_names", "helper_allowed", "HELPER_TIMEOUT_S",
+           "HELPER_DRAWS"]
 
 #: Seconds to wait for the helper's figures before drawing them here instead. Drawing a 10 km run's
 #: three figures takes a few seconds; a helper taking this long is stuck (or the machine is).
@@ -80,13 +81,16 @@ def _serve(conn) -> None:
     filename)`` or ``("failed", reason)``."""
     try:
         _warm_up()
+        # matplotlib's objects, loaded now, stay: the collector need not walk them again while the
+        # figures are drawn, nor write to their pages in the drawing forks (each write copies a page)
+        gc.freeze()
         cpu = {"warm_up_s": time.process_time()}        # a fork's CPU time starts at zero
         msg = conn.recv()
         if msg is None:
             return
         out, result = msg
         c0 = time.process_time()
-        paths = draw_in_two(Path(out), result, cpu)
+        paths = draw_in_parallel(Path(out), result, cpu)
         cpu["draw_s"] = time.process_time() - c0
         reply = ("ok", [str(p) for p in paths], cpu)
     except EOFError:
@@ -118,9 +122,10 @@ _FIGURES = (("pull_force.png", lambda r: True, plot_pull_force),
             ("cross_sections.png", lambda r: bool(r.cross_sections), _cross_sections))
 _DRAW = {name: draw for name, _, draw in _FIGURES}
 
-#: The figures the helper's second process draws; the helper draws the others at the same time.
-#: The pulling force's figure (two axes) is the costliest alone, ~2/3 of the other two together.
-SECOND_PROCESS = frozenset({"pull_force.png", "cross_sections.png"})
+#: The figure the helper draws itself, each other one in a fork of its own at the same time: the
+#: cheapest (~0.1 s CPU against 0.15-0.2 s for the others, ``benchmarks/figure_cost.py``), since the
+#: helper also collects the forks' replies.
+HELPER_DRAWS = "tension_profile.png"
 
 
 def draw_figures(out: Path, result, names=None) -> list[Path]:
@@ -148,33 +153,24 @@ def _raise(reply: tuple) -> None:
     raise RuntimeError(reply[1])
 
 
-def draw_in_two(out: Path, result, cpu: dict | None = None) -> list[Path]:
-    """Draw the figures in two processes at once (this one and a fork of it, which draws
-    :data:`SECOND_PROCESS`); returns their paths in :func:`figure_names`' order. Drawing is CPU-bound
-    and single-threaded, so on two free cores the figures take the time of the slower half. The fork
-    reports through a pipe; whatever it did not draw (it failed or died) is drawn here, and an
-    :class:`OSError` of its write is raised here. ``cpu``: a dict given the fork's CPU time [s] as
-    ``second_process_draw_s``."""
-    names = figure_names(result)
-    second = [n for n in names if n in SECOND_PROCESS]
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    if not second or len(second) == len(names) or cores < 2:
-        return draw_figures(out, result)
+def _drawn_in_a_fork(out: Path, result, name: str) -> tuple[int, int] | None:
+    """Fork a process that draws figure ``name`` and reports through a pipe; returns (pid, the
+    pipe's read end), or None if no process could be forked."""
     read_end, write_end = os.pipe()
     try:
         pid = os.fork()
     except OSError:                                 # no process to spare: not a file's error, draw here
         os.close(read_end)
         os.close(write_end)
-        return draw_figures(out, result)
-    if pid == 0:                                    # the second process: draw, report, leave at once
+        return None
+    if pid == 0:                                    # the fork: draw, report, leave at once
         code = 1
         try:
             os.close(read_end)
             try:
-                draw_figures(out, result, second)
+                draw_figures(out, result, [name])
                 reply = ("ok", time.process_time())
-            except BaseException as exc:  # reported; the first process draws what is missing
+            except BaseException as exc:  # reported; the forking process draws what is missing
                 reply = _outcome(exc)
             data = memoryview(pickle.dumps(reply))
             while data:                             # a pipe, not a file: a short reply, written whole
@@ -184,19 +180,45 @@ def draw_in_two(out: Path, result, cpu: dict | None = None) -> list[Path]:
         finally:
             os._exit(code)                          # no cleanup of the parent's state in the fork
     os.close(write_end)
+    return pid, read_end
+
+
+def draw_in_parallel(out: Path, result, cpu: dict | None = None) -> list[Path]:
+    """Draw the figures in processes of their own at once: each in a fork of this process but
+    :data:`HELPER_DRAWS` (or, without it, the last), which is drawn here meanwhile; returns their
+    paths in :func:`figure_names`' order. Drawing is CPU-bound and single-threaded, so on n free
+    cores the figures take about the longer of the costliest figure and the total over n (on two
+    cores, one fork drawing two figures took the time of both). The forks report through pipes;
+    whatever a fork did not draw (it failed or died) is drawn here, and an :class:`OSError` of its
+    write is raised here. ``cpu``: a dict given the forks' CPU times [s], ``forks_draw_s`` (total)
+    and ``longest_fork_draw_s``."""
+    names = figure_names(result)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if len(names) < 2 or cores < 2:
+        return draw_figures(out, result)
+    mine = HELPER_DRAWS if HELPER_DRAWS in names else names[-1]
+    forks = {}
+    for name in names:
+        if name != mine:
+            forked = _drawn_in_a_fork(out, result, name)
+            if forked is not None:
+                forks[name] = forked
+    replies = {}
     try:
-        draw_figures(out, result, [n for n in names if n not in SECOND_PROCESS])
+        draw_figures(out, result, [n for n in names if n not in forks])
     finally:
-        with os.fdopen(read_end, "rb") as f:
-            data = f.read()
-        os.waitpid(pid, 0)
-    reply = pickle.loads(data) if data else ("failed", "the second drawing process died")
-    if reply[0] == "oserror":
-        _raise(reply)
-    if reply[0] != "ok":
-        draw_figures(out, result, second)
-    elif cpu is not None:
-        cpu["second_process_draw_s"] = reply[1]
+        for name, (pid, read_end) in forks.items():
+            with os.fdopen(read_end, "rb") as f:
+                data = f.read()
+            os.waitpid(pid, 0)
+            replies[name] = pickle.loads(data) if data else ("failed", "the drawing process died")
+    for reply in replies.values():
+        if reply[0] == "oserror":
+            _raise(reply)
+    draw_figures(out, result, [n for n, reply in replies.items() if reply[0] != "ok"])
+    drawn = [reply[1] for reply in replies.values() if reply[0] == "ok"]
+    if cpu is not None and drawn:
+        cpu["forks_draw_s"], cpu["longest_fork_draw_s"] = sum(drawn), max(drawn)
     return [out / n for n in names]
 
 
@@ -216,8 +238,9 @@ class Figures:
         self._sent = False               # whether the helper was given results to draw
         self.helper_reason = ""          # why the figures were drawn here, if they were
         #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import and warm-up,
-        #: beside the solve), ``draw_s`` (its drawing after the results arrived) and, where a second
-        #: process drew, ``second_process_draw_s`` (at the same time); empty otherwise
+        #: beside the solve), ``draw_s`` (its drawing after the results arrived) and, where forks
+        #: drew the other figures at the same time, ``forks_draw_s`` (their total) and
+        #: ``longest_fork_draw_s``; empty otherwise
         self.helper_cpu_s: dict[str, float] = {}
         if helper is None:
             helper, self.helper_reason = helper_allowed()

@@ -20,6 +20,9 @@ LEFT_IN, RIGHT_IN, BOTTOM_IN = 0.9, 0.3, 0.6
 SAVE_DPI = 120
 #: A title wider than the axes by more than this [in] is wrapped onto more lines instead of widening the figure.
 TITLE_OVERHANG_IN = 2.0
+#: The title's height in axes coordinates, given: without it matplotlib measures the x axis's tick
+#: labels once more at every draw to lift the title clear of labels on top, which these axes never have.
+TITLE_Y = 1.0
 
 
 def _text_width_in(text: str, size_pt: float) -> float:
@@ -149,7 +152,7 @@ def plot_pull_force(path, result) -> None:
     low.set_xlabel("static solve step (one steady state: no time axis)" if steady_mode else "time [s]")
     ax.ticklabel_format(axis="y", useOffset=False, style="plain")
     ax.set_ylabel("pulling force [N]")
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title, fontsize=10, y=TITLE_Y)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=7)
     save_figure(fig, path)
@@ -167,7 +170,7 @@ def plot_tension_profile(path, result) -> None:
         ax.plot(result.extras["x_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
     ax.set_xlabel("x: material coordinate from the trailing end [m]")
     ax.set_ylabel("tension [N]")
-    ax.set_title(title, fontsize=12)
+    ax.set_title(title, fontsize=12, y=TITLE_Y)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     save_figure(fig, path)
@@ -205,7 +208,7 @@ def plot_pressure(path, result) -> None:
     ax.set_ylim(0, top)
     ax.set_xlabel("s along the conduit [m]")
     ax.set_ylabel("sidewall bearing pressure [N/m]")
-    ax.set_title(title, fontsize=12)
+    ax.set_title(title, fontsize=12, y=TITLE_Y)
     ax.grid(alpha=0.3)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
     save_figure(fig, path, dpi=SAVE_DPI)
