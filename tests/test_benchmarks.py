@@ -21,6 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # script -> a line fragment of the table header it prints (how a reader finds the table)
 SCRIPTS = {
     "benchmarks/bundle_route.py": "ratio bundle / one cable",
+    "benchmarks/bundle_start.py": "CPU clearance / axis",
     "benchmarks/cable_element.py": "| part (CPU per call, median) | exudyn [ms] | compiled [ms]",
     "benchmarks/contact_kernel.py": "ms/eval",
     "benchmarks/figure_cost.py": "| mode | figures | wall, median [s]",
@@ -61,7 +62,7 @@ SCRIPTS = {
 # Exudyn and numba, or an industry route of hundreds of elements): run with -m slow
 SLOW = {"benchmarks/naive_baseline.py", "benchmarks/run_examples.py", "benchmarks/sweep_scaling.py",
         "benchmarks/sweep_throughput.py",
-        "benchmarks/industry_suite.py", "studies/industry_dynamic.py",
+        "benchmarks/industry_suite.py", "studies/industry_dynamic.py", "benchmarks/bundle_start.py",
         # minutes even in their smoke runs: two cables through four bends; multibody steady runs both ways
         "benchmarks/bundle_route.py", "studies/fit_engines.py"}
 

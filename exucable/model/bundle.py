@@ -1,10 +1,11 @@
 """Several cables pulled together through one conduit (``cable.count`` 2-4), in steady sliding.
 
 One ANCF cable per conductor, each with the scenario's cable data, laid along the conduit in the
-arrangement's cross-section (:func:`arrangement_offsets`) turned, station by station, toward the
-lateral load on a cable (:func:`load_turn_rad`: in a bend the tension presses the bundle onto the
-bend's inner wall), and pre-tensioned to the rope solution of one cable carrying its share, except
-that a cable resting on the others only starts at its back tension (:func:`start_tensions`). Each cable has its own wall contact (the cable-conduit kernel in its
+arrangement's cross-section (:func:`arrangement_offsets`), its centroid on the path of the rope
+with clearance of one cable's share (free spans across the duct included) and the arrangement turned,
+station by station, toward the wall that path bears on (in a bend the tension presses the bundle onto
+the bend's inner wall), and pre-tensioned to that rope's tension, except that a cable resting on the
+others only starts at its back tension (:func:`start_tensions`). Each cable has its own wall contact (the cable-conduit kernel in its
 steady-sliding form) and one more coupling carries the contact between the cables
 (:class:`~exucable.contact.cable_pairs.CableContactKernel`).
 
@@ -155,10 +156,18 @@ def load_turn_rad(centreline, s_m, tension_N, weight_per_length_N_per_m: float, 
     kn = np.atleast_2d(centreline.curvature_vector(s))
     ez = np.array([0.0, 0.0, 1.0])
     load = np.asarray(tension_N, dtype=float)[:, None] * kn - weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
+    return _turn_toward(centreline, s, load, None, blend_length_m)
+
+
+def _turn_toward(centreline, s, vectors, loaded, blend_length_m: float) -> np.ndarray:
+    """φ(s) [rad] of :func:`load_turn_rad` from vectors across the duct, shape (m, 3), at the
+    uniform grid ``s``: their direction where ``loaded`` (None: where they are not ~0), the loaded
+    neighbours' angle elsewhere, unwrapped and smoothed over ``blend_length_m``."""
     eh, ev = _cross_section_frame(centreline, s)
-    ph, pv = np.einsum("ij,ij->i", load, eh), np.einsum("ij,ij->i", load, ev)
+    ph, pv = np.einsum("ij,ij->i", vectors, eh), np.einsum("ij,ij->i", vectors, ev)
     size = np.hypot(ph, pv)
-    loaded = size > 1e-9 * max(float(size.max()), 1e-300)
+    if loaded is None:
+        loaded = size > 1e-9 * max(float(size.max()), 1e-300)
     if not loaded.any():
         return np.zeros_like(s)
     phi = np.unwrap(np.arctan2(ph[loaded], -pv[loaded]))
@@ -201,6 +210,47 @@ def start_tensions(centreline, share_rope, offsets_m, clearance_m: float, weight
     n_free = n - int(np.count_nonzero(on_wall))
     T_wall = np.maximum((n * T_share - n_free * T_free) / (n - n_free), 0.0)
     return [(lambda s, T=(T_wall if wall else T_free): np.interp(s, s_r, T)) for wall in on_wall]
+
+
+def _smooth_rows(values, sigma: float) -> np.ndarray:
+    """``values`` (m, k) on a uniform grid smoothed along it with a Gaussian of ``sigma`` grid steps
+    (ends padded with their values)."""
+    if not sigma > 0.5:
+        return values
+    half = int(np.ceil(4 * sigma))
+    k = np.exp(-0.5 * (np.arange(-half, half + 1) / sigma) ** 2)
+    k /= k.sum()
+    pad = np.pad(values, ((half, half), (0, 0)), mode="edge")
+    return np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(values.shape[1])], axis=1)
+
+
+def _centroid_path(centreline, offsets_m, friction: float, weight_per_length_N_per_m: float,
+                   back_tension_N: float, cable_length_m: float):
+    """The path of the bundle's centroid at the start: the rope with clearance
+    (:func:`~exucable.quasistatic.clearance.solve_rope_with_clearance`) of one cable's share (friction
+    μ times the weight correction, back tension T_b/n, one cable's weight) whose clearance is the
+    resting arrangement's centroid's distance from the duct's axis, or None (no clearance left, or a
+    share that runs slack).
+
+    With gravity a tensioned cable leaves the bottom in a free span, crossing the duct in a straight
+    line toward a bend's inner wall, √(2TΔ/w) long (metres at kilonewtons); a start that hugs the
+    bottom up to the bend and rolls there is centimetres off that, and its cross-section, held only
+    by the tension in the span, must swing over. The share rope's tension on this path also has the
+    path's lower friction where the spans cut the bends' corners.
+    """
+    from ..quasistatic.clearance import solve_rope_with_clearance
+
+    mid_h, mid_v = np.asarray(offsets_m, dtype=float).mean(axis=0)
+    clearance = -float(mid_v)
+    # only for an arrangement resting with its centroid straight below the axis (any of
+    # arrangement_offsets'): the path's offset is the direction the arrangement's "down" is turned to
+    if not clearance > 1e6 * abs(float(mid_h)):
+        return None
+    try:
+        return solve_rope_with_clearance(centreline, clearance, friction, weight_per_length_N_per_m, back_tension_N,
+                                         cable_length_m=cable_length_m)
+    except ModelError:
+        return None
 
 
 @dataclass
@@ -457,8 +507,13 @@ class BundleModel:
         return float(np.sum(self.pull_shares_N())), self.back_tension_N * self.load_scale.end_force, tmax
 
 
-def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
+def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearance") -> BundleModel:
     """Build and assemble the Exudyn system of ``scenario``'s bundle (``cable.count`` > 1, steady mode).
+
+    ``start_path``: ``"clearance"`` lays the bundle's centroid on the rope with clearance's path
+    (:func:`_centroid_path`; where that rope has no solution, as ``"axis"``); ``"axis"`` lays the
+    arrangement about the duct's axis, turned toward the centreline rope's lateral load
+    (:func:`load_turn_rad`), the start before the path was used, kept to compare the two.
 
     Raises
     ------
@@ -506,17 +561,34 @@ def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
     mesh = plan_cable_mesh(sc, conduit, rope, refine)
     n_el = mesh.elements
 
-    tension_fns = start_tensions(centre, rope, offsets, sc.conduit.inner_radius_m - c.radius_m, w, back)
-
-    # the arrangement turned, station by station, to the lateral load the share rope puts on a cable
-    # (its rigid-circle rest under that load): in a bend the tension presses the bundle to the
-    # bend's inner wall, and a start left resting on the bottom there is far from any equilibrium
     s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * n_el + 1))
     # Rolled over a few elements (a faster roll the cubic elements cannot follow: measured 1 mm into
     # the wall and 2 mm into each other at 1 m elements and a 0.5 m roll)
     T_ref = max(float(np.max(rope.tension_N)), 1e-6)
     blend = max(L_cable / n_el, math.sqrt(c.bending_stiffness_N_m2 / T_ref))
-    turn = load_turn_rad(centre, s_grid, np.interp(s_grid, rope.s_conduit_m, rope.tension_N), w, blend)
+    path = _centroid_path(centre, offsets, sc.contact.friction * wcf, w, back, L_cable - lead_out) \
+        if start_path == "clearance" else None
+    start_rope = rope if path is None else path
+    tension_fns = start_tensions(centre, start_rope, offsets, sc.conduit.inner_radius_m - c.radius_m, w, back)
+    if path is None:
+        # the arrangement turned, station by station, to the lateral load the share rope puts on a
+        # cable (its rigid-circle rest under that load): in a bend the tension presses the bundle to
+        # the bend's inner wall, and a start left resting on the bottom there is far from any equilibrium
+        turn = load_turn_rad(centre, s_grid, np.interp(s_grid, rope.s_conduit_m, rope.tension_N), w, blend)
+        centroid_fn = None
+    else:
+        # the bundle's centroid on the path of the rope with clearance, the arrangement turned toward
+        # the wall that path bears on: free spans cross the duct where they do (see _centroid_path)
+        P = np.stack([np.interp(s_grid, path.s_conduit_m, path.offset_m[:, j]) for j in range(3)], axis=1)
+        # smoothed as the roll is, and the roll taken from its direction wherever it is near the wall,
+        # so that the arrangement turns with the path (a roll lagging the path's turn onto a bend's
+        # wall put the cables into the wall and into one another)
+        P = _smooth_rows(P, blend / (s_grid[1] - s_grid[0]))
+        near = np.linalg.norm(P, axis=1) > 0.5 * path.clearance_m
+        turn = _turn_toward(centre, s_grid, P, near if near.any() else None, 0.0)
+
+        def centroid_fn(s):
+            return np.stack([np.interp(s, s_grid, P[:, j]) for j in range(3)], axis=1)
     # laid as circles START_GAP·r larger: the cables start that far off the wall and apart, so what
     # the fit and the roll leave over is a gap the first steps close, not an overlap they must undo
     try:
@@ -528,13 +600,30 @@ def build_bundle_model(scenario, refine: float = 1.0) -> BundleModel:
     # they are laid, and there they are the rigid circles (a gap held open at the eye is not the pull's)
     L_e = L_cable / n_el
     layouts = []
+    mid0, mid1 = offsets.mean(axis=0), laid.mean(axis=0)
+    laid_radius = float(np.max(np.hypot(laid[:, 0], laid[:, 1])))   # the laid circles' distance to the wall
     for (h0, v0), (h1, v1), cable_tension_fn in zip(offsets, laid, tension_fns):
         def offset_fn(s, h0=h0, v0=v0, h1=h1, v1=v1):
             eh, ev = _cross_section_frame(centre, s)
             f = np.clip((centre.length_m - np.asarray(s, dtype=float)) / L_e, 0.0, 1.0)[:, None]
             h, v = h0 + f * (h1 - h0), v0 + f * (v1 - v0)
             phi = np.interp(s, s_grid, turn)[:, None]
-            return (h * np.cos(phi) - v * np.sin(phi)) * eh + (h * np.sin(phi) + v * np.cos(phi)) * ev
+            o = (h * np.cos(phi) - v * np.sin(phi)) * eh + (h * np.sin(phi) + v * np.cos(phi)) * ev
+            if centroid_fn is not None:
+                # the centroid moved onto the path (scaled as the laid circles are), except at the eye,
+                # which holds the ends where the circles rest (the blend's f: 0 there)
+                mh, mv = mid0[0] + f * (mid1[0] - mid0[0]), mid0[1] + f * (mid1[1] - mid0[1])
+                k = mv / float(mid0[1])
+                mid = (mh * np.cos(phi) - mv * np.sin(phi)) * eh + (mh * np.sin(phi) + mv * np.cos(phi)) * ev
+                o = o + f * (k * centroid_fn(s) - mid)
+                # where the turn (smoothed) lags the path's direction, a cable would stand out of the
+                # duct: held at its laid distance from the axis instead
+                cap = np.hypot(h0 + f[:, 0] * (h1 - h0), v0 + f[:, 0] * (v1 - v0))
+                cap = np.maximum(cap, laid_radius)
+                size = np.linalg.norm(o, axis=1)
+                over = size > cap
+                o[over] *= (cap[over] / size[over])[:, None]
+            return o
         layouts.append(lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, cable_tension_fn,
                                  offset_fn, lead_out_m=lead_out))
     Le = layouts[0].element_length_m
