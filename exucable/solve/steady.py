@@ -44,6 +44,15 @@ exact-step continuation above runs from the start.
 Where that does not converge either, the loads themselves are ramped (friction, gravity and end forces
 scaled by λ) with the increment halved on failure (:meth:`SteadySolver.ramp_loads`).
 
+Several cables (:mod:`exucable.model.bundle`) follow three more rules. Their start is far from
+equilibrium across the duct, so a phase that gives up hands its best state on, not the start
+(:meth:`SteadySolver.restart_state`); a one-iteration step is held to the smallest residual reached,
+not the last (steps that each stayed within 2x of the one before drifted 496 -> 22 000 N), and
+an exact step that converges far above it is undone (``runaway_growth``: 5e3 -> 3e8 N seen). And the load ramp
+scales their friction only: with gravity and the end forces ramped to zero the cables float in
+the duct, their equilibrium is singular, and the ramp stalled at load scale 0 (one 90° bend at
+4000 N back tension: with friction only it converged at λ = 0.5).
+
 A solve may instead start warm, from a state near its steady state (``warm_start``: the coarse mesh's
 solved state subdivided, :func:`exucable.solve.start.nested_start`). The phases above assume the rope
 start, far from equilibrium: their first pseudo-time steps are short (c0, an isotropic spring) because
@@ -154,6 +163,10 @@ class SteadySettings:
         ``benchmarks/long_routes.py``'s 1, 2, 5 km routes, Newton iterations): k = 2: 10, 9, 10;
         3: 7, 8, 9; 4: 13, 8, 26; 5: -, 10, 29 (k = 0 at 1 km: 12; from the rope start 19, 26, 24):
         a softer first spring lets the first Newton step overshoot.
+    runaway_growth : float
+        Several cables only: an exact-step continuation's converged step whose residual exceeds
+        this many times the smallest one at its load scale is undone like a failed step [-]
+        (accepted, such steps ran a bundle's residual from 5e3 to 3e8 N).
     max_warm_start_steps : int
         Pseudo-time steps (accepted and rejected) a warm start may take, the stall rule
         (``max_one_iteration_stall``) included, before the solve starts again from the rope start [-]
@@ -178,6 +191,7 @@ class SteadySettings:
     time_limit_s: float = 60.0
     warm_start_skipped_steps: int = 3
     max_warm_start_steps: int = 20
+    runaway_growth: float = 10.0
 
     def __post_init__(self):
         for f in fields(self):
@@ -410,8 +424,8 @@ class _FailedSteps:
         return f"{text}: {message}"
 
 
-def _set_scale(model, lam: float) -> None:
-    model.load_scale.apply(model.mbs, gravity=lam, end_force=lam)
+def _set_scale(model, lam: float, loads: bool = True) -> None:
+    model.load_scale.apply(model.mbs, gravity=lam if loads else 1.0, end_force=lam if loads else 1.0)
     model.kernel.set_friction_scale(lam)
     if model.coupling is not None:
         # a pass at the same coordinates was of the former friction scale
@@ -474,6 +488,9 @@ class SteadySolver:
         self._cpu_start = time.process_time()
         self.timed_out = False           # stopped at settings.time_limit_s
         self._trace_lam, self._trace = 0.0, []   # the load scale of the last accepted steps, their residuals [N]
+        #: several cables (exucable.model.bundle): the continuation's bundle rules apply (module notes)
+        self.bundle = getattr(model, "n_cables", 1) > 1
+        self.best = (np.inf, None)       # the smallest true residual [N] of an accepted step and its state
 
     def out_of_time(self) -> bool:
         """Whether the solve has used up its CPU time (:attr:`SteadySettings.time_limit_s`)."""
@@ -541,8 +558,9 @@ class SteadySolver:
         return float(np.linalg.norm(r))
 
     def at_scale(self, lam: float) -> None:
-        """Loads and friction at scale ``lam`` [-]; the stored state's kernel pass was of another."""
-        _set_scale(self.model, lam)
+        """Loads and friction at scale ``lam`` [-] (a bundle's friction only, :meth:`ramp_loads`);
+        the stored state's kernel pass was of another."""
+        _set_scale(self.model, lam, loads=not self.bundle)
         self.store.saved = self.store.saved[:2] + (None,)
 
     def relax_one_iteration(self, lam: float, skip: int = 0, max_steps: int | None = None) -> tuple[bool, str]:
@@ -568,7 +586,9 @@ class SteadySolver:
             stalled += 1
             ok, message, _ = self.pseudo_step(c, self.one_iteration_settings)
             residual = self.true_residual() if ok else np.inf
-            if residual > s.reject_growth * previous or not ok:
+            # a bundle's steps are held to the best residual, not the last: drifting up by 2x per
+            # step went 496 -> 22 000 N on the 100 m route
+            if residual > s.reject_growth * (min(previous, self.best[0]) if self.bundle else previous) or not ok:
                 c *= 4.0
                 after_reject = True
                 if c > 1e6 * self.c0:
@@ -578,6 +598,8 @@ class SteadySolver:
             self.record(lam, residual)
             if residual <= self.tolerance_N:
                 return True, ""
+            if residual < self.best[0]:
+                self.best = (residual, self.store.saved)
             if residual <= 0.5 * best:
                 best, stalled = residual, 0
             c /= s.rate_fall_after_reject if after_reject else s.rate_fall
@@ -617,6 +639,14 @@ class SteadySolver:
             q_now = _cable_part(self.model, np.array(self.mbs.systemData.GetODE2Coordinates()))
             # the equilibrium residual is at most the spring's force plus what Newton left over
             residual = float(np.linalg.norm(self.spring.force(q_now))) + (leftover if exact else 0.0)
+            if self.bundle and residual > s.runaway_growth * best:
+                # a converged step far from the best state (a bundle's steps ran 5e3 -> 3e8 N):
+                # undone like a failed one
+                stuck.record(exact, leftover)
+                c *= 4.0
+                if c > 1e6 * self.c0:
+                    return False, stuck.why(message, lam, best, self.tolerance_N, self.exact_settings)
+                continue
             self.store.save()
             self.record(lam, residual)
             if residual <= self.tolerance_N:
@@ -639,8 +669,12 @@ class SteadySolver:
     def ramp_loads(self, first_message: str) -> tuple[str, str]:
         """Continuation in the load scale λ (friction, gravity, end forces) from the start, each
         stage solved by :meth:`relax`, the increment doubled after a success and halved after a
-        failure: status ("ok" or "failed") and message."""
-        self.store.saved = self.start
+        failure: status ("ok" or "failed") and message.
+
+        A bundle ramps its friction only, from the best state reached (:meth:`restart_state`):
+        without gravity and end forces several cables in a duct float, their equilibrium is
+        singular, and a ramp from λ = 0 stalled there."""
+        self.store.saved = self.restart_state()
         lam, step, stages = 0.0, 0.5, 0
         if self.timed_out:
             return "failed", (f"no steady state found: stopped at `{TIME_LIMIT_KEY}` = {self.settings.time_limit_s:g} s "
@@ -689,7 +723,7 @@ class SteadySolver:
             self.store.saved = self.start
             ok, first_message = self.relax_one_iteration(1.0)
             if not ok and not self.timed_out:
-                self.store.saved = self.start
+                self.store.saved = self.restart_state()
                 ok, first_message = self.relax(1.0)
             first_message += warm_note
         if ok:
@@ -716,6 +750,14 @@ class SteadySolver:
         return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
                             steps=self.steps, newton_iterations=self.newton_iterations,
                             jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from)
+
+    def restart_state(self):
+        """The state a later phase starts from: the start, or for a bundle the accepted state of
+        smallest true residual so far (a bundle's start is far from its equilibrium across the duct,
+        and the one-iteration steps' progress from it is worth keeping)."""
+        if self.bundle and self.best[1] is not None:
+            return self.best[1]
+        return self.start
 
     def relax_warm(self) -> tuple[bool, str]:
         """The one-iteration continuation at the full loads from :attr:`warm_start`, its first
