@@ -313,11 +313,6 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         # extent, evaluated at the window's mean time): remove that drift first
         pf = pull_force_uncertainty(h["time_s"], h["pull_force_N"] - drift * h["time_s"],
                                     st.from_s if np.isfinite(st.from_s) else 0.0) if len(h["time_s"]) else None
-    if sp.mode == "steady":
-        uncertainty = _steady_uncertainty(sc, bar, out)
-    else:
-        uncertainty = {"pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
-                       "pull_force_uncertainty_method": (pf.method if pf else "no history: none")}
     # the cable's tension from the equilibrium of its loads (exucable.post.tension.equilibrium_tension):
     # EA·ε of the elements oscillates next to the concentrated loads at bend ends
     x = profile_stations_m(model.layout.element_length_m)
@@ -333,6 +328,13 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     has_history = bool(len(h["time_s"]))
     pull_force_N = float(np.mean(h["pull_force_N"][i0:])) if has_history else None
     warnings = list(model.mesh.warnings) if model.mesh is not None else []
+    if sp.mode == "steady":
+        bar, wall_warning = _with_wall_part(model, bar, h, refs, points)
+        warnings += wall_warning
+        uncertainty = _steady_uncertainty(sc, bar, out)
+    else:
+        uncertainty = {"pull_force_uncertainty_N": pf.uncertainty_N if pf else None,
+                       "pull_force_uncertainty_method": (pf.method if pf else "no history: none")}
     start = None
     if first is not None:
         start = {"kind": "steady" if first.layout is not None else "rope",
@@ -711,6 +713,34 @@ def _steady_on_the_rule(sc) -> bool:
     """A steady solve on the mesh rule's mesh (no ``cable.elements`` or ``cable.element_length`` given)."""
     return (sc.solver.mode == "steady" and "elements" in sc.cable.derived_keys
             and sc.cable.element_length_m is None)
+
+
+def _with_wall_part(model, bar, h, refs, points) -> tuple:
+    """The steady error bar with the wall's compliance added (:func:`exucable.solve.error_bar.with_wall_compliance`:
+    the rigid wall's pull is higher by up to u_wall), and a warning naming ``contact.stiffness`` when
+    that part exceeds ``WALL_WARNING`` of the force; ``(bar, [])`` without a bar, contact or rope."""
+    from .solve.dynamic import steady_quantity
+    from .solve.error_bar import WALL_WARNING, with_wall_compliance
+
+    if bar is None or bar.uncertainty_N is None or points is None or model.rope is None or not len(h["time_s"]):
+        return bar, []
+    quantity = steady_quantity(model)
+    value = float(h[quantity][-1])
+    if quantity == "trailing_tension_N":
+        rope_N = model.rope.trailing_tension_N
+    else:
+        rope_N = refs.get("rope_clearance_pull_force_N") or refs.get("rope_pull_force_N", model.rope.pull_force_N)
+    sc = model.scenario
+    clearance = model.conduit.inner_radius_m - sc.cable.radius_m
+    deepest = float(np.max(points["penetration_m"])) if len(points["penetration_m"]) else 0.0
+    bar = with_wall_compliance(bar, value, rope_N, deepest, clearance)
+    if not bar.wall_N > WALL_WARNING * abs(value):
+        return bar, []
+    name = quantity.removesuffix("_N").replace("_", " ")
+    return bar, [f"the wall's compliance: the cable sinks {1e3 * deepest:.3g} mm into the wall "
+                 f"({100 * deepest / clearance:.3g} % of the clearance {1e3 * clearance:.3g} mm); against a rigid wall "
+                 f"the {name} may be up to {bar.wall_N:.3g} N ({100 * bar.wall_N / abs(value):.2g} %) higher, in its "
+                 f"uncertainty (raise contact.stiffness: the penetration falls about as its -1/2 power)"]
 
 
 def _steady_uncertainty(sc, bar, out) -> dict:

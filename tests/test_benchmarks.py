@@ -52,6 +52,7 @@ SCRIPTS = {
     "studies/bundle_bend_study.py": "p/formula",
     "studies/bundle_jam_study.py": "F/formula",
     "studies/bundle_physics_study.py": "| place | arrangement | D/d | μ_c |",
+    "studies/wall_compliance_study.py": "| case | c [mm] | K [N/m^1.5] | δ/c [-]",
 }
 
 # the slowest smoke runs, 10-35 s each on the shared 2-core machine (several processes each importing

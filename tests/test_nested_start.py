@@ -130,9 +130,10 @@ def test_a_steady_run_solves_the_coarse_mesh_first(solved):
     n, m = s["mesh"]["elements"], coarse.mesh.elements
     assert n == 2 * m
     # the bar is Richardson's estimate against the coarse solve's value (the fixture's: the same
-    # model solved alike, deterministic), with the stop residual's term
+    # model solved alike, deterministic), with the stop residual's term and the wall's part
     solve_N = settings.steady_residual * coarse.rope.max_tension_N
-    expected = combine(s["pull_force_N"], float(steady_forces(coarse)[0]), n, m, solve_N)[1]
+    expected = (combine(s["pull_force_N"], float(steady_forces(coarse)[0]), n, m, solve_N)[1]
+                + s["pull_force_uncertainty"]["wall_N"])
     assert s["pull_force_uncertainty_N"] == pytest.approx(expected, rel=1e-6)
     plain = run_scenario(sc, None, plots=False, error_bar=False)
     assert "from the coarse mesh's state" not in plain.summary["message"]

@@ -64,7 +64,7 @@ class RunSummary(Mapping):
     pull_force_unexplained_drift_N_per_s: float | None = _key(
         "dynamic mode: that drift less the references' expected drift [N/s]", _TIME)
     pull_force_uncertainty: dict | None = _key("the uncertainty's parts (dynamic: periods and window [s]; "
-                                               "steady: mesh_N, solve_N, coarse_value_N, coarse_elements)", _TIME)
+                                               "steady: mesh_N, solve_N, wall_N, coarse_value_N, coarse_elements)", _TIME)
     steady_quantity: str | None = _key("the history column the steady detector watches", _TIME)
     steady_drift_N: float | None = _key("drift of that quantity over the steady window [N]", _TIME)
     trailing_tension_N: float | None = _key("tension at the trailing end [N] (a bundle: its back tension)", _BOTH)

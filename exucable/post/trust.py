@@ -36,6 +36,8 @@ import numpy as np
 __all__ = ["AxisGauge", "cable_sample_points", "PullForceEstimate", "pull_force_uncertainty", "assess", "not_steady_fix",
            "PENETRATION_LIMIT", "DYNAMIC_LIMIT", "FRICTION_DEFICIT_LIMIT", "TRUSTED_STATUSES", "friction_factor"]
 
+# beyond ¼ of the clearance a stiff cable in a tight duct is > 5 % low (studies/wall_compliance_study.py);
+# inside it the steady error bar's wall part states the shortfall (exucable.solve.error_bar)
 PENETRATION_LIMIT = 0.25
 DYNAMIC_LIMIT = 0.01
 # 1e-4 of μ: the capstan force's error μθ·deficit stays below 0.05 % up to μθ = 5 (a long route)
