@@ -1,9 +1,9 @@
 """The steady continuation's rules for several cables (exucable/solve/steady.py, module notes).
 
-A bundle's load ramp scales its friction only: with gravity and the end forces ramped to zero the
-cables float in the duct (their equilibrium is singular) and a ramp from λ = 0 stalled there. A
-phase that gives up hands the best state reached on, not the start. One cable keeps every rule it
-had (its whole load ramp, the start as every phase's start). Coarse models: 8 elements of 0.5 m.
+Where a bundle's loads' ramp stalls, its friction alone is ramped from the best state reached: with
+gravity and the end forces ramped to zero the cables float in the duct (their equilibrium is
+singular) and a ramp from λ = 0 stalled there. One cable keeps every rule it had (its whole load
+ramp, from the start). Coarse models: 8 elements of 0.5 m.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ def duct(count):
 def test_a_bundles_load_ramp_scales_its_friction_only():
     model = build_bundle_model(duct(3))
     solver = SteadySolver(model)
+    solver.friction_only = True          # as ramp_loads(..., friction_only=True) sets it
     solver.at_scale(0.25)
     assert model.load_scale.gravity == 1.0 and model.load_scale.end_force == 1.0
     assert all(k.law.friction == pytest.approx(0.25 * MU, rel=1e-15) for k in model.walls)
