@@ -34,8 +34,9 @@ one, and prints the CPU time after/before of the whole process, the solves and t
 pulling force's change: a pass's effect measured in one run.
 
 Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing] [--before TREE] [--compare-cold]``;
-``--clearance-spacing`` solves the longest route's rope with clearance at 2, 5 and 10 cm node spacings and at
-the default rule's, with the pulling force's change and the CPU time of each.
+``--clearance-spacing`` solves the longest route's rope with clearance on uniform chains of 2, 5 and 10 cm node
+spacing and on the default chain (graded away from the bends), with the pulling force's change against the 2 cm
+chain and the CPU time of each.
 ``--compare-cold`` runs each length a second time with the solved mesh started from the rope start
 instead of the error bar's coarse solve (steady mode's nested start), in a process of its own right
 after, and prints the two side by side (Newton iterations, CPU of the solves and of the whole process,
@@ -82,11 +83,15 @@ def route_path(length_m: float) -> list[dict]:
     return path
 
 
-def route_data(length_m: float) -> dict:
-    """The scenario (as a TOML-like dict) of a route of ``length_m`` [m], steady mode."""
+def route_data(length_m: float, cable_element: str | None = None) -> dict:
+    """The scenario (as a TOML-like dict) of a route of ``length_m`` [m], steady mode;
+    ``cable_element``: ``[solver] cable_element`` (None: the default)."""
     import math
 
     area = math.pi * CABLE_RADIUS_M ** 2
+    solver = {"mode": "steady", "end_time": 1.0}   # end_time: required, unused by a steady solve
+    if cable_element is not None:
+        solver["cable_element"] = cable_element
     return {
         "name": f"long-route-{length_m:g}m",
         "cable": {"radius": CABLE_RADIUS_M, "mass_per_length": MASS_PER_LENGTH_KG_PER_M,
@@ -95,7 +100,7 @@ def route_data(length_m: float) -> dict:
         "contact": {"friction": 0.2},
         "pull": {"speed": 0.1, "back_tension": 500.0},
         "gravity": {"g": 9.81},
-        "solver": {"mode": "steady", "end_time": 1.0},   # end_time: required, unused by a steady solve
+        "solver": solver,
     }
 
 
@@ -145,7 +150,7 @@ class _Timed:
         setattr(module, name, timed)
 
 
-def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
+def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_element: str | None = None) -> dict:
     """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints).
 
     Stages: import, parse, build (every model built, the rope references included), of it the
@@ -167,7 +172,7 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
     if cold:
         start.nested_start = lambda fine, coarse: None     # run.py imports it at call time
     clock.lap("import_s")
-    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    sc = parse_scenario(route_data(length_m, cable_element), ROOT, default_name="route")
     clock.lap("parse_s")
     # run_scenario and the error bar import these at call time: the timed copies are the ones called
     timed = _Timed()
@@ -216,14 +221,15 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False) -> dict:
             "cpu_s": cpu, "peak_rss_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **wall}
 
 
-def in_child(length_m: float, figures: bool, cold: bool = False, tree: str | None = None) -> dict:
+def in_child(length_m: float, figures: bool, cold: bool = False, tree: str | None = None,
+             cable_element: str | None = None) -> dict:
     """:func:`one_case` in a fresh process; adds the whole process's wall time ``process_s``.
     ``cold``: the solved mesh from the rope start (``--compare-cold``); ``tree``: an exucable source tree
     whose package the child imports instead of the installed one."""
     import os
 
     cmd = ([sys.executable, __file__, "--case", f"{length_m:g}"] + ([] if figures else ["--no-figures"])
-           + (["--cold"] if cold else []))
+           + (["--cold"] if cold else []) + (["--cable-element", cable_element] if cable_element else []))
     env = None
     if tree is not None:
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(tree).resolve())]
@@ -298,6 +304,16 @@ def compare(b: dict, a: dict) -> str:
     return (f"{'':9s}CPU after/before: {ratios}; change of the pulling force {rel('pull_force_N')}, "
             f"of the rope with clearance's {rel('rope_clearance_pull_force_N')}; Newton "
             f"{b['newton_iterations']}/{b['error_bar_newton_iterations']} -> {a['newton_iterations']}/{a['error_bar_newton_iterations']}")
+
+
+def per_iteration(b: dict, a: dict) -> str:
+    """One line: CPU per Newton iteration of both steady solves, exudyn's element (b) and the compiled one (a)."""
+    def each(r):
+        n = r["newton_iterations"] + r["error_bar_newton_iterations"]
+        return 1e3 * (r["cpu_s"]["solve_s"] + r["cpu_s"]["error_bar_s"]) / max(n, 1), n
+    (x, nx), (y, ny) = each(b), each(a)
+    return (f"{'':9s}CPU per Newton iteration (solve and error bar): exudyn {x:.1f} ms ({nx} iterations), "
+            f"compiled {y:.1f} ms ({ny}), ratio {y / x:.2f}")
 
 
 def profile(length_m: float, top: int = 25) -> None:
@@ -422,10 +438,9 @@ def newton_parts(length_m: float, reps: int = 5) -> None:
 
 
 def clearance_spacing(length_m: float, spacings_m=(0.02, 0.05, 0.10, None)) -> None:
-    """The rope with clearance of the route of ``length_m`` [m] at node spacings ``spacings_m``
-    (None: the default rule), with its pulling force and the CPU time of each solve."""
-    import math
-
+    """The rope with clearance of the route of ``length_m`` [m] at uniform node spacings
+    ``spacings_m`` (None: the default chain, graded away from the bends on routes over 400 m), with
+    its pulling force against the first (finest) and the CPU time of each solve."""
     from exucable.quasistatic.clearance import default_node_spacing_m, solve_rope_with_clearance
     from exucable.scenario.specs import parse_scenario
 
@@ -433,15 +448,15 @@ def clearance_spacing(length_m: float, spacings_m=(0.02, 0.05, 0.10, None)) -> N
     clearance = DUCT_INNER_RADIUS_M - CABLE_RADIUS_M
     first = None
     for h in spacings_m:
-        h = default_node_spacing_m(centre, clearance) if h is None else h
         t0 = time.process_time()
         r = solve_rope_with_clearance(centre, clearance, 0.2, MASS_PER_LENGTH_KG_PER_M * 9.81, 500.0,
                                       node_spacing_m=h)
         cpu = time.process_time() - t0
         first = first if first is not None else r.pull_force_N
-        print(f"rope with clearance, {length_m / 1000:g} km, node spacing {100 * h:5.1f} cm "
-              f"({math.ceil(length_m / h)} nodes): pulling force {r.pull_force_N:.4f} N "
-              f"({r.pull_force_N / first - 1:+.1e} relative), CPU {cpu:.2f} s", flush=True)
+        what = (f"uniform spacing {100 * h:5.1f} cm" if h is not None else
+                f"the default chain ({100 * default_node_spacing_m(centre, clearance):.1f} cm on the bends, graded)")
+        print(f"rope with clearance, {length_m / 1000:g} km, {what}, {len(r.s_conduit_m)} nodes: pulling force "
+              f"{r.pull_force_N:.4f} N ({r.pull_force_N / first - 1:+.1e} relative), CPU {cpu:.2f} s", flush=True)
 
 
 def main() -> None:
@@ -450,7 +465,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smoke run: 200 m and 400 m")
     ap.add_argument("--profile", action="store_true", help="also cProfile the longest route")
     ap.add_argument("--clearance-spacing", action="store_true",
-                    help="also the longest route's rope with clearance at 2, 5, 10 cm and at the default node spacing")
+                    help="also the longest route's rope with clearance at uniform 2, 5, 10 cm and on the default (graded) chain")
     ap.add_argument("--newton-parts", action="store_true",
                     help="also the CPU time of each part of one Newton iteration on the longest route")
     ap.add_argument("--no-figures", action="store_true", help="skip the figures stage")
@@ -461,21 +476,35 @@ def main() -> None:
     ap.add_argument("--before", metavar="TREE",
                     help="an exucable source tree to compare with (e.g. `git archive <commit> | tar -x -C TREE`): "
                          "each length runs with it and then with the installed package, interleaved")
+    ap.add_argument("--cable-element", choices=("exudyn", "compiled"),
+                    help="[solver] cable_element of the runs (default: the scenario default)")
+    ap.add_argument("--compare-elements", action="store_true",
+                    help="each length with cable_element = \"exudyn\" and then \"compiled\", in processes of their "
+                         "own one after the other, and their CPU ratios and pulling forces side by side")
     ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.case:
-        print(json.dumps(one_case(float(args.case), figures=not args.no_figures, cold=args.cold)))
+        print(json.dumps(one_case(float(args.case), figures=not args.no_figures, cold=args.cold,
+                                  cable_element=args.cable_element)))
         return
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
     rows, pairs = [], []
     for L in lengths:
-        if args.before:
-            b = in_child(L, figures=not args.no_figures, tree=args.before)
-            print("before: " + report(b), flush=True)
-        r = in_child(L, figures=not args.no_figures)
-        print(("after:  " if args.before else "") + report(r), flush=True)
-        if args.before:
-            print(compare(b, r), flush=True)
+        if args.compare_elements:
+            b = in_child(L, figures=not args.no_figures, cable_element="exudyn")
+            print("exudyn:   " + report(b), flush=True)
+            r = in_child(L, figures=not args.no_figures, cable_element="compiled")
+            print("compiled: " + report(r), flush=True)
+            print(compare(b, r).replace("after/before", "compiled/exudyn"), flush=True)
+            print(per_iteration(b, r), flush=True)
+        else:
+            if args.before:
+                b = in_child(L, figures=not args.no_figures, tree=args.before, cable_element=args.cable_element)
+                print("before: " + report(b), flush=True)
+            r = in_child(L, figures=not args.no_figures, cable_element=args.cable_element)
+            print(("after:  " if args.before else "") + report(r), flush=True)
+            if args.before:
+                print(compare(b, r), flush=True)
         if args.compare_cold:
             c = in_child(L, figures=not args.no_figures, cold=True)
             print(report(c), flush=True)

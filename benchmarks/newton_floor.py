@@ -1,7 +1,8 @@
 """Where one steady Newton iteration's CPU time goes on a long route, and what its floor is.
 
 For each route length (``benchmarks/long_routes.py``'s realistic routes: 30 mm cable, gravity,
-μ 0.2, a 15° bend every ~350 m; the solved mesh of the default rules), in a process of its own,
+μ 0.2, a 15° bend every ~350 m; the solved mesh of the default rules; Exudyn's ANCF cable element,
+``solver.cable_element = "exudyn"``: the compiled one is ``benchmarks/cable_element.py``'s), in a process of its own,
 two variants of the contact coupling's Jacobian handover, their calls interleaved (before, after,
 before, ...) so that both see the same load:
 
@@ -49,9 +50,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 
-def _triplets_before(self, res, f_q, f_v):
-    """The contact Jacobian's triplets as the coupling built them before (the baseline)."""
+def _triplets_before(self, res, f_q, f_v, elastic_blocks=None):
+    """The contact Jacobian's triplets as the coupling built them before (the baseline; the models
+    here have Exudyn's cable elements, so no compiled element's blocks)."""
     import numpy as np
+
+    assert elastic_blocks is None
 
     if not hasattr(self, "_before_rows"):
         self._before_rows = self._triplets[:, 0].copy()
@@ -80,7 +84,8 @@ def measure(length_m: float, repeat: int) -> dict:
     variants = {"before": _triplets_before, "after": after}
     # the coupling's own timers then count this process's CPU time, not wall
     coupling.time = types.SimpleNamespace(perf_counter=time.process_time)
-    sc = parse_scenario(long_routes.route_data(length_m), ROOT, default_name="route")
+    # Exudyn's ANCF elements, whose floor this measures (the compiled element: benchmarks/cable_element.py)
+    sc = parse_scenario(long_routes.route_data(length_m, "exudyn"), ROOT, default_name="route")
     first = build_model(sc)
     model = build_model(sc, refine=2.0, check_points_per_element=first.mesh.check_points_per_element,
                         references=first.start)

@@ -21,6 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # script -> a line fragment of the table header it prints (how a reader finds the table)
 SCRIPTS = {
     "benchmarks/bundle_route.py": "ratio bundle / one cable",
+    "benchmarks/cable_element.py": "| part (CPU per call, median) | exudyn [ms] | compiled [ms]",
     "benchmarks/contact_kernel.py": "ms/eval",
     "benchmarks/figure_cost.py": "| mode | figures | wall, median [s]",
     "benchmarks/fixed_cost.py": "| command | wall, median [s]",

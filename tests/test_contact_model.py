@@ -159,3 +159,17 @@ def test_contact_jacobian_triplets_are_the_plain_formula_bit_for_bit(mode):
     for f_q, f_v in [(1.0, 0.0), (0.7, 0.0), (1.0, 37.3), (0.3, 1.1e3)]:
         got = c.jacobian_triplets(res, f_q, f_v).copy()
         np.testing.assert_array_equal(got, _reference_triplets(c, res, f_q, f_v))
+
+
+@pytest.mark.parametrize("n_elements", [1, 2, 5, 64])
+def test_the_couplings_sparsity_pattern_is_numpys_unique_of_the_element_blocks(n_elements):
+    from exucable.contact import block_sparsity
+    from exucable.model.coupling import _chain_pattern
+
+    rows, cols = block_sparsity(n_elements)
+    n = 6 * (n_elements + 1)
+    unique, inverse = np.unique(rows.astype(np.int64) * n + cols, return_inverse=True)
+    got_rows, got_cols, got_inverse = _chain_pattern(rows, cols, n_elements)
+    np.testing.assert_array_equal(got_rows, unique // n)
+    np.testing.assert_array_equal(got_cols, unique % n)
+    np.testing.assert_array_equal(got_inverse, inverse.reshape(-1))

@@ -2,7 +2,7 @@
 
 The kernels (:mod:`.fast`, the broad phase :mod:`.broadphase`, the steady-mode kernel :mod:`.steady`,
 the parts those two share, :mod:`.kernel_parts`, the trust gauge's nearest-sample search
-:mod:`.nearest`) are decorated with :func:`njit` from here, not numba's: it records the function
+:mod:`.nearest`, the compiled ANCF cable element :mod:`.ancf_cable`) are decorated with :func:`njit` from here, not numba's: it records the function
 and its numba options and imports nothing until the first call (``import exucable`` stays light).
 A call goes to numba's JIT dispatcher, created on first use with ``cache=True``: the first call in a
 fresh environment compiles (tens of seconds for :mod:`.fast`; ``exucable compile`` does it up front,
@@ -45,7 +45,7 @@ __all__ = ["njit", "Kernel", "SLOW_TO_COMPILE", "forget_stale_machine_code", "ji
            "kernels_to_compile", "load_cached_kernels", "sources_key", "KERNEL_MODULES"]
 
 # The modules of this package holding kernels (``load_cached_kernels``)
-KERNEL_MODULES = ("fast", "steady", "broadphase", "nearest", "profiles", "cable_pairs")
+KERNEL_MODULES = ("fast", "steady", "broadphase", "nearest", "profiles", "cable_pairs", "ancf_cable")
 
 # The kernels whose compilation takes long enough to announce (tens of seconds each; the others
 # take about a second): the dynamic and the steady contact kernel, as "module.function".

@@ -139,12 +139,15 @@ class CableInConduit:
     trailing_end: str = "back_tension"
     end_loads: dict = field(default_factory=lambda: {"leading": [], "trailing": []})
     gravity_loads: tuple = ()
+    # the cable's elastic forces and weight when exucable assembles them (steady mode,
+    # solver.cable_element = "compiled"; exucable.contact.ancf_cable.AncfCableForces), else None
+    cable_forces: object = None
     _ode2_index: np.ndarray | None = field(default=None)
     # a steady state's loads and the system state they were computed at (see :meth:`loads`)
     _loads_memo: tuple | None = field(default=None)
 
     def __repr__(self) -> str:
-        return (f"{type(self).__name__}({self.scenario.name!r}: {len(self.cable.elements)} cable elements, "
+        return (f"{type(self).__name__}({self.scenario.name!r}: {self.cable.n_elements} cable elements, "
                 f"{'with' if self.coupling is not None else 'without'} contact)")
 
     @property
@@ -255,6 +258,8 @@ class CableInConduit:
         else:
             point_x, point_f = np.zeros(0), np.zeros((0, 3))
         g = np.asarray(mbs.GetLoadValues(self.gravity_loads[0]), dtype=float) if self.gravity_loads else np.zeros(3)
+        if self.cable_forces is not None:
+            g = self.cable_forces.gravity_m_per_s2 * self.cable_forces.gravity_scale
         if state is not None and self.gravity_loads and self.scenario.pull.ramp_time_s > 0.0 and not static:
             g = np.asarray(self.load_scale.vector(self.gravity_loads[0]), dtype=float) * self.load_factor(t)
         q_rel = (q - self.layout.coordinates).reshape(-1)
@@ -353,6 +358,7 @@ class LoadScale:
         self.end_force = 1.0
         self._gravity_loads: list[tuple[int, list]] = []
         self._end_loads: list[tuple[int, list]] = []
+        self.cable_forces = None     # AncfCableForces whose weight scales with gravity, if any
 
     def track(self, gravity_loads=(), end_loads=(), vectors=None) -> None:
         """Remember loads (indices) and their full-scale vectors [N or m/s²]."""
@@ -368,6 +374,8 @@ class LoadScale:
     def apply(self, mbs, gravity: float, end_force: float) -> None:
         """Set the factors and rewrite the loads' vectors."""
         self.gravity, self.end_force = float(gravity), float(end_force)
+        if self.cable_forces is not None:
+            self.cable_forces.gravity_scale = self.gravity
         for loads, f in ((self._gravity_loads, self.gravity), (self._end_loads, self.end_force)):
             for i, vec in loads:
                 mbs.SetLoadParameter(i, "loadVector", [f * x for x in vec])
@@ -402,7 +410,8 @@ def _scenario_from(scenario, parts: dict):
 
 def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | ReelOnto | None = None,
                          trailing: str | JoinToMarker | None = None, with_contact: bool = True,
-                         start: InitialLayout | None = None, **parts) -> CableInConduit:
+                         start: InitialLayout | None = None, cable_element: str = "exudyn",
+                         **parts) -> CableInConduit:
     """Add a cable pulled through a conduit to the user's own Exudyn system, without assembling it.
 
     Adds the ANCF cable (paper Sect. 2.2) pre-tensioned in the conduit (:func:`initial_layout`),
@@ -427,6 +436,10 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         False: no conduit wall (a free cable, for tests).
     start : InitialLayout, optional
         A start state computed before (default: ``initial_layout(scenario, with_contact)``).
+    cable_element : {"exudyn", "compiled"}
+        Exudyn's ``ObjectANCFCable`` objects (default: the user's system gets Exudyn's elements), or,
+        for a steady-mode scenario with contact, exucable's compiled copy in the contact's user
+        function (what :func:`build_model` does with ``solver.cable_element``).
 
     Returns
     -------
@@ -470,8 +483,10 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
         bending_damping_N_m2_s=c.bending_damping_N_m2_s if internal_damping else 0.0,
         integration=c.integration,
     )
+    # steady mode may assemble the cable's elastic forces itself, in the contact's user function
+    compiled = sc.solver.mode == "steady" and cable_element == "compiled" and with_contact
     cable = add_cable(mbs, layout.coordinates, layout.element_length_m, props, layout.velocities,
-                      draw_radius_m=c.radius_m)
+                      draw_radius_m=c.radius_m, with_elements=not compiled)
     lead_node, trail_node = cable.nodes[-1], cable.nodes[0]
     h = CableInConduit(
         scenario=sc, mbs=mbs, conduit=conduit, cable=cable, layout=layout, start=start, properties=props,
@@ -489,7 +504,7 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
     ramp_time = sc.pull.ramp_time_s
     factor = None if (steady or ramp_time <= 0) else (lambda t: smooth_ramp(t, ramp_time))
     g = sc.gravity.g_m_per_s2 if sc.gravity is not None else 0.0
-    if g > 0:
+    if g > 0 and not compiled:
         gravity_vector = [0.0, 0.0, -g]
         loads = add_gravity(mbs, cable, gravity_vector, factor)
         h.load_scale.track(gravity_loads=loads, vectors={i: gravity_vector for i in loads})
@@ -549,7 +564,13 @@ def add_cable_in_conduit(mbs, scenario=None, *, leading: str | JoinToMarker | Re
                                start.mesh.check_points_per_element, rule=ct.check_point_rule,
                                reference_spacing_m=ct.reference_spacing_m, broad_phase=ct.broad_phase,
                                surface=ct.surface, centreline=centre, **extra)
-        h.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, h.kernel)
+        if compiled:
+            from ..contact.ancf_cable import AncfCableForces
+            h.cable_forces = AncfCableForces(layout.element_length_m, props.axial_stiffness_N,
+                                             props.bending_stiffness_N_m2, props.integration,
+                                             props.mass_per_length_kg_per_m, [0.0, 0.0, -g])
+            h.load_scale.cable_forces = h.cable_forces
+        h.coupling = ContactCoupling(mbs, cable.nodes, layout.coordinates, h.kernel, cable_forces=h.cable_forces)
         sp = sc.solver
         Le = layout.element_length_m
         lumped = c.mass_per_length_kg_per_m * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2  # [kg]
@@ -594,7 +615,8 @@ def build_model(scenario, with_contact: bool = True, refine: float = 1.0,
                                references=references)
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
-    h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start)
+    h = add_cable_in_conduit(mbs, scenario, with_contact=with_contact, start=start,
+                             cable_element=scenario.solver.cable_element)
     model = Model(**{f: getattr(h, f) for f in h.__dataclass_fields__}, system_container=SC)
     model.recorder.cable = model
     mbs.Assemble()

@@ -54,7 +54,8 @@ class CableProperties:
 
 @dataclass(frozen=True)
 class CableHandles:
-    """Exudyn indices of the cable: ``nodes[0]`` is the trailing end."""
+    """Exudyn indices of the cable: ``nodes[0]`` is the trailing end; ``elements`` is empty when
+    the cable's elastic forces are assembled by exucable (:func:`add_cable`'s ``with_elements``)."""
 
     nodes: tuple[int, ...]
     elements: tuple[int, ...]
@@ -62,11 +63,11 @@ class CableHandles:
 
     @property
     def n_elements(self) -> int:
-        return len(self.elements)
+        return len(self.element_length_m)
 
 
 def add_cable(mbs, coordinates, element_length_m, properties: CableProperties, velocities=None,
-              draw_radius_m: float = 0.0) -> CableHandles:
+              draw_radius_m: float = 0.0, with_elements: bool = True) -> CableHandles:
     """Add ANCF cable nodes and elements to ``mbs``.
 
     Parameters
@@ -82,6 +83,9 @@ def add_cable(mbs, coordinates, element_length_m, properties: CableProperties, v
         Initial coordinate rates [m/s, 1/s].
     draw_radius_m : float
         Radius for Exudyn's renderer only [m].
+    with_elements : bool
+        False: the nodes only, no ``ObjectANCFCable`` (a steady solve whose cable forces come from
+        :class:`exucable.contact.ancf_cable.AncfCableForces` in the contact's user function).
     """
     coords = np.asarray(coordinates, dtype=float)
     lengths = np.asarray(element_length_m, dtype=float)
@@ -107,7 +111,7 @@ def add_cable(mbs, coordinates, element_length_m, properties: CableProperties, v
         visualization={"show": True, "radius": draw_radius_m, "color": [-1.0, -1.0, -1.0, -1.0]},
     ))
     elements = tuple(mbs.AddObject(dict(element, nodeNumbers=[nodes[i], nodes[i + 1]], length=length))
-                     for i, length in enumerate(lengths.tolist()))
+                     for i, length in enumerate(lengths.tolist())) if with_elements else ()
     return CableHandles(nodes=nodes, elements=elements, element_length_m=lengths)
 
 

@@ -10,6 +10,11 @@ friction-normal-force coupling, is what lets Newton converge in a few iterations
 Exudyn passes coordinates *without* their reference values: absolute = reference + q.
 The start-up damper (:mod:`exucable.model.startup`) and the force-controlled pull's guide
 (:func:`exucable.model.rig.add_guide`) are objects of their own.
+
+A steady model with ``[solver] cable_element = "compiled"`` has no ``ObjectANCFCable`` objects: the
+same user functions then add the cable's elastic forces and weight
+(:class:`exucable.contact.ancf_cable.AncfCableForces`, ``cable_forces``) and their stiffness blocks,
+which share the contact blocks' sparsity (element blocks of 12 × 12), so one handover carries both.
 """
 
 from __future__ import annotations
@@ -22,6 +27,25 @@ import exudyn as exu
 from .generic import add_user_force_object
 
 __all__ = ["ContactCoupling"]
+
+
+def _chain_pattern(rows, cols, n_elements: int):
+    """The distinct (row, column) pairs of a chain's element blocks in row-major order, and the
+    index of each block entry among them: what ``np.unique(rows·n + cols, return_inverse=True)``
+    gives, without sorting 144 entries per element. Element e's 12 × 12 block spans nodes e and
+    e + 1 (coordinates 6e … 6e + 11), so the row of node k's coordinates holds the columns of
+    nodes max(k − 1, 0) … min(k + 1, n_nodes − 1), contiguous."""
+    n_nodes = n_elements + 1
+    node = np.arange(n_nodes)
+    first = np.maximum(node - 1, 0)                      # first column node of each row node
+    width = 6 * (np.minimum(node + 1, n_nodes - 1) - first + 1)
+    row_width = np.repeat(width, 6)                      # per row (6 per node)
+    row_start = np.concatenate([[0], np.cumsum(row_width)])
+    col_start = np.repeat(6 * first, 6)
+    inverse = row_start[rows] + (cols - col_start[rows])
+    unique_rows = np.repeat(np.arange(6 * n_nodes), row_width)
+    unique_cols = (np.arange(row_start[-1]) - np.repeat(row_start[:-1], row_width)) + np.repeat(col_start, row_width)
+    return unique_rows, unique_cols, inverse
 
 
 class ContactCoupling:
@@ -46,25 +70,33 @@ class ContactCoupling:
     jacobian_with_force : bool
         Compute the Jacobian blocks already in the force call (default; False: only when asked,
         two kernel passes per Newton iteration, for the benchmarks' comparison).
+    cable_forces : AncfCableForces or None
+        The cable's elastic forces and weight, added to the contact's (None: Exudyn's elements
+        carry them).
+    cable_time_s : float
+        Wall time spent in ``cable_forces`` [s].
     """
 
-    def __init__(self, mbs, nodes, reference_coordinates, kernel):
+    def __init__(self, mbs, nodes, reference_coordinates, kernel, cable_forces=None):
         from ..contact import block_sparsity
 
         self.kernel = kernel
+        self.cable_forces = cable_forces
+        self.cable_time_s = 0.0
+        if cable_forces is not None and cable_forces.n_elements != kernel.n_elements:
+            raise ValueError("kernel and cable forces disagree on the number of elements")
         self.q_ref = np.ascontiguousarray(np.asarray(reference_coordinates, dtype=float).reshape(-1))
         self.n = self.q_ref.size
         if self.n != kernel.n_coordinates:
             raise ValueError("kernel and cable disagree on the number of coordinates")
         rows, cols = block_sparsity(kernel.n_elements)
-        lin = rows.astype(np.int64) * self.n + cols
-        unique, self._inverse = np.unique(lin, return_inverse=True)
-        self._n_unique = unique.size
+        unique_rows, unique_cols, self._inverse = _chain_pattern(rows, cols, kernel.n_elements)
+        self._n_unique = unique_rows.size
         # the triplets (row, column, value) handed to Exudyn, rows and columns filled once; a row is
         # also one 24-byte record, so that dropping the zero values is one gather of records
         self._triplets = np.zeros((self._n_unique, 3))
-        self._triplets[:, 0] = unique // self.n
-        self._triplets[:, 1] = unique % self.n
+        self._triplets[:, 0] = unique_rows
+        self._triplets[:, 1] = unique_cols
         self._records = self._triplets.view(np.dtype((np.void, 24))).reshape(-1)
         self.kernel_time_s = 0.0
         self.user_time_s = 0.0
@@ -123,11 +155,20 @@ class ContactCoupling:
             return last[3]
         t0 = time.perf_counter()
         res = self.kernel.evaluate(q, q_t, jacobian=jacobian, held_onset=self.held_onset)
-        self.kernel_time_s += time.perf_counter() - t0
+        t1 = time.perf_counter()
+        self.kernel_time_s += t1 - t0
         self.kernel_evaluations += 1
+        elastic = None
+        if self.cable_forces is not None:
+            elastic = self.cable_forces.evaluate(q, jacobian=jacobian)
+            self.cable_time_s += time.perf_counter() - t1
         # copies: Exudyn may hand over views of vectors it later overwrites
-        self._last = (t, q.copy(), q_t.copy(), res)
+        self._last = (t, q.copy(), q_t.copy(), res, elastic)
         return res
+
+    def _elastic(self):
+        """The cable forces of the last pass (``(rhs, blocks)``; None without ``cable_forces``)."""
+        return self._last[4] if self._last is not None and len(self._last) > 4 else None
 
     def last_evaluation(self):
         """The last kernel pass (time, coordinates, rates, result), to :meth:`offer_evaluation`
@@ -149,8 +190,15 @@ class ContactCoupling:
         qa, va = self.absolute(q, q_t)
         res = self._evaluate(t, qa, va, jacobian=self.jacobian_with_force)
         self.force_calls += 1
+        elastic = self._elastic()
+        out = res.generalized_force
+        if elastic is not None:
+            out = out + elastic[0]
+            weight = self.cable_forces.weight()     # at the loads' scale now, never a cached one
+            if weight is not None:
+                out += weight
         self.user_time_s += time.perf_counter() - t0
-        return res.generalized_force
+        return out
 
     def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
         t0 = time.perf_counter()
@@ -158,7 +206,8 @@ class ContactCoupling:
         res = self._evaluate(t, qa, va, jacobian=True)
         self.jacobian_calls += 1
         m = exu.MatrixContainer()
-        trip = self.jacobian_triplets(res, f_q, f_v)
+        elastic = self._elastic()
+        trip = self.jacobian_triplets(res, f_q, f_v, None if elastic is None else elastic[1])
         if trip.shape[0]:
             m.SetWithSparseMatrix(trip, self.n, self.n, False)
         else:
@@ -166,7 +215,7 @@ class ContactCoupling:
         self.user_time_s += time.perf_counter() - t0
         return m
 
-    def jacobian_triplets(self, res, f_q: float, f_v: float) -> np.ndarray:
+    def jacobian_triplets(self, res, f_q: float, f_v: float, elastic_blocks=None) -> np.ndarray:
         """Sparse triplets (row, column, value) of the LHS derivative ``-(f_q ∂Q/∂q + f_v ∂Q/∂q̇)``
         of the kernel result ``res``, the element blocks summed where they share a node, zero
         values left out (Exudyn leaves an element's zero entries out of the system matrix too, so
@@ -175,7 +224,8 @@ class ContactCoupling:
         Without a velocity term (``f_v = 0``, or the steady kernel's zero q̇-blocks) the blocks
         are ``(-f_q) ∂Q/∂q``: the same values bit for bit as the general formula (a product's
         rounding does not depend on its sign; the only difference, a zero's sign, is dropped).
-        The array returned is reused by the next call.
+        ``elastic_blocks`` (n_el, 12, 12): the cable's stiffness ∂Q_e/∂q, a left-hand-side term,
+        added as ``f_q`` times it. The array returned is reused by the next call.
         """
         jq, jv = res.jac_q_blocks, res.jac_qt_blocks
         if f_v == 0.0 or jv is None or not jv.any():
@@ -183,6 +233,8 @@ class ContactCoupling:
         else:
             # LHS derivative: the contact force is on the right-hand side, hence the minus sign.
             blocks = -(f_q * jq + f_v * jv)
+        if elastic_blocks is not None:
+            blocks = blocks + f_q * elastic_blocks
         vals = np.bincount(self._inverse, weights=blocks.reshape(-1), minlength=self._n_unique)
         self._triplets[:, 2] = vals
         nz = vals != 0.0

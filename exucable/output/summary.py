@@ -41,6 +41,9 @@ class RunSummary(Mapping):
     mode: str = _key('"dynamic" (time integration) or "steady" (the static solve of steady sliding): the mode used',
                      _BOTH, default="dynamic")
     mode_rule: str | None = _key('the mode as given, or what solver.mode = "auto" chose and why')
+    cable_element: str | None = _key('who assembled the cable\'s elastic forces: "compiled" (exucable\'s copy of '
+                                     'the ANCF cable element, steady mode, solver.cable_element) or "exudyn" '
+                                     '(Exudyn\'s ObjectANCFCable)')
     status: str = _key('"ok", "steady", "failed" or the first trust flag (docs/results-format.md "Status")',
                        _BOTH, default="failed")
     message: str = _key("what the solver or the trust checks said; empty when there is nothing to say",

@@ -47,7 +47,7 @@ from exucable.errors import ModelError
 
 from .newton import armijo_step
 
-__all__ = ["ClearanceRopeSolution", "solve_rope_with_clearance", "default_node_spacing_m"]
+__all__ = ["ClearanceRopeSolution", "solve_rope_with_clearance", "default_node_spacing_m", "graded_node_grid_m"]
 
 _E_Z = np.array([0.0, 0.0, 1.0])
 # Wall penalty k = _PENALTY · T_ref / h: the wall is this much stiffer than the chain's own lateral
@@ -79,6 +79,16 @@ _COARSEN_REQUESTED_ABOVE = 800
 # is within a fifth of the 1e-4 relative floor of a steady run's error bar, the finest this reference
 # is compared at.
 _MAX_NODES = 20_000
+_SPACING_M = 0.02
+# On routes over 400 m (where the spacing may grow past 2 cm) the chain is graded: the bends' spacing on
+# the bends, growing by _GRADING per metre of distance from the nearest bend up to _FAR_SPACING_M.
+# Away from the bends a chain on a straight wall is exact at any spacing (the friction of a node
+# is μ w ℓ of its segments, as for the continuous rope); what needs nodes is where the cable
+# leaves and regains the wall, the free spans next to the bends (metres long at these tensions).
+# The effect on the pulling force is measured in tests/test_rope_clearance.py and at
+# benchmarks/long_routes.py --clearance-spacing.
+_GRADING = 0.05
+_FAR_SPACING_M = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,11 +174,45 @@ def default_node_spacing_m(centreline, clearance_m: float) -> float:
     A hundredth of the tightest bend radius (each node turns 0.01 rad; the discrete capstan's
     error is O((μ·0.01)³) per node) and at most 2 cm (free spans across 10 mm clearances are
     metres long), or on routes over 400 m at most a ``_MAX_NODES``-th of the route (20 000 nodes);
-    at least 400 nodes over the route. The measured effect of the cap is at ``_MAX_NODES``.
+    at least 400 nodes over the route. The measured effect of the cap is at ``_MAX_NODES``. On
+    routes over 400 m it is the spacing on the bends of the graded default chain
+    (:func:`graded_node_grid_m`).
     """
     L = centreline.length_m
-    h = min(0.01 * centreline.min_bend_radius_m, max(0.02, L / _MAX_NODES), L / 400.0)
+    h = min(0.01 * centreline.min_bend_radius_m, max(_SPACING_M, L / _MAX_NODES), L / 400.0)
     return float(h)
+
+
+def graded_node_grid_m(centreline, s_from_m: float, s_to_m: float, clearance_m: float,
+                       scale: float = 1.0) -> np.ndarray:
+    """Node arc lengths [m] of the default chain on ``[s_from_m, s_to_m]`` of ``centreline``.
+
+    The spacing is :func:`default_node_spacing_m` (times ``scale``, for the coarser chains of the
+    nested solve). On routes over 400 m (``_MAX_NODES`` × 2 cm), it holds on the curved pieces only and grows away from them by ``_GRADING`` per metre of distance to
+    the nearest one, up to ``_FAR_SPACING_M`` (times ``scale``); the nodes are where the integral
+    of 1/spacing passes whole numbers, so neighbouring segments differ by ≤ ``_GRADING``.
+    """
+    length = s_to_m - s_from_m
+    h_bend = scale * default_node_spacing_m(centreline, clearance_m)
+    n_uniform = max(int(np.ceil(length / h_bend)), 4)
+    curved = [(a, b) for a, b in centreline.curved_ranges_m() if b > s_from_m and a < s_to_m]
+    h_far = max(scale * _FAR_SPACING_M, h_bend)
+    if centreline.length_m <= _MAX_NODES * _SPACING_M or not curved or h_far <= h_bend:
+        return np.linspace(s_from_m, s_to_m, n_uniform + 1)
+    # the spacing on a sample grid fine enough to integrate it (half the bends' spacing); the distance
+    # to the nearest curved piece from the one before and the one after each sample (pieces in order)
+    x = np.linspace(s_from_m, s_to_m, int(np.ceil(2.0 * length / h_bend)) + 1)
+    starts, ends = np.array(curved).T
+    after = np.searchsorted(starts, x, side="right")        # the first curved piece starting past x
+    before_dist = np.where(after > 0, np.maximum(x - ends[np.maximum(after - 1, 0)], 0.0), np.inf)
+    after_dist = np.where(after < len(starts), starts[np.minimum(after, len(starts) - 1)] - x, np.inf)
+    h = np.minimum(h_bend + _GRADING * np.minimum(before_dist, after_dist), h_far)
+    inv = 1.0 / h
+    count = np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(x))])
+    n_seg = max(int(np.ceil(count[-1] - 1e-9)), 4)
+    grid = np.interp(np.linspace(0.0, count[-1], n_seg + 1), count, x)
+    grid[0], grid[-1] = s_from_m, s_to_m
+    return grid
 
 
 def _frames(tangents: np.ndarray) -> np.ndarray:
@@ -395,7 +439,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
                               weight_per_length_N_per_m: float = 0.0, trailing_tension_N: float = 0.0,
                               direction: str = "forward", cable_length_m: float | None = None,
                               node_spacing_m: float | None = None, rtol: float = 1e-10,
-                              _coarsen_above: int | None = None) -> ClearanceRopeSolution:
+                              _coarsen_above: int | None = None, _grid_scale: float = 1.0) -> ClearanceRopeSolution:
     """Steady pull of a perfectly flexible cable through a conduit with clearance (module docstring).
 
     Parameters
@@ -415,14 +459,17 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     cable_length_m : float, optional
         Length of conduit the cable occupies, from the leading end [m]; default the whole conduit.
     node_spacing_m : float, optional
-        Spacing of the chain's nodes along the conduit [m]; default :func:`default_node_spacing_m`.
-        The answer converges as the spacing squared.
+        Uniform spacing of the chain's nodes along the conduit [m]; default the chain of
+        :func:`graded_node_grid_m` (:func:`default_node_spacing_m` on routes of 400 m or less, graded
+        away from the bends on longer ones). The answer converges as the spacing squared.
     rtol : float
         Relative change of the tensions (and of the shape, in units of the clearance) at which the
         fixed point stops.
     _coarsen_above : int, optional
         Internal: a chain of more segments starts from the solution on a coarser chain (default
         ``_COARSEN_REQUESTED_ABOVE``; the coarser chains' own solves use ``_COARSEN_ABOVE``).
+    _grid_scale : float, optional
+        Internal: the default grid's spacings times this (the coarser chains of the nested solve).
 
     Returns
     -------
@@ -446,20 +493,36 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     length = L if cable_length_m is None else float(cable_length_m)
     if not (0 < length <= L * (1 + 1e-12)):
         raise ModelError("cable_length_m", f"must be in (0, {L:g}] m, got {cable_length_m!r}")
-    h = default_node_spacing_m(curve, c) if node_spacing_m is None else float(node_spacing_m)
-    if not np.isfinite(h) or h <= 0:
-        raise ModelError("node_spacing_m", f"must be > 0, got {node_spacing_m!r}")
-    n_seg = max(int(np.ceil(length / h)), 4)
-    s = np.linspace(max(L - length, 0.0), L, n_seg + 1)
+    if node_spacing_m is None:
+        s = graded_node_grid_m(curve, max(L - length, 0.0), L, c, scale=_grid_scale)
+    else:
+        h = float(node_spacing_m)
+        if not np.isfinite(h) or h <= 0:
+            raise ModelError("node_spacing_m", f"must be > 0, got {node_spacing_m!r}")
+        s = np.linspace(max(L - length, 0.0), L, max(int(np.ceil(length / h)), 4) + 1)
+    n_seg = len(s) - 1
     centre = np.asarray(curve.point(s), dtype=float)
     a = np.asarray(curve.tangent(s), dtype=float)
     frames = _frames(a)
-    hs = length / n_seg
+    seg = np.diff(s)
+    uniform = bool(np.ptp(seg) <= 1e-9 * seg[0])
+    if uniform:
+        # a uniform chain's spacing, weights and coarser chain exactly as they always were
+        hs = length / n_seg
+        seg = np.full(n_seg, hs)
+        weight_length = np.full(n_seg + 1, hs)
+    else:
+        hs = float(np.min(seg))       # the finest segment: it sets the wall's stiffness
+    share = np.zeros(n_seg + 1)       # the length of conduit each node stands for [m]
+    share[:-1] += 0.5 * seg
+    share[1:] += 0.5 * seg
+    if not uniform:
+        weight_length = share
 
     # start: capstan growth over the bends plus friction and lift of the weight (a rough upper guess)
     kappa = np.linalg.norm(np.asarray(curve.curvature_vector(s), dtype=float), axis=1)
     Tb = float(trailing_tension_N)
-    T_nodes = Tb * np.exp(mu * np.concatenate([[0.0], np.cumsum(0.5 * (kappa[1:] + kappa[:-1]) * hs)]))
+    T_nodes = Tb * np.exp(mu * np.concatenate([[0.0], np.cumsum(0.5 * (kappa[1:] + kappa[:-1]) * seg)]))
     T_nodes = T_nodes + w * (mu + 1.0) * (s - s[0])
     T = 0.5 * (T_nodes[1:] + T_nodes[:-1])
     T_ref = max(float(np.max(T)), w * length, 1e-9)
@@ -473,7 +536,7 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     d[pressed] *= (c * (1.0 + _ON_WALL) / size[pressed])[:, None]
     d[~pressed] = 0.0
     G = np.zeros((n_seg + 1, 3))
-    G[:, 2] = -w * hs
+    G[:, 2] = -w * weight_length
     newton = 0
     ramp = True
     if n_seg > (_COARSEN_REQUESTED_ABOVE if _coarsen_above is None else _coarsen_above):
@@ -481,8 +544,9 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
         # the tensions to within a few of these nodes, from where few Newton steps finish (a free span's
         # end moves about one node per step; on 1 km, 50 000 nodes, the fine chain needed ~110 steps).
         coarse = solve_rope_with_clearance(centreline, clearance_m, friction, weight_per_length_N_per_m,
-                                           trailing_tension_N, direction, cable_length_m, _COARSEN * hs, rtol,
-                                           _coarsen_above=_COARSEN_ABOVE)
+                                           trailing_tension_N, direction, cable_length_m,
+                                           _COARSEN * hs if uniform else None, rtol,
+                                           _coarsen_above=_COARSEN_ABOVE, _grid_scale=_COARSEN * _grid_scale)
         s_c = coarse.s_conduit_m if direction == "forward" else L - coarse.s_conduit_m
         order = np.argsort(s_c)
         off = np.stack([np.interp(s, s_c[order], coarse.offset_m[order, j]) for j in range(3)], axis=1)
@@ -516,8 +580,6 @@ def solve_rope_with_clearance(centreline, clearance_m: float, friction: float,
     offset = x - centre
     r = _row_norm(d)
     node_T = np.concatenate([[Tb], 0.5 * (T[1:] + T[:-1]), [pull]])
-    share = np.full(n_seg + 1, hs)
-    share[[0, -1]] = 0.5 * hs
     s_out = s if direction == "forward" else L - s
     return ClearanceRopeSolution(
         s_conduit_m=s_out, offset_m=offset, position_m=x, tension_N=node_T, contact_force_N=rho,

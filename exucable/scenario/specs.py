@@ -661,7 +661,9 @@ class SolverSpec(_Spec):
         Steady mode: cable laid out past the conduit's exit at the start [m] (None: the rule of
         :func:`exucable.model.layout.steady_lead_out_m`, 10 bending lengths past the last bend).
     steady_time_limit_s : float
-        Steady mode: CPU time one static solve may take before it stops as failed [s].
+        Steady mode: CPU time one static solve may take before it stops as failed [s].    cable_element : {"exudyn", "compiled"}
+        Steady mode: Exudyn's ``ObjectANCFCable`` or exucable's compiled copy of it
+        (:mod:`exucable.contact.ancf_cable`) assembles the cable's elastic forces.
     """
 
     _SECTION: ClassVar[str] = "solver"
@@ -685,6 +687,7 @@ class SolverSpec(_Spec):
     steady_residual: float = _default("solver.steady_residual")
     steady_time_limit_s: float = _default("solver.steady_time_limit")
     start_from: str = _default("solver.start_from")
+    cable_element: str = _default("solver.cable_element")
 
     @property
     def mode_rule(self) -> str:
