@@ -27,7 +27,11 @@ in a dynamic run U = S q̇, the nodal rates mapped to the point, and ∂Q/∂q̇
 
 Broad phase: the cables are meshed alike and laid side by side, so the check point at index p of
 one cable lies beside the points near index p of the others. Only the segments within ``window``
-indices of p are searched: cost n_pairs × n_points × (2·window + 1), linear in the route length.
+indices of p are searched, linear in the route length. The compiled search goes by blocks of
+G ≈ √(2·window) segments, each in a bounding ball: a block whose ball lies farther from P than a
+segment already found is skipped, so it finds the full scan's segment (the same one, ties included)
+in about 2√(2·window) tests instead of 2·window (at 69 check points per element, window 209:
+a pass 26 → 3.4 ms).
 A closest segment at the window's edge (not at a cable's end) is counted (``at_window_edge``), so
 that a run whose cables slid apart along the route by more than the window says so.
 
@@ -214,38 +218,90 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
 
 
 @njit(**_JIT)
+def _segment_distance2(X, j, px, py, pz):
+    """(t, squared distance) of P = (px, py, pz) to the segment [X[j], X[j + 1]] (t clamped to [0, 1])."""
+    ex_ = X[j + 1, 0] - X[j, 0]
+    ey_ = X[j + 1, 1] - X[j, 1]
+    ez_ = X[j + 1, 2] - X[j, 2]
+    ax = px - X[j, 0]
+    ay = py - X[j, 1]
+    az = pz - X[j, 2]
+    c = ex_ * ex_ + ey_ * ey_ + ez_ * ez_
+    t = 0.0
+    if c > 0.0:
+        t = min(1.0, max(0.0, (ax * ex_ + ay * ey_ + az * ez_) / c))
+    rx = ax - t * ex_
+    ry = ay - t * ey_
+    rz = az - t * ez_
+    return t, rx * rx + ry * ry + rz * rz
+
+
+@njit(**_JIT)
 def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps2, C, dd, jacobian,
                    index, tpar, pen, force, jac_x, jac_u, edge):
     """Compiled :func:`pair_contacts_reference`; fills the output arrays, returns the contact count."""
     m = 0
+    # the search's blocks: G consecutive segments of a polyline inside a bounding ball (centre,
+    # radius); a block whose ball is farther from P than a segment already found cannot hold the
+    # nearest one and is skipped, so the result is the full window scan's, at a fraction of its cost
+    G = max(4, int(np.sqrt(2.0 * window + 1.0)))
+    n_seg = n_points - 1
+    nb = max(1, (n_seg + G - 1) // G)
+    cen = np.zeros((n_cables, nb, 3))
+    rad = np.zeros((n_cables, nb))
+    for b in range(n_cables):
+        ob = b * n_points
+        for k in range(nb):
+            j0 = k * G
+            j1 = min(j0 + G, n_seg)
+            for v in range(j0, j1 + 1):
+                for l in range(3):
+                    cen[b, k, l] += X[ob + v, l]
+            for l in range(3):
+                cen[b, k, l] /= j1 - j0 + 1
+            r2 = 0.0
+            for v in range(j0, j1 + 1):
+                dx = X[ob + v, 0] - cen[b, k, 0]
+                dy = X[ob + v, 1] - cen[b, k, 1]
+                dz = X[ob + v, 2] - cen[b, k, 2]
+                r2 = max(r2, dx * dx + dy * dy + dz * dz)
+            rad[b, k] = np.sqrt(r2)
     for a in range(n_cables):
         for b in range(a + 1, n_cables):
             ob = b * n_points
+            previous = -1
             for p in range(n_points):
                 i = a * n_points + p
                 first = max(0, p - window)
                 last = min(n_points - 1, p + window)
+                if last <= first:
+                    continue
                 px, py, pz = X[i, 0], X[i, 1], X[i, 2]
+                # an upper bound on the nearest distance: the block of the last point's nearest
+                # segment (or of p's own index)
+                guess = previous if first <= previous < last else min(max(p, first), last - 1)
+                kg = guess // G
+                ub = np.inf
+                for j in range(max(first, kg * G), min(last, kg * G + G)):
+                    d2 = _segment_distance2(X, ob + j, px, py, pz)[1]
+                    if d2 < ub:
+                        ub = d2
+                reach = np.sqrt(ub) + 1e-9
                 best_j, best_t, best_d2 = -1, 0.0, np.inf
-                for j in range(first, last):
-                    ex_ = X[ob + j + 1, 0] - X[ob + j, 0]
-                    ey_ = X[ob + j + 1, 1] - X[ob + j, 1]
-                    ez_ = X[ob + j + 1, 2] - X[ob + j, 2]
-                    ax = px - X[ob + j, 0]
-                    ay = py - X[ob + j, 1]
-                    az = pz - X[ob + j, 2]
-                    c = ex_ * ex_ + ey_ * ey_ + ez_ * ez_
-                    t = 0.0
-                    if c > 0.0:
-                        t = min(1.0, max(0.0, (ax * ex_ + ay * ey_ + az * ez_) / c))
-                    rx = ax - t * ex_
-                    ry = ay - t * ey_
-                    rz = az - t * ez_
-                    d2 = rx * rx + ry * ry + rz * rz
-                    if d2 < best_d2:
-                        best_j, best_t, best_d2 = j, t, d2
+                for k in range(first // G, (last - 1) // G + 1):
+                    if k != kg:
+                        dx = px - cen[b, k, 0]
+                        dy = py - cen[b, k, 1]
+                        dz = pz - cen[b, k, 2]
+                        if np.sqrt(dx * dx + dy * dy + dz * dz) - rad[b, k] > reach:
+                            continue
+                    for j in range(max(first, k * G), min(last, k * G + G)):
+                        t, d2 = _segment_distance2(X, ob + j, px, py, pz)
+                        if d2 < best_d2:
+                            best_j, best_t, best_d2 = j, t, d2
                 if best_j < 0:
                     continue
+                previous = best_j
                 d = np.sqrt(best_d2)
                 delta = gap - d
                 if not delta > 0.0 or d <= 0.0:

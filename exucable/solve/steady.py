@@ -44,6 +44,15 @@ exact-step continuation above runs from the start.
 Where that does not converge either, the loads themselves are ramped (friction, gravity and end forces
 scaled by λ) with the increment halved on failure (:meth:`SteadySolver.ramp_loads`).
 
+Several cables (:mod:`exucable.model.bundle`) follow two more rules. A one-iteration step is held
+to the smallest residual reached, not the last (steps that each stayed within 2x of the one before
+drifted 496 -> 22 000 N). Where the loads' ramp stalls, the friction alone is ramped,
+gravity and the end forces kept, from the best state reached (:meth:`SteadySolver.restart_state`):
+with gravity and the end forces ramped to zero the cables float in the duct, their equilibrium is
+singular, and the ramp stalled at load scale 0 (one 90° bend at 4000 N back tension: with friction
+alone from the best state it converged at λ = 0.5). The loads' ramp from the start stays first:
+a keystone laid in a straight drops into a cradle that way, and not from the best state.
+
 A solve may instead start warm, from a state near its steady state (``warm_start``: the coarse mesh's
 solved state subdivided, :func:`exucable.solve.start.nested_start`). The phases above assume the rope
 start, far from equilibrium: their first pseudo-time steps are short (c0, an isotropic spring) because
@@ -410,8 +419,8 @@ class _FailedSteps:
         return f"{text}: {message}"
 
 
-def _set_scale(model, lam: float) -> None:
-    model.load_scale.apply(model.mbs, gravity=lam, end_force=lam)
+def _set_scale(model, lam: float, loads: bool = True) -> None:
+    model.load_scale.apply(model.mbs, gravity=lam if loads else 1.0, end_force=lam if loads else 1.0)
     model.kernel.set_friction_scale(lam)
     if model.coupling is not None:
         # a pass at the same coordinates was of the former friction scale
@@ -474,6 +483,10 @@ class SteadySolver:
         self._cpu_start = time.process_time()
         self.timed_out = False           # stopped at settings.time_limit_s
         self._trace_lam, self._trace = 0.0, []   # the load scale of the last accepted steps, their residuals [N]
+        #: several cables (exucable.model.bundle): the continuation's bundle rules apply (module notes)
+        self.bundle = getattr(model, "n_cables", 1) > 1
+        self.best = (np.inf, None)       # the smallest true residual [N] of an accepted step and its state
+        self.friction_only = False       # the load ramp scales the friction only (a bundle's first ramp)
 
     def out_of_time(self) -> bool:
         """Whether the solve has used up its CPU time (:attr:`SteadySettings.time_limit_s`)."""
@@ -541,8 +554,9 @@ class SteadySolver:
         return float(np.linalg.norm(r))
 
     def at_scale(self, lam: float) -> None:
-        """Loads and friction at scale ``lam`` [-]; the stored state's kernel pass was of another."""
-        _set_scale(self.model, lam)
+        """Loads and friction at scale ``lam`` [-] (a bundle's friction only, :meth:`ramp_loads`);
+        the stored state's kernel pass was of another."""
+        _set_scale(self.model, lam, loads=not self.friction_only)
         self.store.saved = self.store.saved[:2] + (None,)
 
     def relax_one_iteration(self, lam: float, skip: int = 0, max_steps: int | None = None) -> tuple[bool, str]:
@@ -568,7 +582,9 @@ class SteadySolver:
             stalled += 1
             ok, message, _ = self.pseudo_step(c, self.one_iteration_settings)
             residual = self.true_residual() if ok else np.inf
-            if residual > s.reject_growth * previous or not ok:
+            # a bundle's steps are held to the best residual, not the last: drifting up by 2x per
+            # step went 496 -> 22 000 N on the 100 m route
+            if residual > s.reject_growth * (min(previous, self.best[0]) if self.bundle else previous) or not ok:
                 c *= 4.0
                 after_reject = True
                 if c > 1e6 * self.c0:
@@ -578,6 +594,8 @@ class SteadySolver:
             self.record(lam, residual)
             if residual <= self.tolerance_N:
                 return True, ""
+            if residual < self.best[0]:
+                self.best = (residual, self.store.saved)
             if residual <= 0.5 * best:
                 best, stalled = residual, 0
             c /= s.rate_fall_after_reject if after_reject else s.rate_fall
@@ -636,11 +654,17 @@ class SteadySolver:
         return False, (f"no equilibrium at load scale {lam:.3g} after {s.max_pseudo_steps_total} pseudo-time "
                        f"steps (smallest residual {best:.3g} N, stop at {self.tolerance_N:.3g} N)")
 
-    def ramp_loads(self, first_message: str) -> tuple[str, str]:
+    def ramp_loads(self, first_message: str, friction_only: bool = False) -> tuple[str, str]:
         """Continuation in the load scale λ (friction, gravity, end forces) from the start, each
         stage solved by :meth:`relax`, the increment doubled after a success and halved after a
-        failure: status ("ok" or "failed") and message."""
-        self.store.saved = self.start
+        failure: status ("ok" or "failed") and message.
+
+        ``friction_only`` (a bundle's first ramp): the friction alone is ramped, gravity and the end
+        forces kept, from the best state reached (:meth:`restart_state`): without gravity and end
+        forces several cables in a duct float, their equilibrium is singular, and a ramp from
+        λ = 0 stalled there (one 90° bend at 4000 N back tension)."""
+        self.friction_only = friction_only
+        self.store.saved = self.restart_state() if friction_only else self.start
         lam, step, stages = 0.0, 0.5, 0
         if self.timed_out:
             return "failed", (f"no steady state found: stopped at `{TIME_LIMIT_KEY}` = {self.settings.time_limit_s:g} s "
@@ -697,6 +721,9 @@ class SteadySolver:
                        else f"{self.accepted} pseudo-time steps{warm_note}")
         else:
             status, message = self.ramp_loads(first_message)
+            if status != "ok" and self.bundle and not self.timed_out:
+                # the loads' ramp stalled: the friction's alone, from the best state reached
+                status, message = self.ramp_loads(first_message, friction_only=True)
         self.store.restore_as_initial()
         self.spring.rate = 0.0
         if status == "ok":
@@ -716,6 +743,14 @@ class SteadySolver:
         return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
                             steps=self.steps, newton_iterations=self.newton_iterations,
                             jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from)
+
+    def restart_state(self):
+        """The state the friction's ramp starts from: for a bundle the accepted state of smallest
+        true residual so far (a bundle's start is far from its equilibrium across the duct, and the
+        steps' progress from it is worth keeping), else the start."""
+        if self.bundle and self.best[1] is not None:
+            return self.best[1]
+        return self.start
 
     def relax_warm(self) -> tuple[bool, str]:
         """The one-iteration continuation at the full loads from :attr:`warm_start`, its first

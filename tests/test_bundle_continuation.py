@@ -1,0 +1,59 @@
+"""The steady continuation's rules for several cables (exucable/solve/steady.py, module notes).
+
+Where a bundle's loads' ramp stalls, its friction alone is ramped from the best state reached: with
+gravity and the end forces ramped to zero the cables float in the duct (their equilibrium is
+singular) and a ramp from λ = 0 stalled there. One cable keeps every rule it had (its whole load
+ramp, from the start). Coarse models: 8 elements of 0.5 m.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import exucable as xc
+from exucable.model.build import build_model
+from exucable.model.bundle import build_bundle_model
+from exucable.solve.steady import SteadySolver
+
+D_CABLE, MU = 0.03, 0.3
+
+
+def duct(count):
+    cable = dict(radius=D_CABLE / 2, density=2000.0, youngs_modulus=2e8, elements=8)
+    if count > 1:
+        cable.update(count=count, arrangement="triangular")
+    return xc.Scenario(route=xc.Route(inner_radius=3.3 * D_CABLE / 2).straight(4.0), cable=xc.Cable(**cable),
+                       contact=xc.Contact(friction=MU, check_points_per_element=8),
+                       pull=xc.Pull(speed=0.1, back_tension=30.0 * count), gravity=xc.Gravity(g=9.81),
+                       solver=xc.Solver(mode="steady", end_time=1.0, steady_lead_out=0.0))
+
+
+def test_a_bundles_load_ramp_scales_its_friction_only():
+    model = build_bundle_model(duct(3))
+    solver = SteadySolver(model)
+    solver.friction_only = True          # as ramp_loads(..., friction_only=True) sets it
+    solver.at_scale(0.25)
+    assert model.load_scale.gravity == 1.0 and model.load_scale.end_force == 1.0
+    assert all(k.law.friction == pytest.approx(0.25 * MU, rel=1e-15) for k in model.walls)
+    weight = model.mbs.GetLoadParameter(model.load_scale._gravity_loads[0][0], "loadVector")
+    assert weight[2] == pytest.approx(-9.81, rel=1e-15)
+
+
+def test_one_cables_load_ramp_scales_every_load():
+    model = build_model(duct(1))
+    solver = SteadySolver(model)
+    solver.at_scale(0.25)
+    assert model.load_scale.gravity == 0.25 and model.load_scale.end_force == 0.25
+    assert model.kernel.law.friction == pytest.approx(0.25 * MU, rel=1e-15)
+
+
+def test_a_bundle_restarts_from_its_best_state_one_cable_from_the_start():
+    bundle = SteadySolver(build_bundle_model(duct(3)))
+    assert bundle.restart_state() is bundle.start          # nothing accepted yet
+    best = (np.zeros(3), np.zeros(1), None)
+    bundle.best = (1.0, best)
+    assert bundle.restart_state() is best
+    one = SteadySolver(build_model(duct(1)))
+    one.best = (1.0, best)
+    assert one.restart_state() is one.start
