@@ -50,15 +50,14 @@ def _warm_up() -> None:
 
 def _tiny_bundle():
     """Three cables in a 2 m straight duct, steady: the smallest run that calls the cable-cable kernel."""
-    from .. import api as xc
+    from ..api import Cable, Contact, Gravity, Pull, Route, Scenario, Solver
 
-    route = xc.Route(inner_radius=0.05).straight(2.0)
-    return xc.Scenario(route=route,
-                       cable=xc.Cable(radius=0.015, density=2000.0, youngs_modulus=2e8, count=3,
-                                      arrangement="triangular"),
-                       contact=xc.Contact(friction=0.3, check_points_per_element=8),
-                       pull=xc.Pull(speed=0.1, back_tension=100.0), gravity=xc.Gravity(g=9.81),
-                       solver=xc.Solver(mode="steady", steady_lead_out=0.0))
+    route = Route(inner_radius=0.05).straight(2.0)
+    return Scenario(route=route,
+                    cable=Cable(radius=0.015, density=2000.0, youngs_modulus=2e8, count=3, arrangement="triangular"),
+                    contact=Contact(friction=0.3, check_points_per_element=8),
+                    pull=Pull(speed=0.1, back_tension=100.0), gravity=Gravity(g=9.81),
+                    solver=Solver(mode="steady", steady_lead_out=0.0))
 
 
 def main(args) -> int:
