@@ -288,9 +288,9 @@ def plot(rows, path) -> None:
         ax.legend(fontsize=7)
     axes[0].axhline(0.0, color="k", lw=0.5)
     fig.tight_layout()
-    tmp = Path(str(path) + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(path)
+    from exucable.io import save_figure
+
+    save_figure(fig, path, dpi=110)     # atomic: a reader never sees half a PNG
 
 
 def main(argv=None) -> int:

@@ -21,12 +21,12 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 
 import exucable as xc
 from exucable.errors import ExucableError
+from exucable.io import save_figure
 from exucable.model.bundle import build_bundle_model, bundle_report
 from exucable.quasistatic import engineering as eng
 from exucable.quasistatic.bundle_bend import bundle_bend_split
@@ -114,10 +114,7 @@ def figure(rows, path):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7)
     fig.tight_layout()
-    path = Path(path)
-    tmp = Path(str(path) + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(path)
+    save_figure(fig, path, dpi=110)     # atomic: a reader never sees half a PNG
 
 
 def main(argv=None) -> int:

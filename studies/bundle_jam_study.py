@@ -55,7 +55,7 @@ import numpy as np
 
 import exucable as xc
 from exucable.errors import ExucableError
-from exucable.io import atomic_write_text
+from exucable.io import atomic_write_text, save_figure
 import exucable.model.bundle as bundle_model
 from exucable.model.bundle import build_bundle_model, bundle_report, bundle_sections
 from exucable.quasistatic.bundle_jam import (frictionless_keystone_psi_rad, keystone, keystone_friction_needed,
@@ -351,10 +351,7 @@ def figure(record, path):
         ax.legend(fontsize=6, loc="upper left" if ax is axes[1] else "best")
     axes[0].axhline(1.0, color="k", lw=0.5)
     fig.tight_layout()
-    path = Path(path)
-    tmp = Path(str(path) + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(path)
+    save_figure(fig, path, dpi=110)     # atomic: a reader never sees half a PNG
 
 
 def print_record(record) -> None:

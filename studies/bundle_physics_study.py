@@ -44,6 +44,7 @@ from scipy.integrate import solve_ivp
 
 import exucable as xc
 from exucable.errors import ExucableError
+from exucable.io import save_figure
 from exucable.model.bundle import build_bundle_model, bundle_report, bundle_sections
 from exucable.quasistatic import engineering as eng
 from exucable.solve.steady import solve_steady
@@ -262,10 +263,7 @@ def figure(frows, vrows, path):
                                                       f"{r['status']}" for r in failed),
                 transform=ax.transAxes, fontsize=7, va="center")
     fig.tight_layout()
-    path = Path(path)
-    tmp = Path(str(path) + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(path)
+    save_figure(fig, path, dpi=110)     # atomic: a reader never sees half a PNG
 
 
 def main(argv=None) -> int:

@@ -39,7 +39,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from exucable.io import atomic_write_text  # noqa: E402
+from exucable.io import atomic_write_text, save_figure  # noqa: E402
 
 # the stiff cable of the tight-clearance case: r 29.5 mm, E 5 GPa (EJ 2974 N m²), 1.5 kg/m, 30 m straights
 # either side of a 30° bend of R 10 m, μ 0.2, 500 N back tension, gravity
@@ -181,10 +181,7 @@ def figure(record, path):
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     fig.tight_layout()
-    path = Path(path)
-    tmp = Path(str(path) + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(path)
+    save_figure(fig, path, dpi=110)     # atomic: a reader never sees half a PNG
 
 
 def main(argv=None) -> int:
