@@ -152,3 +152,36 @@ def test_blocked_search_equals_the_numpy_scan_on_a_long_bent_bundle(window):
     np.testing.assert_array_equal(b["edge"], a["edge"])
     np.testing.assert_allclose(b["force"], a["force"], rtol=0, atol=1e-11 * np.abs(a["force"]).max())
     np.testing.assert_allclose(b["jac_x"], a["jac_x"], rtol=0, atol=1e-11 * np.abs(a["jac_x"]).max())
+
+
+@pytest.mark.parametrize("seed", [0, 4])
+def test_compiled_assembly_equals_the_sparse_products_with_rates(seed):
+    """A dynamic evaluation (the points' velocities from nodal rates): the compiled assembly of
+    Sᵀ J S into node blocks gives the numpy path's sparse products, ∂Q/∂q and ∂Q/∂q̇, to round-off."""
+    rng = np.random.default_rng(seed)
+    q = bundle_q(rng)
+    q_t = 0.1 * rng.normal(size=q.size)
+    law = ContactLaw(stiffness=1e6, damping=50.0, exponent=1.5, friction=0.3, regularisation_velocity_m_per_s=1e-3,
+                     damping_onset_m=2e-5)
+    a = kernel("numpy", law=law).evaluate(q, q_t=q_t)
+    b = kernel("numba", law=law).evaluate(q, q_t=q_t)
+    assert a.n_in_contact == b.n_in_contact > 0
+    np.testing.assert_allclose(b.generalized_force, a.generalized_force, rtol=0,
+                               atol=1e-11 * np.abs(a.generalized_force).max())
+    for x, y in ((a.jacobian, b.jacobian), (a.jacobian_t, b.jacobian_t)):
+        assert abs(x - y).max() <= 1e-11 * abs(x).max()
+
+
+@pytest.mark.parametrize("window", [None, 400])
+def test_compiled_assembly_on_a_long_bent_bundle(window):
+    """The node-block assembly on the long trefoil bent into an arc, with the default window and one
+    spanning the whole cable (the blocks' node offsets widest): the numpy path's Jacobian, to round-off."""
+    n_el, Le, bend_R = 40, 0.02, 0.3
+    q = bundle_q(np.random.default_rng(11), n_el=n_el, Le=Le, wobble=2e-4).reshape(-1, 6)
+    x, y = q[:, 0].copy(), q[:, 1].copy()
+    q[:, 0], q[:, 1] = (bend_R + y) * np.sin(x / bend_R), bend_R - (bend_R + y) * np.cos(x / bend_R)
+    q = q.reshape(-1)
+    a = kernel("numpy", n_el=n_el, Le=Le, n_k=12, window=window).evaluate(q)
+    b = kernel("numba", n_el=n_el, Le=Le, n_k=12, window=window).evaluate(q)
+    assert a.n_in_contact > 100
+    assert abs(a.jacobian - b.jacobian).max() <= 1e-11 * abs(a.jacobian).max()

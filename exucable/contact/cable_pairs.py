@@ -38,7 +38,12 @@ that a run whose cables slid apart along the route by more than the window says 
 Jacobians are exact for the chosen segment and clamping (the force is piecewise smooth): with
 x = (P, B0, B1), ∂d/∂x = Aᵀn, A = [I, -(1 - t) I, -t I], and ∂²d/∂x² = Aᵀ(I - nnᵀ)R/d + [0; n; -n]
 ∂t/∂x, R = ∂r/∂x, r = P - C. :func:`pair_contacts_reference` is the numpy definition;
-:func:`_pair_contacts` the compiled loop (tested equal, ``tests/test_cable_pairs.py``).
+:func:`_pair_contacts` the compiled loop (tested equal, ``tests/test_cable_pairs.py``), its Jacobian
+entry by entry into scratch arrays (the reference's ~57 small arrays per contact, allocated in a
+compiled loop, were two thirds of a pass). On the cables' coordinates the Jacobian is Sᵀ J S (S the
+Hermite map from coordinates to check points): the numpy path multiplies sparse matrices, the compiled
+one sums each contact's blocks into 6 × 6 node blocks (:func:`_add_blocks`), a third of the pair
+coupling's time before (the 100 m route with three cables: 40 of 100 ms per Newton iteration).
 """
 
 from __future__ import annotations
@@ -266,6 +271,10 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 dz = X[ob + v, 2] - cen[b, k, 2]
                 r2 = max(r2, dx * dx + dy * dy + dz * dz)
             rad[b, k] = np.sqrt(r2)
+    dr, dn, dvt, dFf = np.empty((3, 9)), np.empty((3, 9)), np.empty((3, 9)), np.empty((3, 9))
+    df, dfu, M, MPn = np.empty(9), np.empty(9), np.empty((3, 3)), np.empty((3, 3))
+    e, av, n, v, vt, Ff = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    dt, g, u = np.empty(9), np.empty(9), np.empty(9)
     for a in range(n_cables):
         for b in range(a + 1, n_cables):
             ob = b * n_points
@@ -308,36 +317,29 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                     continue
                 j = best_j
                 t = best_t
-                e = X[ob + j + 1] - X[ob + j]
-                c = e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
-                av = X[i] - X[ob + j]
-                r = av - t * e
-                n = r / d
-                A = np.zeros((3, 9))
                 for k in range(3):
-                    A[k, k] = 1.0
-                    A[k, 3 + k] = -(1.0 - t)
-                    A[k, 6 + k] = -t
-                dt = np.zeros(9)
+                    e[k] = X[ob + j + 1, k] - X[ob + j, k]
+                    av[k] = X[i, k] - X[ob + j, k]
+                    n[k] = (av[k] - t * e[k]) / d
+                c = e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
+                for k in range(9):
+                    dt[k] = 0.0
                 if 0.0 < t < 1.0:
                     for k in range(3):
                         q = (av[k] - 2.0 * t * e[k]) / c
                         dt[k] = e[k] / c
                         dt[3 + k] = -e[k] / c - q
                         dt[6 + k] = q
-                g = np.zeros(9)
                 for k in range(3):
                     g[k] = n[k]
                     g[3 + k] = -(1.0 - t) * n[k]
                     g[6 + k] = -t * n[k]
                 w = weight[p]
                 f = w * K * delta ** ex
-                u = np.empty(9)
                 for k in range(3):
                     u[k] = U[i, k]
                     u[3 + k] = U[ob + j, k]
                     u[6 + k] = U[ob + j + 1, k]
-                v = np.zeros(3)
                 for k in range(3):
                     v[k] = u[k] - (1.0 - t) * u[3 + k] - t * u[6 + k]
                 vn = n[0] * v[0] + n[1] * v[1] + n[2] * v[2]
@@ -348,9 +350,11 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                     f = f + w * C * on * (-vn)
                     if not f > 0.0:
                         continue
-                vt = v - vn * n
+                for k in range(3):
+                    vt[k] = v[k] - vn * n[k]
                 h = 1.0 / np.sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2] + eps2)
-                Ff = -mu * f * h * vt
+                for k in range(3):
+                    Ff[k] = -mu * f * h * vt[k]
                 for k in range(9):
                     force[m, k] = f * g[k]
                 for k in range(3):
@@ -364,40 +368,143 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 pen[m] = delta
                 edge[m] = (j == first and first > 0) or (j == last - 1 and last < n_points - 1)
                 if jacobian:
-                    # ∂r/∂x = [I, -I, 0] - t [0, -I, I] - e ⊗ ∂t/∂x
-                    dr = np.zeros((3, 9))
+                    # the formulas of pair_contacts_reference entry by entry into scratch arrays
+                    # allocated once per call (a 3 × 9 or 9 × 9 product per line there)
+                    a0, a1, a2 = 1.0, -(1.0 - t), -t
+                    # ∂r/∂x = [I, -(1 - t) I, -t I] - e ⊗ ∂t/∂x and ∂n/∂x = (I - n nᵀ) ∂r/∂x / d
+                    for l in range(9):
+                        for k in range(3):
+                            dr[k, l] = -e[k] * dt[l]
                     for k in range(3):
-                        dr[k, k] = 1.0
-                        dr[k, 3 + k] = -1.0 + t
-                        dr[k, 6 + k] = -t
-                        for l in range(9):
-                            dr[k, l] -= e[k] * dt[l]
-                    Pn = np.eye(3) - np.outer(n, n)
-                    dn = (Pn @ dr) / d
+                        dr[k, k] += a0
+                        dr[k, 3 + k] += a1
+                        dr[k, 6 + k] += a2
+                    for l in range(9):
+                        s_n = n[0] * dr[0, l] + n[1] * dr[1, l] + n[2] * dr[2, l]
+                        for k in range(3):
+                            dn[k, l] = (dr[k, l] - n[k] * s_n) / d
                     coef = -w * K * ex * delta ** (ex - 1.0)
-                    df = coef * g
-                    dfu = np.zeros(9)
+                    ud0, ud1, ud2 = u[3] - u[6], u[4] - u[7], u[5] - u[8]      # U0 - U1
+                    for l in range(9):
+                        df[l] = coef * g[l]
+                        dfu[l] = 0.0
                     if C > 0.0:
-                        drate = -(v @ dn + n @ np.outer(u[3:6] - u[6:9], dt))
-                        df = df + w * C * (-don * (-vn) * g + on * drate)
-                        dfu = -w * C * on * g
-                    swap = np.zeros(9)
+                        n_ud = n[0] * ud0 + n[1] * ud1 + n[2] * ud2
+                        for l in range(9):
+                            drate = -(v[0] * dn[0, l] + v[1] * dn[1, l] + v[2] * dn[2, l] + n_ud * dt[l])
+                            df[l] += w * C * (-don * (-vn) * g[l] + on * drate)
+                            dfu[l] = -w * C * on * g[l]
+                    # M = ∂(h v_τ)/∂v_τ; ∂v_τ/∂x = (I - n nᵀ)(U0 - U1) ⊗ ∂t/∂x - (n vᵀ + (n·v) I) ∂n/∂x
                     for k in range(3):
-                        swap[3 + k] = n[k]
-                        swap[6 + k] = -n[k]
-                    H = A.T @ dn + np.outer(swap, dt)
-                    M = h * np.eye(3) - h * h * h * np.outer(vt, vt)
-                    dv_dx = np.outer(u[3:6] - u[6:9], dt)
-                    dvt_dx = Pn @ dv_dx - (np.outer(n, v) + vn * np.eye(3)) @ dn
-                    dFf_dx = -mu * np.outer(h * vt, df) - mu * f * (M @ dvt_dx)
-                    fswap = np.zeros(9)
+                        for j in range(3):
+                            M[k, j] = -h * h * h * vt[k] * vt[j]
+                        M[k, k] += h
+                    n_ud = n[0] * ud0 + n[1] * ud1 + n[2] * ud2
+                    pud0, pud1, pud2 = ud0 - n[0] * n_ud, ud1 - n[1] * n_ud, ud2 - n[2] * n_ud
+                    for l in range(9):
+                        s_v = v[0] * dn[0, l] + v[1] * dn[1, l] + v[2] * dn[2, l]
+                        dvt[0, l] = pud0 * dt[l] - n[0] * s_v - vn * dn[0, l]
+                        dvt[1, l] = pud1 * dt[l] - n[1] * s_v - vn * dn[1, l]
+                        dvt[2, l] = pud2 * dt[l] - n[2] * s_v - vn * dn[2, l]
+                    # ∂F_f/∂x = -μ (h v_τ) ⊗ ∂f/∂x - μ f M ∂v_τ/∂x
+                    for l in range(9):
+                        for k in range(3):
+                            dFf[k, l] = -mu * (h * vt[k]) * df[l] - mu * f * (
+                                M[k, 0] * dvt[0, l] + M[k, 1] * dvt[1, l] + M[k, 2] * dvt[2, l])
+                    # M (I - n nᵀ), for ∂Q/∂u
                     for k in range(3):
-                        fswap[3 + k] = Ff[k]
-                        fswap[6 + k] = -Ff[k]
-                    jac_x[m] = np.outer(g, df) + f * H + A.T @ dFf_dx + np.outer(fswap, dt)
-                    jac_u[m] = np.outer(g, dfu) + A.T @ (-mu * np.outer(h * vt, dfu) - mu * f * (M @ (Pn @ A)))
+                        Mn = M[k, 0] * n[0] + M[k, 1] * n[1] + M[k, 2] * n[2]
+                        for j in range(3):
+                            MPn[k, j] = M[k, j] - Mn * n[j]
+                    # jac_x = g ⊗ ∂f/∂x + f (Aᵀ ∂n/∂x + [0; n; -n] ⊗ ∂t/∂x) + Aᵀ ∂F_f/∂x + [0; F_f; -F_f] ⊗ ∂t/∂x
+                    # jac_u = g ⊗ ∂f/∂u + Aᵀ (-μ (h v_τ) ⊗ ∂f/∂u - μ f M (I - n nᵀ) A)
+                    for blk in range(3):
+                        ab = a0 if blk == 0 else (a1 if blk == 1 else a2)
+                        for k in range(3):
+                            r_ = 3 * blk + k
+                            sw = 0.0 if blk == 0 else (n[k] if blk == 1 else -n[k])
+                            fs = 0.0 if blk == 0 else (Ff[k] if blk == 1 else -Ff[k])
+                            for l in range(9):
+                                jac_x[m, r_, l] = (g[r_] * df[l] + f * (ab * dn[k, l] + sw * dt[l])
+                                                   + ab * dFf[k, l] + fs * dt[l])
+                            for blk2 in range(3):
+                                ac = a0 if blk2 == 0 else (a1 if blk2 == 1 else a2)
+                                for j in range(3):
+                                    l = 3 * blk2 + j
+                                    jac_u[m, r_, l] = g[r_] * dfu[l] + ab * (-mu * (h * vt[k]) * dfu[l]
+                                                                            - mu * f * (MPn[k, j] * ac))
                 m += 1
     return m
+
+
+@njit(**_JIT)
+def _add_blocks(index, jac, m, n_points, n_k, n_nodes, row_coef, col_coef, scale, W, acc, used):
+    """Adds Sᵀ J S of the contacts' 9 × 9 blocks ``jac[:m]`` to the node blocks ``acc``.
+
+    A point p of a cable lies on element e = p // n_k; its position is Σ_a coef[p, a] times slot a
+    of that element's coordinates (a = 0, 2: the nodes' positions, 1, 3: their slopes), so the
+    contact's block of points (α, β) adds coef_row[p_α, a] coef_col[p_β, b] ``scale`` times it to
+    the 3 × 3 part of the 6 × 6 block of the nodes (of slots a and b). Node blocks are stored as
+    ``acc[row node, column cable, column node - row node's index + W]`` (node indices within each
+    cable), ``used`` marks them.
+    """
+    for c in range(m):
+        for al in range(3):
+            ga = index[c, al]
+            cab_a = ga // n_points
+            pa = ga - cab_a * n_points
+            ea = pa // n_k
+            for a in range(4):
+                ca = row_coef[pa, a]
+                if ca == 0.0:
+                    continue
+                na = ea + a // 2
+                rs = 3 * (a % 2)
+                rnode = cab_a * n_nodes + na
+                for be in range(3):
+                    gb = index[c, be]
+                    cab_b = gb // n_points
+                    pb = gb - cab_b * n_points
+                    eb = pb // n_k
+                    for b in range(4):
+                        cb = col_coef[pb, b]
+                        if cb == 0.0:
+                            continue
+                        off = eb + b // 2 - na + W
+                        if off < 0 or off > 2 * W:
+                            raise ValueError("cable-cable contact beyond the Jacobian's node window")
+                        cs = 3 * (b % 2)
+                        f = ca * cb * scale
+                        used[rnode, cab_b, off] = True
+                        for i in range(3):
+                            for j in range(3):
+                                acc[rnode, cab_b, off, rs + i, cs + j] += f * jac[c, 3 * al + i, 3 * be + j]
+
+
+@njit(**_JIT)
+def _emit_blocks(acc, used, n_nodes, W, rows, cols, vals):
+    """The used node blocks of ``acc`` (:func:`_add_blocks`) as triplets (their zeros left out),
+    zeroing them for the next pass; returns the count."""
+    k = 0
+    n_rows, n_cab, n_off = used.shape
+    for rn in range(n_rows):
+        local = rn % n_nodes
+        for cb in range(n_cab):
+            for off in range(n_off):
+                if not used[rn, cb, off]:
+                    continue
+                used[rn, cb, off] = False
+                cn = cb * n_nodes + local + off - W
+                for i in range(6):
+                    for j in range(6):
+                        x = acc[rn, cb, off, i, j]
+                        if x != 0.0:
+                            rows[k] = 6 * rn + i
+                            cols[k] = 6 * cn + j
+                            vals[k] = x
+                            k += 1
+                        acc[rn, cb, off, i, j] = 0.0
+    return k
 
 
 class CableContactKernel:
@@ -463,6 +570,13 @@ class CableContactKernel:
                         cols.append(6 * node + (3 if slope else 0) + i)
                         vals.append(N[k, a] * scale)
                         dvals.append(dN[k, a] * scale / Le)
+        # the same maps per point and slot (n_points, 4), for the compiled assembly (_add_blocks)
+        slot = np.where(np.arange(4) % 2 == 1, 1.0, 0.0)[None, :]
+        Le_p = np.repeat(self.element_length_m, self.n_k)[:, None]
+        scale_p = 1.0 + slot * (Le_p - 1.0)
+        self._coef = np.ascontiguousarray(np.tile(N, (self.n_el, 1)) * scale_p)
+        self._coef_d = np.ascontiguousarray(np.tile(dN, (self.n_el, 1)) * scale_p / Le_p)
+        self._acc = None
         one = sparse.csr_matrix((vals, (rows, cols)), shape=(3 * self.n_points, self.n_coordinates_per_cable))
         done = sparse.csr_matrix((dvals, (rows, cols)), shape=one.shape)
         self.S = sparse.block_diag([one] * self.n_cables, format="csr")
@@ -485,9 +599,10 @@ class CableContactKernel:
             return (self.S @ q).reshape(-1, 3), (self.S @ np.asarray(q_t, dtype=float).reshape(-1)).reshape(-1, 3)
         return (self.S @ q).reshape(-1, 3), (self.speed_m_per_s * (self.dS @ q)).reshape(-1, 3)
 
-    def contacts(self, q, jacobian: bool = False, q_t=None) -> dict:
+    def contacts(self, q, jacobian: bool = False, q_t=None, copy: bool = True) -> dict:
         """Every contact at absolute coordinates ``q`` (see :func:`pair_contacts_reference`), the
-        points' velocities from the rates ``q_t`` when given (:meth:`points`)."""
+        points' velocities from the rates ``q_t`` when given (:meth:`points`). ``copy=False``:
+        the compiled backend's arrays are views of its buffers, overwritten by the next call."""
         X, U = self.points(q, q_t)
         law = self.law
         if self.backend == "numpy":
@@ -499,11 +614,32 @@ class CableContactKernel:
                            float(law.regularisation_velocity_m_per_s) ** 2, float(law.damping),
                            float(law.damping_onset_m), bool(jacobian),
                            index, t, pen, force, jx, ju, edge)
-        out = {"index": index[:m].copy(), "t": t[:m].copy(), "penetration_m": pen[:m].copy(),
-               "force": force[:m].copy(), "edge": edge[:m].copy()}
-        out["jac_x"] = jx[:m].copy() if jacobian else np.zeros((0, 9, 9))
-        out["jac_u"] = ju[:m].copy() if jacobian else np.zeros((0, 9, 9))
+        keep = (lambda a: a[:m].copy()) if copy else (lambda a: a[:m])
+        out = {"index": keep(index), "t": keep(t), "penetration_m": keep(pen), "force": keep(force), "edge": keep(edge)}
+        out["jac_x"] = keep(jx) if jacobian else np.zeros((0, 9, 9))
+        out["jac_u"] = keep(ju) if jacobian else np.zeros((0, 9, 9))
         return out
+
+    def _assemble(self, parts, index):
+        """Σ scale · Sᵀ J C over ``parts`` (J (m, 9, 9), the column map C's per-point coefficients
+        ``_coef`` for S or ``_coef_d`` for S' (steady sliding's velocity), scale) as a CSR matrix on
+        all cables' coordinates (:func:`_add_blocks`)."""
+        from scipy import sparse
+
+        n_nodes = self.n_el + 1
+        W = (self.window + 1) // self.n_k + 3      # node offsets a contact's blocks can span
+        if self._acc is None:
+            self._acc = (np.zeros((self.n_cables * n_nodes, self.n_cables, 2 * W + 1, 6, 6)),
+                         np.zeros((self.n_cables * n_nodes, self.n_cables, 2 * W + 1), dtype=np.bool_))
+        acc, used = self._acc
+        m = len(index)
+        for jac, col, scale in parts:
+            _add_blocks(index, jac, m, self.n_points, self.n_k, n_nodes, self._coef, col, float(scale), W, acc, used)
+        size = 36 * int(np.count_nonzero(used))
+        rows, cols, vals = np.empty(size, dtype=np.int64), np.empty(size, dtype=np.int64), np.empty(size)
+        k = _emit_blocks(acc, used, n_nodes, W, rows, cols, vals)
+        n = self.n_coordinates
+        return sparse.csr_matrix((vals[:k], (rows[:k], cols[:k])), shape=(n, n))
 
     def point_forces_N(self, q, q_t=None) -> tuple[np.ndarray, np.ndarray]:
         """Each cable's contact load from the other cables, check point by check point.
@@ -536,13 +672,20 @@ class CableContactKernel:
         as ∂Q/∂q and ∂Q/∂q̇ (``jacobian_t``)."""
         from scipy import sparse
 
-        c = self.contacts(q, jacobian, q_t)
+        c = self.contacts(q, jacobian, q_t, copy=False)
         n3 = 3 * self.n_points * self.n_cables
         dof = (3 * c["index"][:, :, None] + np.arange(3)[None, None, :]).reshape(-1, 9)   # (m, 9)
         f_pts = np.bincount(dof.reshape(-1), weights=c["force"].reshape(-1), minlength=n3)
         Q = self.St @ f_pts
         J = J_t = None
-        if jacobian:
+        if jacobian and self.backend == "numba":
+            # Sᵀ J S summed into node blocks in one compiled pass (the same sums as the sparse
+            # products below, in another order: round-off only)
+            J = self._assemble([(c["jac_x"], self._coef, 1.0)] + (
+                [(c["jac_u"], self._coef_d, self.speed_m_per_s)] if q_t is None else []), c["index"])
+            if q_t is not None:
+                J_t = self._assemble([(c["jac_u"], self._coef, 1.0)], c["index"])
+        elif jacobian:
             r = np.broadcast_to(dof[:, :, None], (len(dof), 9, 9)).reshape(-1)
             k = np.broadcast_to(dof[:, None, :], (len(dof), 9, 9)).reshape(-1)
             Jx = sparse.csr_matrix((c["jac_x"].reshape(-1), (r, k)), shape=(n3, n3))
