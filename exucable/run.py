@@ -518,6 +518,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         newton_iterations=out.newton_iterations,
         wall_time_s=out.wall_time_s,
         build_time_s=build_s,
+        cable_element="compiled" if getattr(model.wall_couplings[0], "cable_forces", None) is not None else "exudyn",
         mesh=model.mesh.to_dict() if model.mesh is not None else None,
         warnings=(list(model.mesh.warnings) if model.mesh is not None else []) + _jam_band_warning(sc, model),
         scenario=sc.to_dict(),

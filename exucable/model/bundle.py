@@ -267,6 +267,24 @@ class BundleLayout:
         return np.concatenate([c.coordinates for c in self.cables], axis=0)
 
 
+class _GravityScales:
+    """The cables' compiled elastic forces (:class:`~exucable.contact.ancf_cable.AncfCableForces`)
+    as the one whose weight :class:`~exucable.model.build.LoadScale` scales: setting
+    ``gravity_scale`` sets every cable's."""
+
+    def __init__(self):
+        self.parts = []
+
+    @property
+    def gravity_scale(self) -> float:
+        return self.parts[0].gravity_scale if self.parts else 1.0
+
+    @gravity_scale.setter
+    def gravity_scale(self, value: float) -> None:
+        for p in self.parts:
+            p.gravity_scale = value
+
+
 class _Walls:
     """The cables' wall kernels and their cable-cable kernel as one, for the steady solve."""
 
@@ -414,7 +432,7 @@ class BundleModel:
 
     def __repr__(self) -> str:
         return (f"BundleModel({self.scenario.name!r}: {len(self.cables)} cables {self.arrangement}, "
-                f"{len(self.cables[0].elements)} elements each)")
+                f"{self.cables[0].n_elements} elements each)")
 
     @property
     def n_cables(self) -> int:
@@ -631,10 +649,13 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
 
     SC = exu.SystemContainer()
     mbs = SC.AddSystem()
+    # no Kelvin-Voigt damping, as for one steady cable (exucable.model.build): it acts on the nodal
+    # rates, which a static solve never updates, so Exudyn's element added the start's sliding rates'
+    # damping force to the equilibrium (pull shares 7e-6 to 1.5e-5 off on coarse cases)
     props = CableProperties(
         mass_per_length_kg_per_m=c.mass_per_length_kg_per_m, axial_stiffness_N=c.axial_stiffness_N,
-        bending_stiffness_N_m2=c.bending_stiffness_N_m2, axial_damping_N_s=c.axial_damping_N_s,
-        bending_damping_N_m2_s=c.bending_damping_N_m2_s, integration=c.integration)
+        bending_stiffness_N_m2=c.bending_stiffness_N_m2, axial_damping_N_s=0.0,
+        bending_damping_N_m2_s=0.0, integration=c.integration)
     t_exit = np.asarray(centre.tangent(centre.length_m), dtype=float)
     t_entry = np.asarray(centre.tangent(centre.length_m - L_cable + lead_out), dtype=float)
     load_scale = LoadScale()
@@ -642,11 +663,23 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
     wall_law = ContactLaw(stiffness=ct.stiffness, damping=ct.damping, exponent=ct.exponent, friction=ct.friction,
                           regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s,
                           damping_onset_m=ct.damping_onset_m)
+    # the cables' elastic forces and weight assembled by exucable in each wall coupling's user
+    # function (solver.cable_element, as for one cable), or by Exudyn's ANCF elements and loads
+    compiled = sc.solver.cable_element == "compiled"
+    if compiled:
+        from ..contact.ancf_cable import AncfCableForces
+        load_scale.cable_forces = _GravityScales()
     cables, walls, couplings, drives = [], [], [], []
     for lay in layouts:
-        cable = add_cable(mbs, lay.coordinates, Le, props, lay.velocities, draw_radius_m=c.radius_m)
+        cable = add_cable(mbs, lay.coordinates, Le, props, lay.velocities, draw_radius_m=c.radius_m,
+                          with_elements=not compiled)
         cables.append(cable)
-        if g > 0:
+        forces = None
+        if compiled:
+            forces = AncfCableForces(Le, props.axial_stiffness_N, props.bending_stiffness_N_m2, props.integration,
+                                     props.mass_per_length_kg_per_m, [0.0, 0.0, -g])
+            load_scale.cable_forces.parts.append(forces)
+        elif g > 0:
             vec = [0.0, 0.0, -g]
             loads = add_gravity(mbs, cable, vec)
             load_scale.track(gravity_loads=loads, vectors={i: vec for i in loads})
@@ -660,7 +693,7 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
                                      broad_phase=ct.broad_phase, surface=ct.surface, centreline=centre,
                                      speed_m_per_s=sc.pull.speed_m_per_s)
         walls.append(kernel)
-        couplings.append(ContactCoupling(mbs, cable.nodes, lay.coordinates, kernel))
+        couplings.append(ContactCoupling(mbs, cable.nodes, lay.coordinates, kernel, cable_forces=forces))
     between_law = ContactLaw(stiffness=ct.stiffness, damping=0.0, exponent=ct.exponent, friction=ct.cable_friction,
                              regularisation_velocity_m_per_s=ct.friction_regularisation_velocity_m_per_s)
     # the broad phase's window: one element either side, plus how far apart the cables' nodes of

@@ -343,14 +343,14 @@ FIELDS: tuple[Field, ...] = (
            "reaches after pulling that far: `exucable validate` sets it to the dynamic run's "
            "`reference_pulled_out_m` to compare both modes in the same state)", le=1.0e4, why="keeps the run's size finite"),
     F("solver.cable_element", "cable_element", "choice", "", "compiled", choices=("compiled", "exudyn"), ours=True,
-      rule="steady mode, one cable: who assembles the ANCF cable's elastic forces and their Jacobian: `\"compiled\"`, "
+      rule="steady mode (one cable or several): who assembles the ANCF cables' elastic forces and their Jacobian: `\"compiled\"`, "
            "exucable's compiled copy of Exudyn's `ObjectANCFCable` (`exucable/contact/ancf_cable.py`, equal to "
            "Exudyn's element to 1e-14) inside the contact's user function, with the weight as its consistent nodal "
            "load; `\"exudyn\"`, Exudyn's `ObjectANCFCable` objects, whose Jacobian Exudyn takes by automatic "
            "differentiation over positions and velocities. Exudyn keeps the nodes, end loads, rig, static solver and "
            "factorisation either way. The same pulling force to round-off (≤ 4e-13 on the shipped scenarios), one "
            "Newton iteration at 0.6-0.8 the CPU time (docs/decisions/0004-compiled-cable-element.md); the summary's "
-           "`cable_element` says which ran. Dynamic mode, several cables and `add_cable_in_conduit` into your own "
+           "`cable_element` says which ran. Dynamic mode and `add_cable_in_conduit` into your own "
            "system use Exudyn's element"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
