@@ -21,6 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # script -> a line fragment of the table header it prints (how a reader finds the table)
 SCRIPTS = {
     "benchmarks/bundle_route.py": "ratio bundle / one cable",
+    "benchmarks/bundle_iteration.py": "| tree | cable element |",
     "benchmarks/bundle_start.py": "CPU clearance / axis",
     "benchmarks/cable_element.py": "| part (CPU per call, median) | exudyn [ms] | compiled [ms]",
     "benchmarks/contact_kernel.py": "ms/eval",
@@ -53,6 +54,7 @@ SCRIPTS = {
     "benchmarks/pull_in_history.py": "CPU per point [s]",
     "studies/bundle_bend_study.py": "p/formula",
     "studies/bundle_jam_study.py": "F/formula",
+    "studies/bundle_settle_start.py": "| start | dynamic pull CPU [s] |",
     "studies/bundle_physics_study.py": "| place | arrangement | D/d | μ_c |",
     "studies/checkpoint_study.py": "| case | rule's count | factor | per element |",
     "studies/wall_compliance_study.py": "| case | c [mm] | K [N/m^1.5] | δ/c [-]",
@@ -64,7 +66,9 @@ SLOW = {"benchmarks/naive_baseline.py", "benchmarks/run_examples.py", "benchmark
         "benchmarks/sweep_throughput.py",
         "benchmarks/industry_suite.py", "studies/industry_dynamic.py", "benchmarks/bundle_start.py",
         # minutes even in their smoke runs: two cables through four bends; multibody steady runs both ways
-        "benchmarks/bundle_route.py", "studies/fit_engines.py"}
+        "benchmarks/bundle_route.py", "studies/fit_engines.py",
+        # three processes each building a bundle and solving it for 2 s; a dynamic bundle and two steady solves
+        "benchmarks/bundle_iteration.py", "studies/bundle_settle_start.py"}
 
 
 def test_every_script_is_smoke_tested():

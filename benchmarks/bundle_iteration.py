@@ -1,0 +1,168 @@
+"""What one Newton iteration of a steady bundle costs, and where it goes.
+
+    nice .venv/bin/python benchmarks/bundle_iteration.py [--count 3] [--settle 20] [--repeat 7]
+        [--before TREE] [--quick]
+
+The three cables of ``benchmarks/bundle_route.py``'s 100 m route (four bends, the scenario's mesh
+rule) are solved steady for ``--settle`` s of CPU from their start, to a state representative of
+the solve (the cables resting on one another along the whole route: the start has fewer contacts).
+That state is saved, and at it, in a fresh process per tree (interleaved, ``--repeat`` times each):
+
+- the cable-cable coupling's pass: the pair kernel with its Jacobian, assembled on the cables'
+  coordinates (:meth:`~exucable.contact.cable_pairs.CableContactKernel.evaluate`), CPU [ms];
+- the wall kernels' passes (one per cable) [ms];
+- one Newton iteration of the steady solve (a one-iteration pseudo-time step from that state,
+  :meth:`~exucable.solve.steady.SteadySolver.pseudo_step`: Exudyn's residual, Jacobian, LU and the
+  user functions, with the residual at the new state) [ms], and its true residual after [N]
+  (round-off apart, the same in both trees when the model's equations are).
+
+``--before TREE`` also measures with the exucable package of the source tree TREE (``git archive
+<commit> | tar -x -C TREE``; copy ``exucable/contact/__pycache__`` into it with the sources' time
+stamps, ``touch -r``, or its kernels compile in its first run). Medians of CPU times measured in
+one run on a shared machine: compare the rows with each other.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+
+def _scenario(count: int, length_m: float):
+    import bundle_route
+    from exucable.scenario.specs import parse_scenario
+
+    bends_m = 3 * 0.5 * np.pi * 5.0 + np.pi / 6 * 5.0
+    straight = max(1.0, (length_m - bends_m) / 5.0)
+    text = bundle_route.SCENARIO.format(count=count, arrangement="triangular", straight=f"{straight:.6g}")
+    return parse_scenario(tomllib.loads(text), ROOT, default_name=f"bundle_iteration_{count}")
+
+
+def settle(count: int, length_m: float, settle_s: float, path: str) -> None:
+    """Solve for ``settle_s`` of CPU from the start and save the state reached (the best one)."""
+    from exucable.model.bundle import build_bundle_model
+    from exucable.solve.steady import SteadySettings, SteadySolver
+
+    model = build_bundle_model(_scenario(count, length_m))
+    solver = SteadySolver(model, SteadySettings(time_limit_s=settle_s))
+    out = solver.solve()
+    state = solver.best[1] if solver.best[1] is not None else solver.store.saved
+    np.savez(path, ode2=state[0], ae=state[1])
+    print(f"settled: {out.newton_iterations} Newton iterations, status {out.status}, best residual "
+          f"{solver.best[0]:.3g} N", flush=True)
+
+
+def measure(count: int, length_m: float, path: str, repeat: int, settle_s: float, element: str | None) -> dict:
+    """The figures of the module's notes, in this process: the passes at the saved state, then a
+    steady solve from the start for ``settle_s`` of CPU (Newton iterations, CPU per iteration)."""
+    from exucable.model.bundle import build_bundle_model
+    from exucable.solve.steady import SteadySettings, SteadySolver
+
+    sc = _scenario(count, length_m)
+    if element is not None:
+        sc = sc.replace(**{"solver.cable_element": element})
+    model = build_bundle_model(sc)
+    saved = np.load(path)
+    q = model.layout.coordinates.reshape(-1) + np.asarray(saved["ode2"], dtype=float)[model.ode2_index]
+    n = model.walls[0].n_coordinates
+
+    def cpu(fn):
+        fn()                                # warm (first call of a kernel, buffers)
+        times = []
+        for _ in range(repeat):
+            t0 = time.process_time()
+            fn()
+            times.append(time.process_time() - t0)
+        return 1e3 * statistics.median(times)
+
+    res = model.between.evaluate(q, jacobian=True)
+    pair_ms = cpu(lambda: model.between.evaluate(q, jacobian=True))
+    zeros = np.zeros(n)
+    wall_ms = cpu(lambda: [k.evaluate(q[i * n:(i + 1) * n], zeros, jacobian=True) for i, k in enumerate(model.walls)])
+    solver = SteadySolver(model, SteadySettings(time_limit_s=settle_s))
+    t0 = time.process_time()
+    out = solver.solve()
+    solve_s = time.process_time() - t0
+    return {"contacts": res.n_in_contact, "pair_ms": pair_ms, "wall_ms": wall_ms, "solve_s": solve_s,
+            "newton": out.newton_iterations, "newton_ms": 1e3 * solve_s / max(1, out.newton_iterations),
+            "best_N": float(solver.best[0]), "status": out.status, "elements": int(model.mesh.elements),
+            "check_points": int(model.mesh.check_points_per_element),
+            "element": "compiled" if getattr(model.wall_couplings[0], "cable_forces", None) is not None else "exudyn"}
+
+
+def _child(tree: str | None, element: str | None, args, path: str) -> dict:
+    env = dict(os.environ)
+    if tree:
+        env["PYTHONPATH"] = str(Path(tree).resolve())
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    cmd = [sys.executable, __file__, "--child", path, "--count", str(args.count), "--length", str(args.length),
+           "--repeat", str(args.repeat), "--settle", str(args.settle)] + (["--element", element] if element else [])
+    out = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=tempfile.gettempdir())
+    if out.returncode:
+        raise RuntimeError(out.stderr[-2000:])
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--count", type=int, default=3)
+    p.add_argument("--length", type=float, default=100.0, help="route length [m] (approximately)")
+    p.add_argument("--settle", type=float, default=20.0, help="CPU seconds of the steady solve to the state timed")
+    p.add_argument("--repeat", type=int, default=7)
+    p.add_argument("--runs", type=int, default=2, help="fresh processes per tree, interleaved")
+    p.add_argument("--before", metavar="TREE")
+    p.add_argument("--quick", action="store_true", help="two cables, 12 m, 2 s of settling (a smoke run)")
+    p.add_argument("--child", metavar="STATE", help=argparse.SUPPRESS)
+    p.add_argument("--element", help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    if args.child:
+        print(json.dumps(measure(args.count, args.length, args.child, args.repeat, args.settle, args.element)))
+        return 0
+    if args.quick:
+        args.count, args.length, args.settle, args.repeat, args.runs = 2, 12.0, 2.0, 2, 1
+    with tempfile.TemporaryDirectory() as tmp:
+        path = str(Path(tmp) / "state.npz")
+        settle(args.count, args.length, args.settle, path)
+        trees = {"before": (args.before, None)} if args.before else {}
+        trees.update({"this, exudyn element": (None, "exudyn"), "this": (None, None)})
+        rows = {k: [] for k in trees}
+        for _ in range(args.runs):
+            for label, (tree, element) in trees.items():
+                rows[label].append(_child(tree, element, args, path))
+    first = next(iter(rows.values()))[0]
+    print(f"# steady bundle: {args.count} cables, {args.length:g} m route, {first['elements']} elements each, "
+          f"{first['check_points']} check points per element; the passes at the state the solve reached after "
+          f"{args.settle:g} s CPU ({first['contacts']} cable-cable contacts), CPU medians of {args.repeat} [ms]; then "
+          f"the solve from the start for {args.settle:g} s CPU; one row per process; load {os.getloadavg()[0]:.1f}")
+    print("| tree | cable element | cable-cable pass (kernel + Jacobian) [ms] | wall passes [ms] | solve CPU [s] | "
+          "Newton iterations | CPU per iteration [ms] | smallest residual [N] |")
+    print("|---|---|---|---|---|---|---|---|")
+    for label, runs in rows.items():
+        for r in runs:
+            print(f"| {label} | {r['element']} | {r['pair_ms']:.1f} | {r['wall_ms']:.1f} | {r['solve_s']:.1f} | "
+                  f"{r['newton']} | {r['newton_ms']:.1f} | {r['best_N']:.4g} |")
+    med = {k: {f: statistics.median(r[f] for r in v) for f in ("pair_ms", "wall_ms", "newton_ms")}
+           for k, v in rows.items()}
+    base = "before" if args.before else "this, exudyn element"
+    for label in rows:
+        if label != base:
+            print(f"{label} / {base}: " + ", ".join(f"{f} {med[label][f] / med[base][f]:.2f}"
+                                                   for f in ("pair_ms", "wall_ms", "newton_ms")))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
