@@ -1,0 +1,122 @@
+"""Our own static Newton loop (``solver.static_solver = "exucable"``) against Exudyn's static solver.
+
+The reference is Exudyn's ``MainSolverStatic`` on the same model: the same equations, Newton and
+stop test (``exucable/solve/newton_system.py``'s notes), another linear solver (LAPACK's banded LU
+with the rig's coordinates eliminated, against Eigen's SparseLU of the saddle-point system with
+the multipliers). So the iterates agree to the round-off of two factorisations, not bit for bit.
+Coarse models (the paper's fast examples, one industry route), a few seconds each.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from exucable.data import data_path
+from exucable.model.build import build_model
+from exucable.run import run_scenario
+from exucable.scenario.specs import load_scenario
+from exucable.solve.newton_system import (ExudynStatic, OwnStaticNewton, own_newton_unsupported)
+from exucable.solve.steady import SteadySolver, static_settings
+
+
+def _scenario(path, **changes):
+    sc = load_scenario(data_path("scenarios", *path.split("/")))
+    return sc.replace(**{"solver.mode": "steady", **changes})
+
+
+def _iterates(sc, backend: str, steps: int = 3):
+    """Three pseudo-time steps of one Newton iteration each from the rope start (the spring
+    anchored at the last state, its rate falling by 8 per step, as the continuation does): per
+    step the converged flag, Newton's residual [N], the true residual [N], the absolute cable
+    coordinates, the step's displacement and the rig's multipliers."""
+    model = build_model(sc)
+    solver = SteadySolver(model)
+    if backend == "exudyn":
+        solver.static = ExudynStatic(model.mbs, static_settings)
+    assert type(solver.static).__name__ == {"exudyn": "ExudynStatic", "exucable": "OwnStaticNewton"}[backend]
+    out = []
+    rate = solver.c0
+    for _ in range(steps):
+        before = np.array(solver.store.saved[0])
+        ok, _, residual = solver.pseudo_step(rate, solver.one_iteration_settings)
+        sd = model.mbs.systemData
+        q = np.array(sd.GetODE2Coordinates())
+        out.append((ok, residual, solver.true_residual(), model.layout.coordinates.reshape(-1) + q[model.ode2_index],
+                    q - before, np.array(sd.GetAECoordinates())))
+        solver.store.save()
+        rate /= 8.0
+    return out
+
+
+@pytest.mark.parametrize("path", ["fast/paper_ex2_bend90.toml", "fast/paper_ex1_incline.toml"])
+def test_one_iteration_is_exudyns(path):
+    """From the same state, each one-iteration pseudo-time step reaches Exudyn's state: absolute
+    coordinates within 1e-12 relative (measured ≤ 1e-16), the step itself within 1e-9 of its
+    size (measured ≤ 1.3e-12 on Example 2, ≤ 1e-10 on Example 1, whose state is at equilibrium
+    after the first step: the two LU factorisations' round-off, amplified by the stiff contact's
+    condition number), the rig's multipliers and both residual norms within 1e-9
+    (of the rig's force where the residual is at its round-off floor)."""
+    sc = _scenario(path)
+    a, b = _iterates(sc, "exudyn"), _iterates(sc, "exucable")
+    for (ok_a, r_a, t_a, q_a, d_a, l_a), (ok_b, r_b, t_b, q_b, d_b, l_b) in zip(a, b):
+        assert ok_a and ok_b
+        assert np.linalg.norm(q_b - q_a) <= 1e-12 * np.linalg.norm(q_a)
+        assert np.linalg.norm(d_b - d_a) <= 1e-9 * np.linalg.norm(d_a)
+        assert np.linalg.norm(l_b - l_a) <= 1e-9 * np.linalg.norm(l_a)
+        # a residual at the round-off floor (Example 1's steps end at 6e-9 N) is round-off itself:
+        # compared against the rig's force instead
+        scale = np.linalg.norm(l_a)
+        assert abs(r_b - r_a) <= 1e-9 * max(r_a, scale) and abs(t_b - t_a) <= 1e-9 * max(t_a, scale)
+
+
+def test_banded_and_sparse_lu_take_the_same_step():
+    """LAPACK's banded LU and SuperLU solve the same eliminated system: the same Newton step to
+    1e-10 of its size (measured ~1e-13)."""
+    sc = _scenario("fast/paper_ex2_bend90.toml")
+    steps = {}
+    for linear in ("banded", "splu"):
+        model = build_model(sc)
+        solver = SteadySolver(model)
+        solver.static = OwnStaticNewton(model, solver.spring, linear_solver=linear)
+        solver.pseudo_step(solver.c0, solver.one_iteration_settings)
+        steps[linear] = np.array(model.mbs.systemData.GetODE2Coordinates()) - solver.store.saved[0]
+    assert np.linalg.norm(steps["splu"] - steps["banded"]) <= 1e-10 * np.linalg.norm(steps["banded"])
+
+
+@pytest.mark.parametrize("path", ["fast/paper_ex1_incline.toml", "fast/paper_ex2_bend90.toml",
+                                  "industry/commscope_conquest_run_a_h.toml"])
+def test_whole_steady_runs_equal_exudyns(path):
+    """Whole steady runs (continuation, nested start, error bar): the pulling force within 1e-9
+    relative of Exudyn's static solver's (measured 5e-13, 3e-15, 2e-14) with the same Newton
+    count; the summary says which solver ran."""
+    sc = _scenario(path)
+    a = run_scenario(sc.replace(**{"solver.static_solver": "exudyn"}), None, plots=False).summary
+    b = run_scenario(sc, None, plots=False).summary
+    assert a["status"] == b["status"] == "ok"
+    assert (a["static_solver"], b["static_solver"]) == ("exudyn", "exucable")
+    assert abs(b["pull_force_N"] / a["pull_force_N"] - 1) < 1e-9
+    assert b["newton_iterations"] == a["newton_iterations"]
+
+
+def test_models_ours_cannot_solve_keep_exudyns_solver():
+    """Exudyn's cable element and a force-controlled pull (the sheave) are not our system's: the
+    steady solve uses Exudyn's static solver and says why."""
+    exu_element = build_model(_scenario("fast/paper_ex2_bend90.toml", **{"solver.cable_element": "exudyn"}))
+    assert "exudyn" in own_newton_unsupported(exu_element)
+    assert isinstance(SteadySolver(exu_element).static, ExudynStatic)
+    force = build_model(_scenario("fast/paper_ex3_helix.toml"))
+    assert "sheave" in own_newton_unsupported(force)
+    solver = SteadySolver(force)
+    assert isinstance(solver.static, ExudynStatic) and "sheave" in solver.static_note
+    assert own_newton_unsupported(build_model(_scenario("fast/paper_ex2_bend90.toml"))) == ""
+    with pytest.raises(ValueError, match="cannot solve this model"):
+        OwnStaticNewton(exu_element, SteadySolver(exu_element).spring)
+
+
+def test_the_scenario_key_is_checked():
+    from exucable.errors import ExucableError
+
+    with pytest.raises(ExucableError, match="solver.static_solver"):
+        _scenario("fast/paper_ex2_bend90.toml", **{"solver.static_solver": "eigen"})
+    assert _scenario("fast/paper_ex2_bend90.toml").solver.static_solver == "exucable"
