@@ -209,6 +209,18 @@ class ContactCoupling:
         elastic = self._elastic()
         return self._lhs_values(res, 1.0, 0.0, None if elastic is None else elastic[1])
 
+    def stiffness_blocks(self, q, t: float = 0.0) -> np.ndarray:
+        """The left-hand-side derivative ``-∂Q/∂q`` at ``q`` (at rest) per element, (n_el, 12, 12):
+        element e's block over the coordinates of nodes e and e + 1 (the values
+        :meth:`stiffness_values` sums where two elements share a node). Reuses the kernel pass of
+        :meth:`force` at the same ``q`` and ``t``."""
+        qa, va = self.absolute(q, np.zeros(self.n))
+        res = self._evaluate(t, qa, va, jacobian=True)
+        self.jacobian_calls += 1
+        elastic = self._elastic()
+        # (-1)·∂Q/∂q + the cable's stiffness: the same sum as jacobian_triplets' blocks at f_q = 1
+        return -res.jac_q_blocks if elastic is None else elastic[1] - res.jac_q_blocks
+
     def _force(self, mbs, t, item, q, q_t):
         t0 = time.perf_counter()
         qa, va = self.absolute(q, q_t)

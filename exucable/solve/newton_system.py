@@ -224,12 +224,35 @@ class OwnStaticNewton(StaticBackend):
         for i in range(sd.NumberOfLoads()):
             node = self.mbs.GetMarker(self.mbs.GetLoad(i)["markerNumber"])["nodeNumber"]
             self._loads.append((i, where[self.mbs.GetNodeODE2Index(node) + np.arange(3)]))
-        kl = ku = HALF_BANDWIDTH
-        self._kl = kl
-        # dgbsv's band storage: row kl + ku + i - j holds entry (i, j); kl rows on top for the fill-in
-        self._band_flat = ((kl + ku + rows - indices) * n + indices).astype(np.int64)
-        self._band = np.zeros((2 * kl + ku + 1, n))
         self._rows = rows
+        # dgbsv's band storage, Fortran order (LAPACK's own: no copy on the call): entry (i, j) at
+        # row kl + ku + i - j of column j, so at memory position 34 j + 22 + i - j; the top kl rows
+        # take the LU's fill-in
+        kl = HALF_BANDWIDTH
+        self._kl, self._ld = kl, 3 * kl + 1
+        self._band = np.zeros((self._ld, n), order="F")
+        memory = self._band.T.reshape(-1)                       # a view of the same memory
+        assert np.shares_memory(memory, self._band)
+        top, stride = 2 * kl, memory.strides[0]
+        # element e's 12 × 12 block (a, b) sits at 204 e + 22 + a + 33 b: a strided view, one per
+        # parity (consecutive elements share a node, every second one does not)
+        n_el = (n // 6) - 1
+        self._element_view = np.lib.stride_tricks.as_strided(
+            memory[top:], shape=(n_el, 12, 12), strides=(6 * self._ld * stride, stride, (self._ld - 1) * stride))
+        # the spring's 3 × 3 blocks of node k, positions (c = 0) and slopes (c = 1): 204 k + 102 c + 22 + i + 33 j
+        self._spring_view = np.lib.stride_tricks.as_strided(
+            memory[top:], shape=(spring.n_nodes, 2, 3, 3),
+            strides=(6 * self._ld * stride, 3 * self._ld * stride, stride, (self._ld - 1) * stride))
+        self._memory = memory
+        # the held coordinates' rows and columns in the band (entries beyond the matrix's edge dropped)
+        off = np.arange(-kl, kl + 1)
+        self._held_row, self._held_col = [], []
+        for h in self.held:
+            j = h + off
+            j = j[(j >= 0) & (j < n)]
+            self._held_row.append((j, j * self._ld + top + h - j))     # (columns, positions) of row h
+            self._held_col.append((j, h * self._ld + top + j - h))     # (rows, positions) of column h
+        self._held_diagonal_band = self.held * self._ld + top
         self._residual = np.zeros(n)
         self.time_parts_s = {"forces": 0.0, "assembly": 0.0, "factorisation": 0.0, "glue": 0.0}
 
@@ -248,63 +271,83 @@ class OwnStaticNewton(StaticBackend):
         self.time_parts_s["forces"] += time.process_time() - t0
         return r
 
-    def _stiffness(self, q) -> np.ndarray:
-        """The LHS stiffness -∂f/∂q as the pattern's values (a fresh array)."""
+    def _newton_step(self, q, r, dq_held):
+        """Solve the bordered system [[-K, E], [Eᵀ, 0]] [Δq; Δλ] = [r; C] at ``q`` with the held
+        coordinates eliminated: K_ff Δq_f = -(r_f + K_fh Δq_h), Δq_h = C, Δλ = r_h + K_h· Δq
+        (K = -∂f/∂q, the left-hand-side stiffness). Returns (Δq, Δλ); raises
+        numpy.linalg.LinAlgError for a singular matrix."""
+        if self.linear_solver == "banded":
+            return self._banded_step(q, r, dq_held)
+        return self._sparse_step(q, r, dq_held)
+
+    def _banded_step(self, q, r, dq_held):
+        t0 = time.process_time()
+        blocks = self.coupling.stiffness_blocks(q, self.time_s)
+        spring = self.spring.block_values().reshape(self.spring.n_nodes, 2, 3, 3)
+        t1 = time.process_time()
+        band, view = self._band, self._element_view
+        band.fill(0.0)
+        view[0::2] = blocks[0::2]
+        view[1::2] += blocks[1::2]
+        self._spring_view[...] += spring
+        memory = self._memory
+        rhs = -r
+        rows_k = []
+        for (cols, row_pos), (rows, col_pos), dqh in zip(self._held_row, self._held_col, dq_held):
+            rows_k.append((cols, memory[row_pos].copy()))
+            if dqh != 0.0:
+                rhs[rows] -= memory[col_pos] * dqh
+        for (_, row_pos), (_, col_pos) in zip(self._held_row, self._held_col):
+            memory[row_pos] = 0.0
+            memory[col_pos] = 0.0
+        memory[self._held_diagonal_band] = 1.0
+        rhs[self.held] = dq_held
+        t2 = time.process_time()
+        _, _, dq, info = lapack.dgbsv(self._kl, self._kl, band, rhs, overwrite_ab=True, overwrite_b=True)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"the system matrix is singular (LAPACK dgbsv info {info})")
+        t3 = time.process_time()
+        dlam = r[self.held] + np.array([k @ dq[cols] for cols, k in rows_k])
+        parts = self.time_parts_s
+        parts["forces"] += t1 - t0
+        parts["assembly"] += t2 - t1
+        parts["factorisation"] += t3 - t2
+        parts["glue"] += time.process_time() - t3
+        return dq, dlam
+
+    def _sparse_step(self, q, r, dq_held):
+        """:meth:`_newton_step` on the CSR matrix of the chain's pattern, by SuperLU."""
+        from scipy.sparse import csc_matrix
+        from scipy.sparse.linalg import splu
+
         t0 = time.process_time()
         values = np.array(self.coupling.stiffness_values(q, self.time_s))
         values[self._spring_entries] += self.spring.block_values()
-        self.time_parts_s["forces"] += time.process_time() - t0
-        return values
-
-    def _newton_step(self, values, r, dq_held):
-        """Solve the bordered system [[-K, E], [Eᵀ, 0]] [Δq; Δλ] = [r; C] with the held
-        coordinates eliminated: K_ff Δq_f = -(r_f + K_fh Δq_h), Δq_h = C, Δλ = r_h + K_h· Δq.
-        Returns (Δq, Δλ) or raises numpy.linalg.LinAlgError for a singular matrix."""
-        t0 = time.process_time()
+        t1 = time.process_time()
         rhs = -r
         rhs[self.held] = 0.0
         if np.any(dq_held):
             full = np.zeros(self.n)
             full[self.held] = dq_held
-            rhs -= self._product(values, full)
+            rhs -= np.bincount(self._rows, weights=values * full[self.indices], minlength=self.n)
         rhs[self.held] = dq_held
         reduced = np.where(self._off, 0.0, values)
         reduced[self._held_diagonal] = 1.0
-        t1 = time.process_time()
-        self.time_parts_s["assembly"] += t1 - t0
-        if self.linear_solver == "banded":
-            band = self._band
-            band.fill(0.0)
-            band.reshape(-1)[self._band_flat] = reduced
-            t2 = time.process_time()
-            self.time_parts_s["assembly"] += t2 - t1
-            _, _, dq, info = lapack.dgbsv(self._kl, self._kl, band, rhs, overwrite_ab=True, overwrite_b=True)
-            if info != 0:
-                raise np.linalg.LinAlgError(f"the system matrix is singular (LAPACK dgbsv info {info})")
-        else:
-            from scipy.sparse import csc_matrix
-            from scipy.sparse.linalg import splu
-            t2 = t1
-            # the CSR pattern read as CSC is the transpose: factor Kᵀ's transpose by transposed solve
-            try:
-                dq = splu(csc_matrix((reduced, self.indices, self.indptr), shape=(self.n, self.n))).solve(rhs, trans="T")
-            except RuntimeError as exc:
-                raise np.linalg.LinAlgError(f"the system matrix is singular ({exc})") from exc
+        t2 = time.process_time()
+        # the CSR arrays read as CSC are the transpose: solve with it transposed
+        try:
+            dq = splu(csc_matrix((reduced, self.indices, self.indptr), shape=(self.n, self.n))).solve(rhs, trans="T")
+        except RuntimeError as exc:
+            raise np.linalg.LinAlgError(f"the system matrix is singular ({exc})") from exc
         t3 = time.process_time()
-        self.time_parts_s["factorisation"] += t3 - t2
-        dlam = r[self.held] + self._product(values, dq, rows=self.held)
-        self.time_parts_s["glue"] += time.process_time() - t3
+        dlam = r[self.held] + np.array([values[self.indptr[i]:self.indptr[i + 1]]
+                                        @ dq[self.indices[self.indptr[i]:self.indptr[i + 1]]] for i in self.held])
+        parts = self.time_parts_s
+        parts["forces"] += t1 - t0
+        parts["assembly"] += t2 - t1
+        parts["factorisation"] += t3 - t2
+        parts["glue"] += time.process_time() - t3
         return dq, dlam
-
-    def _product(self, values, x, rows=None):
-        """(K x) for all rows, or for ``rows`` only."""
-        if rows is None:
-            return np.bincount(self._rows, weights=values * x[self.indices], minlength=self.n)
-        out = np.empty(len(rows))
-        for k, i in enumerate(rows):
-            a, b = self.indptr[i], self.indptr[i + 1]
-            out[k] = values[a:b] @ x[self.indices[a:b]]
-        return out
 
     # ---- the interface
     def solve(self, max_iterations, relative_tolerance, absolute_tolerance_N) -> NewtonOutcome:
@@ -328,9 +371,8 @@ class OwnStaticNewton(StaticBackend):
                 initial = 2.0 * absolute_tolerance_N     # at least one step
             while not converged and iterations < max_iterations:
                 iterations += 1
-                values = self._stiffness(q)
                 try:
-                    dq, dlam = self._newton_step(values, r, c)
+                    dq, dlam = self._newton_step(q, r, c)
                 except np.linalg.LinAlgError as exc:
                     message = f"Newton: {exc}"
                     break
