@@ -120,3 +120,33 @@ def test_the_scenario_key_is_checked():
     with pytest.raises(ExucableError, match="solver.static_solver"):
         _scenario("fast/paper_ex2_bend90.toml", **{"solver.static_solver": "eigen"})
     assert _scenario("fast/paper_ex2_bend90.toml").solver.static_solver == "exucable"
+
+
+def test_the_true_residual_is_the_residual_less_the_spring():
+    """Our backend's shortcut for the true residual equals the generic formula on its system
+    residual (ODE2 rows less the spring's force at the state reached) to round-off."""
+    model = build_model(_scenario("fast/paper_ex2_bend90.toml"))
+    solver = SteadySolver(model)
+    solver.pseudo_step(solver.c0, solver.one_iteration_settings)
+    q = np.array(model.mbs.systemData.GetODE2Coordinates())
+    r = solver.static.system_residual()
+    r[model.ode2_index] -= solver.spring.force(q[model.ode2_index])
+    assert abs(solver.true_residual() - np.linalg.norm(r)) <= 1e-12 * np.linalg.norm(r)
+
+
+def test_a_failing_force_pass_is_a_failed_solve_not_an_exception(monkeypatch):
+    """A degenerate state in the kernels (numba raises ZeroDivisionError at |r'| = 0) ends the
+    static solve as not converged, with the cause in its message and a residual that no step
+    accepts (as Exudyn's solver reports a failed solve)."""
+    model = build_model(_scenario("fast/paper_ex2_bend90.toml"))
+    solver = SteadySolver(model)
+    calls = []
+
+    def degenerate(q, t=0.0):
+        calls.append(1)
+        raise ZeroDivisionError("division by zero")
+
+    monkeypatch.setattr(model.coupling, "force", degenerate)
+    ok, message, residual = solver.pseudo_step(solver.c0, solver.one_iteration_settings)
+    assert not ok and "ZeroDivisionError" in message and residual == np.inf and calls
+    assert np.isnan(solver.static.equilibrium_residual_N())
