@@ -391,8 +391,9 @@ def static_solver_iteration(length_m: float, reps: int = 5) -> None:
         print(line)
 
 
-def profile(length_m: float, top: int = 25) -> None:
-    """cProfile of one steady run of ``length_m`` [m] (after a short warm-up in this process)."""
+def profile(length_m: float, top: int = 25, static_solver: str | None = None) -> None:
+    """cProfile of one steady run of ``length_m`` [m] (after a short warm-up in this process);
+    ``static_solver``: ``[solver] static_solver`` (Exudyn's timers are printed when its solver runs)."""
     import contextlib
     import cProfile
     import io
@@ -406,7 +407,7 @@ def profile(length_m: float, top: int = 25) -> None:
     import exucable.solve.steady as steady
 
     run_scenario(parse_scenario(route_data(200.0), ROOT, default_name="route"), None, plots=False)
-    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    sc = parse_scenario(route_data(length_m, static_solver=static_solver), ROOT, default_name="route")
     # Exudyn's own timers of its static solver, summed over the solves (they run only when asked
     # for by show.computationTime, which also prints them: the output is captured and dropped)
     parts = ("jacobianODE2", "factorization", "ODE2RHS", "newtonIncrement", "total")
@@ -436,11 +437,15 @@ def profile(length_m: float, top: int = 25) -> None:
         exu.MainSolverStatic, steady.quiet_sparse = base_solver, base_settings
     s = res.summary
     n = max(s["newton_iterations"], 1)
-    print(f"Exudyn's static solver per Newton iteration (its timers, wall): total {1e3 * timers['total'] / n:.1f} ms = "
-          + ", ".join(f"{k} {1e3 * timers[k] / n:.1f} ms ({100 * timers[k] / max(timers['total'], 1e-12):.0f} %)"
-                      for k in parts[:-1])
-          + f"; of the system Jacobian, our contact coupling's and pseudo-time spring's user functions and the "
-            f"contact kernel are in the cProfile below")
+    if timers["total"] == 0.0:
+        print(f"Exudyn's static solver did not run (static_solver = {s['static_solver']!r}; "
+              f"--static-solver exudyn for its timers)")
+    else:
+        print(f"Exudyn's static solver per Newton iteration (its timers, wall): total {1e3 * timers['total'] / n:.1f} ms = "
+              + ", ".join(f"{k} {1e3 * timers[k] / n:.1f} ms ({100 * timers[k] / max(timers['total'], 1e-12):.0f} %)"
+                          for k in parts[:-1])
+              + f"; of the system Jacobian, our contact coupling's and pseudo-time spring's user functions and the "
+                f"contact kernel are in the cProfile below")
     buf = io.StringIO()
     st = pstats.Stats(pr, stream=buf)
     st.sort_stats("tottime").print_stats(top)
@@ -618,7 +623,7 @@ def main() -> None:
     if args.newton_parts:
         newton_parts(lengths[-1])
     if args.profile:
-        profile(lengths[-1])
+        profile(lengths[-1], static_solver=args.static_solver)
 
 
 if __name__ == "__main__":
