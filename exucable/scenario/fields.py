@@ -357,8 +357,8 @@ FIELDS: tuple[Field, ...] = (
            "assembled system (the rig's coordinates eliminated, a banded LU of the node-major chain; "
            "`exucable/solve/newton_system.py`), with Exudyn's stop test, so the iterates are Exudyn's to round-off; "
            "`\"exudyn\"`, Exudyn's static solver (sparse assembly from triplets, the rig's multipliers, Eigen's "
-           "SparseLU). Ours needs one cable with `cable_element = \"compiled\"` and a position-held rig; other "
-           "models (several cables, Exudyn's element, a force-controlled pull) use Exudyn's, and the summary's "
+           "SparseLU). Ours needs one cable with `cable_element = \"compiled\"`; other models (several cables, "
+           "Exudyn's element) use Exudyn's, and the summary's "
            "`static_solver` says which ran (docs/decisions/0005-own-static-newton.md)"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",

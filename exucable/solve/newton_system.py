@@ -107,16 +107,15 @@ class ExudynStatic(StaticBackend):
         return np.array(self._last.GetSystemResidual())[:n]
 
 
-def own_newton_unsupported(model) -> str:
+def own_newton_unsupported(model, spring=None) -> str:
     """Why :class:`OwnStaticNewton` cannot solve ``model`` ("" when it can): it needs one cable
     whose forces the contact coupling assembles, the rig as coordinate constraints, point forces
-    as the only loads, and no other item."""
+    as the only loads, the force-controlled pull's sheave (a constant stiffness) and, when given,
+    the pseudo-time ``spring``'s object, and no other item."""
     if getattr(model, "n_cables", 1) > 1:
         return "several cables"
     if getattr(model, "cable_forces", None) is None or getattr(model, "coupling", None) is None:
         return "the cable is Exudyn's element (solver.cable_element = \"exudyn\") or there is no contact"
-    if getattr(model, "guide", None) is not None:
-        return "a force-controlled pull's sheave"
     mbs = model.mbs
     sd = mbs.systemData
     if len(sd.GetODE2Coordinates()) != model.ode2_index.size:
@@ -127,6 +126,9 @@ def own_newton_unsupported(model) -> str:
         if not hasattr(d, "constraints"):
             return "a velocity-level drive"
         held.update(int(c) for c in d.constraints)
+    guide = getattr(model, "guide", None)
+    known = {int(model.coupling.object)} | ({int(guide.object)} if guide is not None else set()) \
+        | ({int(spring.object)} if spring is not None else set())
     for i in range(sd.NumberOfObjects()):
         kind = mbs.GetObject(i)["objectType"]
         if kind == "ConnectorCoordinate":
@@ -136,6 +138,8 @@ def own_newton_unsupported(model) -> str:
                 return f"object {i} (a coordinate constraint that is not the rig's)"
         elif kind != "GenericODE2":
             return f"object {i} ({kind})"
+        elif i not in known:
+            return f"object {i} (a generic object that is not the contact's, the sheave's or the spring's)"
     for i in range(sd.NumberOfLoads()):
         load = mbs.GetLoad(i)
         if load["loadType"] != "ForceVector" or load.get("loadVectorUserFunction", 0) not in (0, None):
@@ -170,7 +174,7 @@ class OwnStaticNewton(StaticBackend):
     name = "exucable"
 
     def __init__(self, model, spring, time_s: float = 1.0, linear_solver: str = "banded"):
-        why = own_newton_unsupported(model)
+        why = own_newton_unsupported(model, spring)
         if why:
             raise ValueError(f"our static Newton cannot solve this model: {why}")
         if linear_solver not in ("banded", "splu"):
@@ -225,6 +229,20 @@ class OwnStaticNewton(StaticBackend):
             node = self.mbs.GetMarker(self.mbs.GetLoad(i)["markerNumber"])["nodeNumber"]
             self._loads.append((i, where[self.mbs.GetNodeODE2Index(node) + np.arange(3)]))
         self._rows = rows
+        # the force-controlled pull's sheave: a constant stiffness K on its node, force -K q
+        self._guide = None
+        if model.guide is not None:
+            node = self.mbs.GetObject(model.guide.object)["nodeNumbers"][0]
+            grows = where[self.mbs.GetNodeODE2Index(node) + np.arange(6)]
+            trip = np.asarray(self.mbs.GetObjectParameter(model.guide.object, "stiffnessMatrix")
+                              .GetPythonObject()["triplets"], dtype=float).reshape(-1, 3)
+            K, D = np.zeros((6, 6)), np.zeros((6, 6))
+            np.add.at(K, (trip[:, 0].astype(int), trip[:, 1].astype(int)), trip[:, 2])
+            trip = np.asarray(self.mbs.GetObjectParameter(model.guide.object, "dampingMatrix")
+                              .GetPythonObject()["triplets"], dtype=float).reshape(-1, 3)
+            np.add.at(D, (trip[:, 0].astype(int), trip[:, 1].astype(int)), trip[:, 2])
+            gi, gj = np.repeat(grows, 6), np.tile(grows, 6)
+            self._guide = (grows, K, entry(gi, gj), gj * (3 * HALF_BANDWIDTH + 1) + 2 * HALF_BANDWIDTH + gi - gj, D)
         # dgbsv's band storage, Fortran order (LAPACK's own: no copy on the call): entry (i, j) at
         # row kl + ku + i - j of column j, so at memory position 34 j + 22 + i - j; the top kl rows
         # take the LU's fill-in
@@ -270,6 +288,9 @@ class OwnStaticNewton(StaticBackend):
         spring = self.spring.force(q)
         r = self.coupling.force(q, self.time_s) + spring + loads
         r[self.held] += lam
+        if self._guide is not None:
+            rows, K = self._guide[:2]
+            r[rows] -= K @ q[rows]
         self._last_spring = spring
         self.time_parts_s["forces"] += time.process_time() - t0
         return r
@@ -294,6 +315,8 @@ class OwnStaticNewton(StaticBackend):
         view[1::2] += blocks[1::2]
         self._spring_view[...] += spring
         memory = self._memory
+        if self._guide is not None:
+            memory[self._guide[3]] += self._guide[1].reshape(-1)
         rhs = -r
         rows_k = []
         for (cols, row_pos), (rows, col_pos), dqh in zip(self._held_row, self._held_col, dq_held):
@@ -326,6 +349,8 @@ class OwnStaticNewton(StaticBackend):
         t0 = time.process_time()
         values = np.array(self.coupling.stiffness_values(q, self.time_s))
         values[self._spring_entries] += self.spring.block_values()
+        if self._guide is not None:
+            values[self._guide[2]] += self._guide[1].reshape(-1)
         t1 = time.process_time()
         rhs = -r
         rhs[self.held] = 0.0
@@ -361,6 +386,12 @@ class OwnStaticNewton(StaticBackend):
         q = q_sys[self.index]
         lam = np.zeros(len(self.held))              # Exudyn starts Newton with zero multipliers
         loads = self._load_vector()
+        if self._guide is not None:
+            # Exudyn's static solver evaluates the sheave's damping -D q̇ at the nodes' initial rates
+            # (a static solve never updates them): a constant force, kept so that the iterates match
+            rows, D = self._guide[0], self._guide[4]
+            rates = np.asarray(sd.GetODE2Coordinates_t(configuration=exu.ConfigurationType.Initial))[self.index]
+            loads[rows] -= D @ rates[rows]
         # the rig holds its coordinates at the start's position (a steady model's drive does not move)
         offset = np.zeros(len(self.held))
         self.time_parts_s["glue"] += time.process_time() - t0
@@ -429,7 +460,7 @@ def static_backend(model, spring, settings_of, choice: str):
     """The backend for ``[solver] static_solver`` = ``choice``: ours where the model allows it
     (:func:`own_newton_unsupported`), else Exudyn's; and why Exudyn's when ours was asked for."""
     if choice == "exucable":
-        why = own_newton_unsupported(model)
+        why = own_newton_unsupported(model, spring)
         if not why:
             return OwnStaticNewton(model, spring), ""
         return ExudynStatic(model.mbs, settings_of), why
