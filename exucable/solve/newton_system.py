@@ -12,9 +12,11 @@ either way, so the stored states, post-processing and the rig's reaction read it
   one-cable steady model whose cable is assembled by the contact coupling
   (``solver.cable_element = "compiled"``): the whole force and stiffness are ours already
   (:class:`exucable.model.coupling.ContactCoupling`: contact, elastic forces, weight), plus the
-  pseudo-time spring and the end loads. The Jacobian is a CSR matrix of the chain's fixed
-  sparsity (each element couples its two nodes); the rig's held coordinates are eliminated and
-  the node-major system is banded (half bandwidth 11), solved by LAPACK's ``dgbsv``.
+  pseudo-time spring, the end loads and a force-controlled pull's sheave. The Jacobian has the
+  chain's fixed sparsity (each element couples its two nodes): the element blocks are written
+  straight into LAPACK's band storage (node-major order, half bandwidth 11), the rig's held
+  coordinates eliminated, and solved by ``dgbsv``; a CSR matrix of the same pattern with SuperLU
+  is the cross-check (``linear_solver = "splu"``).
 
 Exudyn's Newton (``CSolverBase::Newton`` with ``CSolverStatic``'s residual, Exudyn 1.13), which
 :class:`OwnStaticNewton` reproduces so that the iterates agree to round-off: the multipliers start
