@@ -163,3 +163,19 @@ def test_a_failing_force_pass_is_a_failed_solve_not_an_exception(monkeypatch):
     ok, message, residual = solver.pseudo_step(solver.c0, solver.one_iteration_settings)
     assert not ok and "ZeroDivisionError" in message and residual == np.inf and calls
     assert np.isnan(solver.static.equilibrium_residual_N())
+
+
+@pytest.mark.slow
+def test_the_benchmarks_comparison_runs():
+    """``benchmarks/long_routes.py --compare-static-solver`` in its smoke mode (four child runs and
+    the interleaved iteration; ~15 s CPU, hence slow): it prints both ways and the per-part line."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run([sys.executable, str(root / "benchmarks" / "long_routes.py"), "--quick", "--no-figures",
+                           "--compare-static-solver"], capture_output=True, text=True, check=False, cwd=root)
+    assert done.returncode == 0, done.stderr[-2000:]
+    for fragment in ("CPU exucable/exudyn", "ours, banded LU", "ratio to Exudyn's", "factorisation"):
+        assert fragment in done.stdout
