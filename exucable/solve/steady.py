@@ -12,7 +12,9 @@ contact law, smooth wall, broad phase, gravity, back tension), built by
 - the rig holding the leading end where the start put it (its reaction is the pulling force), or
   for a force-controlled pull the trailing end (its reaction is the trailing tension);
 
-and solved from the pre-tensioned start (the rope solution) with Exudyn's static solver.
+and solved from the pre-tensioned start (the rope solution) by static solves: Exudyn's Newton method
+on our own assembled system where the model allows it, else Exudyn's static solver
+(``[solver] static_solver``, :mod:`exucable.solve.newton_system`; the same iterates to round-off).
 
 Why pseudo-time steps: the start is near equilibrium, but a full Newton step from it overshoots
 into the wall (Hertz contact is stiff, 1e5-1e6 N/m per node, the free spans are soft), and the
