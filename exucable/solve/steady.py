@@ -133,16 +133,7 @@ class SteadySettings:
         is declared failed.
     reject_growth : float
         Growth of the true residual over the last accepted step's [-] above which a one-iteration
-        pseudo-time step is undone and retried with a 4× stiffer spring (a trust-region test). Why
-        4, not 2: the steps that grow the residual 2-4× are mostly spikes at bend ends (a nearly
-        plain Newton step pushes a few check points into the wall), which the next step removes;
-        undone, the rate climbed back and fell onto them again (the 1 km route's coarse mesh: 11
-        of 37 Newton iterations undone). ``benchmarks/steady_iterations.py --long``, all 24 cases:
-        710 → 465 Newton iterations, none more but coarse Ex2 (+1) and coarse Fig. 12 3 coils
-        (+5); 8 sent the 1 km case to the exact steps (139), 3 gave 548.
-    bundle_reject_growth : float
-        ``reject_growth`` for several cables (:mod:`exucable.model.bundle`), whose steps are held
-        to the best residual reached [-].
+        pseudo-time step is undone and retried with a 4× stiffer spring (a trust-region test).
     rate_fall, rate_fall_after_reject : float
         Factor by which the spring rate falls after an accepted one-iteration step, and right after
         a rejected one [-]. Measured (Newton iterations, one-iteration steps vs the exact-step
@@ -187,8 +178,7 @@ class SteadySettings:
     axial_release: float = 0.25
     max_pseudo_steps: int = 80
     max_pseudo_steps_total: int = 400
-    reject_growth: float = 4.0
-    bundle_reject_growth: float = 2.0
+    reject_growth: float = 2.0
     rate_fall: float = 8.0
     rate_fall_after_reject: float = 2.0
     max_one_iteration_steps: int = 80
@@ -594,8 +584,7 @@ class SteadySolver:
             residual = self.true_residual() if ok else np.inf
             # a bundle's steps are held to the best residual, not the last: drifting up by 2x per
             # step went 496 -> 22 000 N on the 100 m route
-            growth = s.bundle_reject_growth if self.bundle else s.reject_growth
-            if residual > growth * (min(previous, self.best[0]) if self.bundle else previous) or not ok:
+            if residual > s.reject_growth * (min(previous, self.best[0]) if self.bundle else previous) or not ok:
                 c *= 4.0
                 after_reject = True
                 if c > 1e6 * self.c0:
