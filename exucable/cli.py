@@ -103,7 +103,7 @@ def main(argv=None) -> int:
 #: :func:`main` has returned: by then every output file is written (atomically, through
 #: exucable.io, fsynced and renamed) and the figures' helper process joined, and a normal
 #: interpreter exit would spend 0.3-0.5 s of CPU finalising the loaded extensions (Exudyn, numba's
-#: kernels; docs/decisions/0005-exit-without-finalising.md).
+#: kernels; docs/decisions/0006-exit-without-finalising.md).
 ENDS_WITH_OS_EXIT = frozenset({"run", "plan"})
 
 

@@ -1,5 +1,5 @@
 """The ``exucable`` command ends ``run`` and ``plan`` with ``os._exit`` once everything is written
-(exucable.cli.console_main; docs/decisions/0005-exit-without-finalising.md): the exit status, the
+(exucable.cli.console_main; docs/decisions/0006-exit-without-finalising.md): the exit status, the
 printed lines (stdout is a pipe here, so block-buffered: they must be flushed first) and every
 output file must be what the same command gives when called in-process (``main``), where the
 process is not ended. Coarse, fast cases only: each process is a few seconds of CPU."""
