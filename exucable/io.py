@@ -244,23 +244,9 @@ def csv_text(columns, data: dict) -> str:
     # writer took ~10 µs a row: 0.03 s of a 0.3 s steady run's 6600 rows)
     arrays = [np.asarray(data[c]) for c in columns]
     text = [list(map(str, a.astype(np.int64).tolist())) if np.issubdtype(a.dtype, np.integer)
-            else _float_strings(a.astype(float)) for a in arrays]
+            else list(map(repr, a.astype(float).tolist())) for a in arrays]
     body = "\n".join(map(",".join, zip(*text)))
     return buf.getvalue() + body + ("\n" if body else "")
-
-
-def _float_strings(a: np.ndarray) -> list[str]:
-    """``repr`` of each value of the float array ``a``. A column of few distinct values (a
-    snapshot's time, its stations' ξ, the rates a steady state does not have) formats each
-    distinct bit pattern once: ``repr`` is ~0.3 µs a value, most of writing 10⁵-row files."""
-    if a.size > 1024:
-        bits = np.ascontiguousarray(a).view(np.int64)
-        if np.unique(bits[:256]).size <= 16:        # cheap test first: most columns are all distinct
-            distinct, where = np.unique(bits, return_inverse=True)
-            if distinct.size <= a.size // 16:
-                names = np.array(list(map(repr, distinct.view(float).tolist())), dtype=object)
-                return names[where.reshape(-1)].tolist()
-    return list(map(repr, a.tolist()))
 
 
 def read_csv(path) -> dict[str, np.ndarray]:
