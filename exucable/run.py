@@ -25,7 +25,7 @@ from .post.pressure import bend_table, default_window_m, pressure_profile
 from .post.tension import SteadyState, detect_steady_state, profile_stations_m
 from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, not_steady_fix, pull_force_uncertainty
 
-__all__ = ["run_scenario", "contact_profile"]
+__all__ = ["run_scenario", "contact_profile", "one_blas_thread"]
 
 
 def check_point_loads(model) -> dict | None:
@@ -225,16 +225,33 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         return solve
 
     if out_dir is None:
-        return checked_solver()(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
+        with one_blas_thread():
+            return checked_solver()(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
     # the figures' helper process is forked before anything loads Exudyn (or was, by the caller), to
     # import matplotlib beside the solve; refused input stops it at once, before anything is written
     started = plots if isinstance(plots, Figures) else Figures() if plots else contextlib.nullcontext(False)
     with started as figures:
         solve = checked_solver()
-        with owned_out_dir(out_dir) as out:
+        with owned_out_dir(out_dir) as out, one_blas_thread():
             result = solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
             write_results(out, result, plots=figures)
     return result
+
+
+def one_blas_thread():
+    """A context in which numpy's and scipy's BLAS run on one thread; the former limits come back on exit.
+
+    Why: a run's linear algebra is vectors and thin bands (the banded LU's half bandwidth is 11), far
+    below the size where BLAS threads pay; OpenBLAS still splits every product of more than ~10 000
+    entries over its threads, whose start-up and spin-wait cost more than they save. Measured
+    (``benchmarks/long_routes.py --lengths 10000 --no-figures``, one BLAS thread against OpenBLAS's
+    default two, one run each on a quiet machine): the 10 km run 10.83 → 8.96 s CPU, 11.34 → 8.99 s
+    wall; its rope references 1.20 → 0.51 s. The limit is process-wide while the run lasts: another
+    thread of the caller's doing linear algebra meanwhile runs on one BLAS thread too.
+    """
+    from threadpoolctl import threadpool_limits   # at call time: importing exucable changes nothing
+
+    return threadpool_limits(limits=1, user_api="blas")
 
 
 def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_per_element,
