@@ -287,3 +287,17 @@ def test_the_figures_fast_png_encoding_keeps_every_pixel(tmp_path):
         a, b = imread(fast), imread(default)
         assert a.shape == b.shape and np.array_equal(a, b), name
         assert default.stat().st_size < fast.stat().st_size <= 1.25 * default.stat().st_size, name
+
+
+def test_frames_stop_being_built_once_the_results_arrive(tmp_path):
+    """The helper builds frames only while it waits: once results are there, the figures left without
+    a frame are drawn on new figures (the same files)."""
+    from exucable.output import figure_process as fp
+
+    arrived = iter([False, True, True])
+    frames = fp.build_frames(until=lambda: next(arrived))
+    assert list(frames) == ["pull_force.png"]
+    new = fp.draw_figures(tmp_path / "new", _result())
+    fp.draw_figures(tmp_path / "framed", _result(), frames=frames)
+    for p in new:
+        assert (tmp_path / "framed" / p.name).read_bytes() == p.read_bytes(), p.name

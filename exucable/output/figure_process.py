@@ -81,10 +81,17 @@ def _warm_up() -> None:
     fig.savefig(io.BytesIO(), format="png", dpi=40)
 
 
-def build_frames(ticks: int = FRAME_TICKS) -> dict:
+def build_frames(ticks: int = FRAME_TICKS, until=None) -> dict:
     """Each figure's frame (:data:`exucable.plots.results.FRAMES`: figure, axes, ``ticks`` major
-    ticks on each axis), built before the results exist; each is drawn on once."""
-    return {name: frame(ticks) for name, frame in FRAMES.items()}
+    ticks on each axis), built before the results exist; each is drawn on once. ``until``: a
+    callable checked before each frame; once it is true no more are built (the results arrived: a
+    figure without a frame is drawn on a new one, the same file, rather than wait)."""
+    frames = {}
+    for name, frame in FRAMES.items():
+        if until is not None and until():
+            break
+        frames[name] = frame(ticks)
+    return frames
 
 
 def _serve(conn) -> None:
@@ -93,7 +100,7 @@ def _serve(conn) -> None:
     filename)`` or ``("failed", reason)``."""
     try:
         _warm_up()
-        frames = build_frames()
+        frames = build_frames(until=conn.poll)
         # matplotlib's objects, loaded now, stay: the collector need not walk them again while the
         # figures are drawn, nor write to their pages in the drawing forks (each write copies a page)
         gc.freeze()
