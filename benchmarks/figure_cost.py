@@ -281,7 +281,7 @@ def _wait_idle(pid: int, settle_s: float = 0.3, timeout_s: float = 60.0) -> None
 
 
 CRITICAL_ROWS = (("main", "this process's extra CPU with figures (sending, writing beside the helper)"),
-                 ("warm_up_s", "helper: matplotlib's import and warm-up, beside the solve"),
+                 ("warm_up_s", "helper: matplotlib's import, warm-up and the figures' frames, beside the solve"),
                  ("draw_s", "helper: drawing its own figures after the results arrived"),
                  ("forks_draw_s", "the helper's forks: drawing the other figures at the same time, total"),
                  ("longest_fork_draw_s", "the helper's forks: the longest one"),

@@ -263,7 +263,7 @@ class Figures:
         self._proc = self._conn = None
         self._sent = False               # whether the helper was given results to draw
         self.helper_reason = ""          # why the figures were drawn here, if they were
-        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import and warm-up,
+        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import, warm-up and frames,
         #: beside the solve), ``draw_s`` (its drawing after the results arrived) and, where forks
         #: drew the other figures at the same time, ``forks_draw_s`` (their total) and
         #: ``longest_fork_draw_s``; empty otherwise
