@@ -33,7 +33,12 @@ sources' time stamps, ``touch -r``, or its kernels compile in its first child), 
 one, and prints the CPU time after/before of the whole process, the solves and the rest, and the
 pulling force's change: a pass's effect measured in one run.
 
-Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing] [--before TREE] [--compare-cold]``;
+``--compare-static-solver`` runs each length with ``[solver] static_solver = "exudyn"`` and then
+``"exucable"`` (processes of their own, one after the other: CPU ratios, pulling forces, Newton counts),
+then times one Newton iteration of each (Exudyn's static solver, ours with the banded LU and with
+SuperLU) interleaved in this process from the same state, and our iteration by part.
+
+Run: ``nice .venv/bin/python benchmarks/long_routes.py [--lengths 1000 2000 5000 10000] [--profile] [--newton-parts] [--clearance-spacing] [--before TREE] [--compare-cold] [--compare-static-solver]``;
 ``--clearance-spacing`` solves the longest route's rope with clearance on uniform chains of 2, 5 and 10 cm node
 spacing and on the default chain (graded away from the bends), with the pulling force's change against the 2 cm
 chain and the CPU time of each.
@@ -83,15 +88,17 @@ def route_path(length_m: float) -> list[dict]:
     return path
 
 
-def route_data(length_m: float, cable_element: str | None = None) -> dict:
+def route_data(length_m: float, cable_element: str | None = None, static_solver: str | None = None) -> dict:
     """The scenario (as a TOML-like dict) of a route of ``length_m`` [m], steady mode;
-    ``cable_element``: ``[solver] cable_element`` (None: the default)."""
+    ``cable_element``, ``static_solver``: those ``[solver]`` keys (None: the default)."""
     import math
 
     area = math.pi * CABLE_RADIUS_M ** 2
     solver = {"mode": "steady", "end_time": 1.0}   # end_time: required, unused by a steady solve
     if cable_element is not None:
         solver["cable_element"] = cable_element
+    if static_solver is not None:
+        solver["static_solver"] = static_solver
     return {
         "name": f"long-route-{length_m:g}m",
         "cable": {"radius": CABLE_RADIUS_M, "mass_per_length": MASS_PER_LENGTH_KG_PER_M,
@@ -150,7 +157,8 @@ class _Timed:
         setattr(module, name, timed)
 
 
-def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_element: str | None = None) -> dict:
+def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_element: str | None = None,
+             static_solver: str | None = None) -> dict:
     """Every stage of one steady run of ``length_m`` [m] in this process (the JSON a child prints).
 
     Stages: import, parse, build (every model built, the rope references included), of it the
@@ -172,7 +180,7 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_el
     if cold:
         start.nested_start = lambda fine, coarse: None     # run.py imports it at call time
     clock.lap("import_s")
-    sc = parse_scenario(route_data(length_m, cable_element), ROOT, default_name="route")
+    sc = parse_scenario(route_data(length_m, cable_element, static_solver), ROOT, default_name="route")
     clock.lap("parse_s")
     # run_scenario and the error bar import these at call time: the timed copies are the ones called
     timed = _Timed()
@@ -222,14 +230,15 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_el
 
 
 def in_child(length_m: float, figures: bool, cold: bool = False, tree: str | None = None,
-             cable_element: str | None = None) -> dict:
+             cable_element: str | None = None, static_solver: str | None = None) -> dict:
     """:func:`one_case` in a fresh process; adds the whole process's wall time ``process_s``.
     ``cold``: the solved mesh from the rope start (``--compare-cold``); ``tree``: an exucable source tree
     whose package the child imports instead of the installed one."""
     import os
 
     cmd = ([sys.executable, __file__, "--case", f"{length_m:g}"] + ([] if figures else ["--no-figures"])
-           + (["--cold"] if cold else []) + (["--cable-element", cable_element] if cable_element else []))
+           + (["--cold"] if cold else []) + (["--cable-element", cable_element] if cable_element else [])
+           + (["--static-solver", static_solver] if static_solver else []))
     env = None
     if tree is not None:
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(tree).resolve())]
@@ -306,18 +315,85 @@ def compare(b: dict, a: dict) -> str:
             f"{b['newton_iterations']}/{b['error_bar_newton_iterations']} -> {a['newton_iterations']}/{a['error_bar_newton_iterations']}")
 
 
-def per_iteration(b: dict, a: dict) -> str:
-    """One line: CPU per Newton iteration of both steady solves, exudyn's element (b) and the compiled one (a)."""
+def per_iteration(b: dict, a: dict, names=("exudyn", "compiled")) -> str:
+    """One line: CPU per Newton iteration of both steady solves, run b (exudyn's element) and run a
+    (the compiled one), or as ``names`` say."""
     def each(r):
         n = r["newton_iterations"] + r["error_bar_newton_iterations"]
         return 1e3 * (r["cpu_s"]["solve_s"] + r["cpu_s"]["error_bar_s"]) / max(n, 1), n
     (x, nx), (y, ny) = each(b), each(a)
-    return (f"{'':9s}CPU per Newton iteration (solve and error bar): exudyn {x:.1f} ms ({nx} iterations), "
-            f"compiled {y:.1f} ms ({ny}), ratio {y / x:.2f}")
+    return (f"{'':9s}CPU per Newton iteration (solve and error bar): {names[0]} {x:.1f} ms ({nx} iterations), "
+            f"{names[1]} {y:.1f} ms ({ny}), ratio {y / x:.2f}")
 
 
-def profile(length_m: float, top: int = 25) -> None:
-    """cProfile of one steady run of ``length_m`` [m] (after a short warm-up in this process)."""
+def static_solver_iteration(length_m: float, reps: int = 5) -> None:
+    """CPU time of one one-iteration pseudo-time step (one Newton iteration: two residuals, one
+    Jacobian, one factorisation) on the solved mesh of the route of ``length_m`` [m], by Exudyn's
+    static solver and by ours with LAPACK's banded LU and with SuperLU, interleaved in this process
+    from the same state (median of ``reps``), with the states' difference; then our iteration's CPU
+    time by part (the forces: kernel, cable, spring; assembly; factorisation and solve; the rest)."""
+    import types
+
+    import numpy as np
+
+    import exucable.model.coupling as coupling
+    import exucable.solve.steady as steady
+    from exucable.model.build import build_model
+    from exucable.scenario.specs import parse_scenario
+    from exucable.solve.newton_system import ExudynStatic, OwnStaticNewton
+
+    # the coupling's own timers (kernel, cable) then count this process's CPU time, not wall
+    coupling.time = types.SimpleNamespace(perf_counter=time.process_time)
+    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    first = build_model(sc)
+    model = build_model(sc, refine=2.0, check_points_per_element=first.mesh.check_points_per_element,
+                        references=first.start)
+    solver = steady.SteadySolver(model)
+    backends = {"exudyn": ExudynStatic(model.mbs, steady.static_settings),
+                "ours, banded LU": OwnStaticNewton(model, solver.spring, linear_solver="banded"),
+                "ours, SuperLU": OwnStaticNewton(model, solver.spring, linear_solver="splu")}
+    times = {k: [] for k in backends}
+    kernel = {k: 0.0 for k in backends}
+    cable = {k: 0.0 for k in backends}
+    states = {}
+    c = model.coupling
+    solver.pseudo_step(solver.c0, solver.one_iteration_settings)     # warm-up (kernels loaded)
+    for _ in range(reps):
+        for name, backend in backends.items():
+            solver.static = backend
+            solver.store.restore_as_initial()
+            solver.spring.anchor_at(steady._cable_part(model, solver.store.saved[0]))
+            solver.spring.rate = solver.c0
+            model.coupling.forget_evaluation()       # every backend pays its kernel passes
+            t, k0, c0 = time.process_time(), c.kernel_time_s, c.cable_time_s
+            solver.one_solve(solver.one_iteration_settings)
+            times[name].append(time.process_time() - t)
+            kernel[name] += c.kernel_time_s - k0
+            cable[name] += c.cable_time_s - c0
+            states[name] = np.array(model.mbs.systemData.GetODE2Coordinates())
+    base = float(np.median(times["exudyn"]))
+    step = np.linalg.norm(states["exudyn"] - solver.store.saved[0])
+    print(f"one Newton iteration (a one-iteration pseudo-time step), {length_m / 1000:g} km, "
+          f"{model.mesh.elements} elements, {states['exudyn'].size} coordinates; CPU, median of {reps}, interleaved:")
+    for name in backends:
+        m = float(np.median(times[name]))
+        diff = np.linalg.norm(states[name] - states["exudyn"]) / step
+        print(f"  {name:16s} {1e3 * m:8.1f} ms  ratio to Exudyn's {m / base:5.2f}  step vs Exudyn's {diff:.1e}")
+    print(f"  (each iteration here makes two kernel passes: the start's pass is not reused, as it is in a solve)")
+    for name in backends:
+        line = f"  {name}, by part per iteration [ms]: contact kernel {1e3 * kernel[name] / reps:.1f}, cable element {1e3 * cable[name] / reps:.1f}"
+        if name != "exudyn":
+            parts = dict(backends[name].time_parts_s)
+            parts["forces"] -= kernel[name] + cable[name]      # what is left of the forces: sums, spring, blocks
+            line += ", " + ", ".join(f"{'other forces' if k == 'forces' else k} {1e3 * v / reps:.1f}" for k, v in parts.items())
+        else:
+            line += f", the rest (Exudyn: handover, assembly, SparseLU) {1e3 * (np.sum(times[name]) - kernel[name] - cable[name]) / reps:.1f}"
+        print(line)
+
+
+def profile(length_m: float, top: int = 25, static_solver: str | None = None) -> None:
+    """cProfile of one steady run of ``length_m`` [m] (after a short warm-up in this process);
+    ``static_solver``: ``[solver] static_solver`` (Exudyn's timers are printed when its solver runs)."""
     import contextlib
     import cProfile
     import io
@@ -331,7 +407,7 @@ def profile(length_m: float, top: int = 25) -> None:
     import exucable.solve.steady as steady
 
     run_scenario(parse_scenario(route_data(200.0), ROOT, default_name="route"), None, plots=False)
-    sc = parse_scenario(route_data(length_m), ROOT, default_name="route")
+    sc = parse_scenario(route_data(length_m, static_solver=static_solver), ROOT, default_name="route")
     # Exudyn's own timers of its static solver, summed over the solves (they run only when asked
     # for by show.computationTime, which also prints them: the output is captured and dropped)
     parts = ("jacobianODE2", "factorization", "ODE2RHS", "newtonIncrement", "total")
@@ -361,11 +437,15 @@ def profile(length_m: float, top: int = 25) -> None:
         exu.MainSolverStatic, steady.quiet_sparse = base_solver, base_settings
     s = res.summary
     n = max(s["newton_iterations"], 1)
-    print(f"Exudyn's static solver per Newton iteration (its timers, wall): total {1e3 * timers['total'] / n:.1f} ms = "
-          + ", ".join(f"{k} {1e3 * timers[k] / n:.1f} ms ({100 * timers[k] / max(timers['total'], 1e-12):.0f} %)"
-                      for k in parts[:-1])
-          + f"; of the system Jacobian, our contact coupling's and pseudo-time spring's user functions and the "
-            f"contact kernel are in the cProfile below")
+    if timers["total"] == 0.0:
+        print(f"Exudyn's static solver did not run (static_solver = {s['static_solver']!r}; "
+              f"--static-solver exudyn for its timers)")
+    else:
+        print(f"Exudyn's static solver per Newton iteration (its timers, wall): total {1e3 * timers['total'] / n:.1f} ms = "
+              + ", ".join(f"{k} {1e3 * timers[k] / n:.1f} ms ({100 * timers[k] / max(timers['total'], 1e-12):.0f} %)"
+                          for k in parts[:-1])
+              + f"; of the system Jacobian, our contact coupling's and pseudo-time spring's user functions and the "
+                f"contact kernel are in the cProfile below")
     buf = io.StringIO()
     st = pstats.Stats(pr, stream=buf)
     st.sort_stats("tottime").print_stats(top)
@@ -481,16 +561,30 @@ def main() -> None:
     ap.add_argument("--compare-elements", action="store_true",
                     help="each length with cable_element = \"exudyn\" and then \"compiled\", in processes of their "
                          "own one after the other, and their CPU ratios and pulling forces side by side")
+    ap.add_argument("--static-solver", choices=("exucable", "exudyn"),
+                    help="[solver] static_solver of the runs (default: the scenario default)")
+    ap.add_argument("--compare-static-solver", action="store_true",
+                    help="each length with static_solver = \"exudyn\" and then \"exucable\", in processes of "
+                         "their own one after the other (CPU ratios, pulling forces), and one Newton iteration "
+                         "of each, interleaved in this process")
     ap.add_argument("--case", metavar="LENGTH_M", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.case:
         print(json.dumps(one_case(float(args.case), figures=not args.no_figures, cold=args.cold,
-                                  cable_element=args.cable_element)))
+                                  cable_element=args.cable_element, static_solver=args.static_solver)))
         return
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
     rows, pairs = [], []
     for L in lengths:
-        if args.compare_elements:
+        if args.compare_static_solver:
+            b = in_child(L, figures=not args.no_figures, static_solver="exudyn")
+            print("exudyn:   " + report(b), flush=True)
+            r = in_child(L, figures=not args.no_figures, static_solver="exucable")
+            print("exucable: " + report(r), flush=True)
+            print(compare(b, r).replace("after/before", "exucable/exudyn"), flush=True)
+            print(per_iteration(b, r, names=("exudyn", "exucable")), flush=True)
+            static_solver_iteration(L, reps=3 if args.quick else 5)
+        elif args.compare_elements:
             b = in_child(L, figures=not args.no_figures, cable_element="exudyn")
             print("exudyn:   " + report(b), flush=True)
             r = in_child(L, figures=not args.no_figures, cable_element="compiled")
@@ -501,7 +595,8 @@ def main() -> None:
             if args.before:
                 b = in_child(L, figures=not args.no_figures, tree=args.before, cable_element=args.cable_element)
                 print("before: " + report(b), flush=True)
-            r = in_child(L, figures=not args.no_figures, cable_element=args.cable_element)
+            r = in_child(L, figures=not args.no_figures, cable_element=args.cable_element,
+                         static_solver=args.static_solver)
             print(("after:  " if args.before else "") + report(r), flush=True)
             if args.before:
                 print(compare(b, r), flush=True)
@@ -528,7 +623,7 @@ def main() -> None:
     if args.newton_parts:
         newton_parts(lengths[-1])
     if args.profile:
-        profile(lengths[-1])
+        profile(lengths[-1], static_solver=args.static_solver)
 
 
 if __name__ == "__main__":

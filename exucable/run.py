@@ -360,6 +360,7 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
         mode=sp.mode,
         mode_rule=sp.mode_rule,
         cable_element="compiled" if getattr(model, "cable_forces", None) is not None else "exudyn",
+        static_solver=getattr(out, "static_solver", None),
         status=status,
         message=message,
         pull_force_N=pull_force_N,

@@ -92,6 +92,8 @@ class ContactCoupling:
         rows, cols = block_sparsity(kernel.n_elements)
         unique_rows, unique_cols, self._inverse = _chain_pattern(rows, cols, kernel.n_elements)
         self._n_unique = unique_rows.size
+        self._csr = (np.concatenate([[0], np.cumsum(np.bincount(unique_rows, minlength=self.n))]).astype(np.int64),
+                     unique_cols.astype(np.int64))
         # the triplets (row, column, value) handed to Exudyn, rows and columns filled once; a row is
         # also one 24-byte record, so that dropping the zero values is one gather of records
         self._triplets = np.zeros((self._n_unique, 3))
@@ -185,6 +187,40 @@ class ContactCoupling:
         """Reuse no former kernel pass: the kernel's law changed (its friction scale)."""
         self._last = None
 
+    def chain_pattern_csr(self) -> tuple[np.ndarray, np.ndarray]:
+        """The Jacobian's fixed sparsity as CSR ``(indptr, indices)`` over the cable's coordinates
+        (node-major; each row's columns sorted): the order of :meth:`stiffness_values`."""
+        return self._csr
+
+    def force(self, q, t: float = 0.0) -> np.ndarray:
+        """The generalized force [N, N·m] on the cable's displacement coordinates ``q`` at rest
+        (q̇ = 0): contact, and the cable's elastic forces and weight when assembled here; the same
+        vector the force user function hands Exudyn (a static solve's right-hand side)."""
+        q = np.asarray(q, dtype=float)
+        return self._force(None, t, 0, q, np.zeros_like(q))
+
+    def stiffness_values(self, q, t: float = 0.0) -> np.ndarray:
+        """The left-hand-side derivative ``-∂Q/∂q`` at ``q`` (at rest), as the values of
+        :meth:`chain_pattern_csr` (zeros kept, so the pattern never changes). Reuses the kernel pass
+        of :meth:`force` at the same ``q`` and ``t``; the array returned is reused by the next call."""
+        qa, va = self.absolute(q, np.zeros(self.n))
+        res = self._evaluate(t, qa, va, jacobian=True)
+        self.jacobian_calls += 1
+        elastic = self._elastic()
+        return self._lhs_values(res, 1.0, 0.0, None if elastic is None else elastic[1])
+
+    def stiffness_blocks(self, q, t: float = 0.0) -> np.ndarray:
+        """The left-hand-side derivative ``-∂Q/∂q`` at ``q`` (at rest) per element, (n_el, 12, 12):
+        element e's block over the coordinates of nodes e and e + 1 (the values
+        :meth:`stiffness_values` sums where two elements share a node). Reuses the kernel pass of
+        :meth:`force` at the same ``q`` and ``t``."""
+        qa, va = self.absolute(q, np.zeros(self.n))
+        res = self._evaluate(t, qa, va, jacobian=True)
+        self.jacobian_calls += 1
+        elastic = self._elastic()
+        # (-1)·∂Q/∂q + the cable's stiffness: the same sum as jacobian_triplets' blocks at f_q = 1
+        return -res.jac_q_blocks if elastic is None else elastic[1] - res.jac_q_blocks
+
     def _force(self, mbs, t, item, q, q_t):
         t0 = time.perf_counter()
         qa, va = self.absolute(q, q_t)
@@ -227,6 +263,15 @@ class ContactCoupling:
         ``elastic_blocks`` (n_el, 12, 12): the cable's stiffness ∂Q_e/∂q, a left-hand-side term,
         added as ``f_q`` times it. The array returned is reused by the next call.
         """
+        vals = self._lhs_values(res, f_q, f_v, elastic_blocks)
+        nz = vals != 0.0
+        if nz.all():
+            return self._triplets
+        return self._records[nz].view(float).reshape(-1, 3)
+
+    def _lhs_values(self, res, f_q: float, f_v: float, elastic_blocks=None) -> np.ndarray:
+        """:meth:`jacobian_triplets`' values in the chain pattern, zeros kept (a view of the
+        triplets' value column)."""
         jq, jv = res.jac_q_blocks, res.jac_qt_blocks
         if f_v == 0.0 or jv is None or not jv.any():
             blocks = (-f_q) * jq
@@ -235,9 +280,5 @@ class ContactCoupling:
             blocks = -(f_q * jq + f_v * jv)
         if elastic_blocks is not None:
             blocks = blocks + f_q * elastic_blocks
-        vals = np.bincount(self._inverse, weights=blocks.reshape(-1), minlength=self._n_unique)
-        self._triplets[:, 2] = vals
-        nz = vals != 0.0
-        if nz.all():
-            return self._triplets
-        return self._records[nz].view(float).reshape(-1, 3)
+        self._triplets[:, 2] = np.bincount(self._inverse, weights=blocks.reshape(-1), minlength=self._n_unique)
+        return self._triplets[:, 2]

@@ -222,8 +222,9 @@ def problem_description(model) -> dict:
                    "w_k = smoothstep(((r_k - exit point) . exit_tangent) / ramp_length_m), clipped to [0, 1]",
         },
         "solver": {
-            "method": ("Exudyn MainSolverStatic: pseudo-transient continuation to the static equilibrium "
-                       "(exucable/solve/steady.py); no time, no inertia" if steady else
+            "method": ("Exudyn's static Newton (exucable's own loop on the assembled system, or Exudyn "
+                       "MainSolverStatic: solver.static_solver): pseudo-transient continuation to the static "
+                       "equilibrium (exucable/solve/steady.py); no time, no inertia" if steady else
                        "Exudyn MainSolverImplicitSecondOrder (generalized-alpha), adaptive step, full Newton"),
             "steady_residual": sp.steady_residual,
             "steady_residual_rule": ("steady mode: stop when |residual| <= steady_residual * the rope "

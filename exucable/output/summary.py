@@ -44,6 +44,9 @@ class RunSummary(Mapping):
     cable_element: str | None = _key('who assembled the cable\'s elastic forces: "compiled" (exucable\'s copy of '
                                      'the ANCF cable element, steady mode, solver.cable_element) or "exudyn" '
                                      '(Exudyn\'s ObjectANCFCable)')
+    static_solver: str | None = _key('steady mode: who ran the static solves\' Newton iterations: "exucable" (our '
+                                     'own loop on the assembled system, solver.static_solver) or "exudyn" '
+                                     '(Exudyn\'s static solver); None in dynamic mode')
     status: str = _key('"ok", "steady", "failed" or the first trust flag (docs/results-format.md "Status")',
                        _BOTH, default="failed")
     message: str = _key("what the solver or the trust checks said; empty when there is nothing to say",

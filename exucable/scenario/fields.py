@@ -352,6 +352,14 @@ FIELDS: tuple[Field, ...] = (
            "Newton iteration at 0.6-0.8 the CPU time (docs/decisions/0004-compiled-cable-element.md); the summary's "
            "`cable_element` says which ran. Dynamic mode, several cables and `add_cable_in_conduit` into your own "
            "system use Exudyn's element"),
+    F("solver.static_solver", "static_solver", "choice", "", "exucable", choices=("exucable", "exudyn"), ours=True,
+      rule="steady mode: who runs the static solves' Newton iterations: `\"exucable\"`, our own Newton loop on the "
+           "assembled system (the rig's coordinates eliminated, a banded LU of the node-major chain; "
+           "`exucable/solve/newton_system.py`), with Exudyn's stop test, so the iterates are Exudyn's to round-off; "
+           "`\"exudyn\"`, Exudyn's static solver (sparse assembly from triplets, the rig's multipliers, Eigen's "
+           "SparseLU). Ours needs one cable with `cable_element = \"compiled\"`; other models (several cables, "
+           "Exudyn's element) use Exudyn's, and the summary's "
+           "`static_solver` says which ran (docs/decisions/0005-own-static-newton.md)"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",
       rule="array of times in [0, `solver.end_time`]: the whole state is written at each "

@@ -675,6 +675,10 @@ class SolverSpec(_Spec):
         Steady mode: CPU time one static solve may take before it stops as failed [s].    cable_element : {"exudyn", "compiled"}
         Steady mode: Exudyn's ``ObjectANCFCable`` or exucable's compiled copy of it
         (:mod:`exucable.contact.ancf_cable`) assembles the cable's elastic forces.
+    static_solver : {"exucable", "exudyn"}
+        Steady mode: who runs the static solves' Newton iterations: our own loop on the assembled
+        system where the model allows it (:mod:`exucable.solve.newton_system`), or Exudyn's
+        static solver.
     """
 
     _SECTION: ClassVar[str] = "solver"
@@ -699,6 +703,7 @@ class SolverSpec(_Spec):
     steady_time_limit_s: float = _default("solver.steady_time_limit")
     start_from: str = _default("solver.start_from")
     cable_element: str = _default("solver.cable_element")
+    static_solver: str = _default("solver.static_solver")
 
     @property
     def mode_rule(self) -> str:

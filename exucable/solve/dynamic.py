@@ -43,6 +43,7 @@ class SolveOutcome:
     jacobian_updates: int
     wall_time_s: float
     started_from: str = "rope"   # a steady solve's start that converged: "rope" or "coarse mesh"
+    static_solver: str | None = None   # a steady solve's static solver: "exucable" or "exudyn"
 
 
 class Progress:

@@ -12,7 +12,9 @@ contact law, smooth wall, broad phase, gravity, back tension), built by
 - the rig holding the leading end where the start put it (its reaction is the pulling force), or
   for a force-controlled pull the trailing end (its reaction is the trailing tension);
 
-and solved from the pre-tensioned start (the rope solution) with Exudyn's static solver.
+and solved from the pre-tensioned start (the rope solution) by static solves: Exudyn's Newton method
+on our own assembled system where the model allows it, else Exudyn's static solver
+(``[solver] static_solver``, :mod:`exucable.solve.newton_system`; the same iterates to round-off).
 
 Why pseudo-time steps: the start is near equilibrium, but a full Newton step from it overshoots
 into the wall (Hertz contact is stiff, 1e5-1e6 N/m per node, the free spans are soft), and the
@@ -76,6 +78,7 @@ from ..errors import SolverError
 from .dynamic import History, Progress, SolveOutcome, quiet_sparse
 from ..post.tension import TensionStations, profile_stations_m
 from .steady_advice import TIME_LIMIT_KEY, failure_advice
+from .newton_system import ExudynStatic, static_backend
 
 __all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
 
@@ -297,9 +300,14 @@ class PseudoTimeSpring:
     def _force(self, mbs, t, item, q, q_t):
         return self.force(q)
 
+    def block_values(self, f_q: float = 1.0) -> np.ndarray:
+        """The stiffness c·m_k·P_k of the spring's 3 × 3 blocks times ``f_q``, per node, positions
+        then slopes, row-major (the left-hand-side derivative of :meth:`force`)."""
+        return (f_q * self.rate * self.block_mass[:, :, None, None] * self._proj[:, None, :, :]).reshape(-1)
+
     def _jacobian(self, mbs, t, item, q, q_t, f_q, f_v):
         m = exu.MatrixContainer()
-        vals = (f_q * self.rate * self.block_mass[:, :, None, None] * self._proj[:, None, :, :]).reshape(-1)
+        vals = self.block_values(f_q)
         nz = vals != 0.0  # Exudyn's sparse triplets must not contain zeros
         if not nz.any():
             m.Initialize(self.n, self.n, False)
@@ -419,6 +427,12 @@ class _FailedSteps:
         return f"{text}: {message}"
 
 
+def _static_choice(model) -> str:
+    """``[solver] static_solver`` of the model's scenario ("exucable" when it has none)."""
+    solver = getattr(getattr(model, "scenario", None), "solver", None)
+    return getattr(solver, "static_solver", "exucable")
+
+
 def _set_scale(model, lam: float, loads: bool = True) -> None:
     model.load_scale.apply(model.mbs, gravity=lam if loads else 1.0, end_force=lam if loads else 1.0)
     model.kernel.set_friction_scale(lam)
@@ -478,7 +492,8 @@ class SteadySolver:
         self.stations = force_stations(model)
         self.one_iteration_settings = static_settings(tolerance=1.0, max_iterations=1,
                                                       absolute_tolerance_N=1e-3 * self.tolerance_N)
-        self._last_solver = None
+        #: who solves each static problem (``[solver] static_solver``; exucable.solve.newton_system)
+        self.static, self.static_note = static_backend(model, self.spring, static_settings, _static_choice(model))
         self._solved = False
         self._cpu_start = time.process_time()
         self.timed_out = False           # stopped at settings.time_limit_s
@@ -506,20 +521,17 @@ class SteadySolver:
     def one_solve(self, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
         """One static solve with the exact, inexact or given settings: converged?, message, and
         Newton's last residual norm [N]."""
-        solver = exu.MainSolverStatic()
-        self._last_solver = solver
         if isinstance(exact, exu.SimulationSettings):
             chosen = exact
         else:
             chosen = self.exact_settings if exact else self.inexact_settings
-        try:
-            ok = solver.SolveSystem(self.mbs, chosen)
-            message = "" if ok else (solver.GetErrorString() or "Newton did not converge")
-        except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
-            ok, message = False, f"{type(exc).__name__}: {exc}".strip()
-        self.newton_iterations += int(solver.it.newtonStepsCount)
-        self.jacobian_updates += int(solver.it.newtonJacobiCount)
-        return ok, message, float(solver.conv.residual)
+        newton = chosen.staticSolver.newton
+        extra = {"settings": chosen} if isinstance(self.static, ExudynStatic) else {}
+        out = self.static.solve(int(newton.maxIterations), float(newton.relativeTolerance),
+                                float(newton.absoluteTolerance), **extra)
+        self.newton_iterations += out.newton_iterations
+        self.jacobian_updates += out.jacobian_updates
+        return out.converged, out.message, out.residual_N
 
     def pseudo_step(self, c: float, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
         """One pseudo-time step at spring rate ``c`` [1/s²] from the stored state (see :meth:`one_solve`)."""
@@ -547,9 +559,12 @@ class SteadySolver:
     def true_residual(self) -> float:
         """Norm [N] of the unregularised equilibrium residual at the current state: the last
         solve's residual there (Exudyn evaluates it after its last update) minus the spring's force."""
+        own = getattr(self.static, "equilibrium_residual_N", None)
+        if own is not None:
+            return own()
         sd = self.mbs.systemData
         q_all = np.array(sd.GetODE2Coordinates())
-        r = np.array(self._last_solver.GetSystemResidual())[:q_all.size]
+        r = self.static.system_residual()[:q_all.size]
         r[self.model.ode2_index] -= self.spring.force(_cable_part(self.model, q_all))
         return float(np.linalg.norm(r))
 
@@ -742,7 +757,8 @@ class SteadySolver:
             self.progress.close()
         return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
                             steps=self.steps, newton_iterations=self.newton_iterations,
-                            jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from)
+                            jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from,
+                            static_solver=self.static.name)
 
     def restart_state(self):
         """The state the friction's ramp starts from: for a bundle the accepted state of smallest

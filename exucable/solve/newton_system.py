@@ -1,0 +1,469 @@
+"""The static solves of the steady continuation: Exudyn's solver, or our Newton loop on the same model.
+
+:class:`exucable.solve.steady.SteadySolver` runs many short static solves (pseudo-time steps of one
+Newton iteration, or a few). It asks each through a small interface (:class:`StaticBackend`):
+``solve(max_iterations, relative_tolerance, absolute_tolerance_N)`` → :class:`NewtonOutcome`;
+``system_residual()``, the last residual's ODE2 part; the state lives in ``mbs.systemData``
+either way, so the stored states, post-processing and the rig's reaction read it unchanged.
+
+- :class:`ExudynStatic`: Exudyn's ``MainSolverStatic`` (one load step, plain Newton), the
+  reference path; bundles, Exudyn's cable element and models with other items use it.
+- :class:`OwnStaticNewton`: the same Newton iterations on our own assembled system, for a
+  one-cable steady model whose cable is assembled by the contact coupling
+  (``solver.cable_element = "compiled"``): the whole force and stiffness are ours already
+  (:class:`exucable.model.coupling.ContactCoupling`: contact, elastic forces, weight), plus the
+  pseudo-time spring, the end loads and a force-controlled pull's sheave. The Jacobian has the
+  chain's fixed sparsity (each element couples its two nodes): the element blocks are written
+  straight into LAPACK's band storage (node-major order, half bandwidth 11), the rig's held
+  coordinates eliminated, and solved by ``dgbsv``; a CSR matrix of the same pattern with SuperLU
+  is the cross-check (``linear_solver = "splu"``).
+
+Exudyn's Newton (``CSolverBase::Newton`` with ``CSolverStatic``'s residual, Exudyn 1.13), which
+:class:`OwnStaticNewton` reproduces so that the iterates agree to round-off: the multipliers start
+at zero; the residual is ``[f(q) + C_qᵀλ ; C(q)]``, f the sum of the right-hand-side forces, and
+its norm the Euclidean norm over every row, multipliers' rows and the held coordinates' included
+(``weightTolerancePerCoordinate`` off); the initial residual is the start's (raised to twice the
+absolute tolerance if below it, and to the first iterate's if that is larger:
+``adaptInitialResidual``); a step converges when residual / initial ≤ the relative tolerance or
+residual ≤ the absolute one; a non-finite iterate stops Newton.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import exudyn as exu
+from scipy.linalg import lapack
+
+__all__ = ["NewtonOutcome", "StaticBackend", "ExudynStatic", "OwnStaticNewton", "own_newton_unsupported",
+           "static_backend", "HALF_BANDWIDTH"]
+
+#: Half bandwidth of the node-major chain's Jacobian: a row of node k reaches nodes k ± 1 (6 each).
+HALF_BANDWIDTH = 11
+
+
+@dataclass
+class NewtonOutcome:
+    """What one static solve did.
+
+    Attributes
+    ----------
+    converged : bool
+    message : str
+        Why not ("" when converged).
+    residual_N : float
+        Newton's last residual norm [N] (Exudyn's ``conv.residual``).
+    newton_iterations, jacobian_updates : int
+    """
+
+    converged: bool
+    message: str
+    residual_N: float
+    newton_iterations: int
+    jacobian_updates: int
+
+
+class StaticBackend:
+    """The interface :class:`exucable.solve.steady.SteadySolver` solves through (see the module)."""
+
+    name = ""
+
+    def solve(self, max_iterations: int, relative_tolerance: float, absolute_tolerance_N: float) -> NewtonOutcome:
+        """Newton from the system's current state; the state reached is left in ``mbs.systemData``."""
+        raise NotImplementedError
+
+    def system_residual(self) -> np.ndarray:
+        """The last residual's ODE2 rows [N, N·m]: forces plus the multipliers' reactions."""
+        raise NotImplementedError
+
+
+class ExudynStatic(StaticBackend):
+    """Exudyn's static solver (:func:`exucable.solve.steady.static_settings`' one load step)."""
+
+    name = "exudyn"
+
+    def __init__(self, mbs, settings_of):
+        self.mbs = mbs
+        self._settings_of = settings_of       # (tolerances) -> exu.SimulationSettings
+        self._last = None
+
+    def solve(self, max_iterations, relative_tolerance, absolute_tolerance_N, settings=None) -> NewtonOutcome:
+        """As :meth:`StaticBackend.solve`; ``settings``: Exudyn's settings to use as they are instead."""
+        solver = exu.MainSolverStatic()
+        self._last = solver
+        if settings is None:
+            settings = self._settings_of(tolerance=relative_tolerance, max_iterations=max_iterations,
+                                         absolute_tolerance_N=absolute_tolerance_N)
+        try:
+            ok = solver.SolveSystem(self.mbs, settings)
+            message = "" if ok else (solver.GetErrorString() or "Newton did not converge")
+        except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
+            ok, message = False, f"{type(exc).__name__}: {exc}".strip()
+        return NewtonOutcome(bool(ok), message, float(solver.conv.residual), int(solver.it.newtonStepsCount),
+                             int(solver.it.newtonJacobiCount))
+
+    def system_residual(self) -> np.ndarray:
+        n = len(self.mbs.systemData.GetODE2Coordinates())
+        return np.array(self._last.GetSystemResidual())[:n]
+
+
+def own_newton_unsupported(model, spring=None) -> str:
+    """Why :class:`OwnStaticNewton` cannot solve ``model`` ("" when it can): it needs one cable
+    whose forces the contact coupling assembles, the rig as coordinate constraints, point forces
+    as the only loads, the force-controlled pull's sheave (a constant stiffness) and, when given,
+    the pseudo-time ``spring``'s object, and no other item."""
+    if getattr(model, "n_cables", 1) > 1:
+        return "several cables"
+    if getattr(model, "cable_forces", None) is None or getattr(model, "coupling", None) is None:
+        return "the cable is Exudyn's element (solver.cable_element = \"exudyn\") or there is no contact"
+    mbs = model.mbs
+    sd = mbs.systemData
+    if len(sd.GetODE2Coordinates()) != model.ode2_index.size:
+        return "coordinates other than the cable's"
+    drives = [d for d in (model.lead_drive, model.trail_drive) if d is not None]
+    held = set()
+    for d in drives:
+        if not hasattr(d, "constraints"):
+            return "a velocity-level drive"
+        held.update(int(c) for c in d.constraints)
+    guide = getattr(model, "guide", None)
+    known = {int(model.coupling.object)} | ({int(guide.object)} if guide is not None else set()) \
+        | ({int(spring.object)} if spring is not None else set())
+    for i in range(sd.NumberOfObjects()):
+        kind = mbs.GetObject(i)["objectType"]
+        if kind == "ConnectorCoordinate":
+            o = mbs.GetObject(i)
+            if (i not in held or float(o["factor1"]) != 1.0 or o["velocityLevel"] or float(o["offset"]) != 0.0
+                    or mbs.GetMarker(o["markerNumbers"][1])["markerType"] != "NodeCoordinate"):
+                return f"object {i} (a coordinate constraint that is not the rig's)"
+        elif kind != "GenericODE2":
+            return f"object {i} ({kind})"
+        elif i not in known:
+            return f"object {i} (a generic object that is not the contact's, the sheave's or the spring's)"
+    for i in range(sd.NumberOfLoads()):
+        load = mbs.GetLoad(i)
+        if load["loadType"] != "ForceVector" or load.get("loadVectorUserFunction", 0) not in (0, None):
+            return f"load {i} ({load['loadType']})"
+        if mbs.GetMarker(load["markerNumber"])["markerType"] != "NodePosition":
+            return f"load {i} (not on a node's position)"
+    return ""
+
+
+class OwnStaticNewton(StaticBackend):
+    """Exudyn's static Newton iterations (the module's notes) on our own assembled system.
+
+    Parameters
+    ----------
+    model : exucable.model.build.Model
+        A one-cable steady model with the compiled cable (:func:`own_newton_unsupported` is "").
+    spring : exucable.solve.steady.PseudoTimeSpring
+        The pseudo-time spring (its force and its 3 × 3 nodal blocks c·m·P).
+    time_s : float
+        The time handed to the coupling (Exudyn's static solver evaluates at its load step's end, 1).
+    linear_solver : {"banded", "splu"}
+        LAPACK's banded LU (``dgbsv``) or SuperLU (``scipy.sparse.linalg.splu``); both solve the
+        same system (``benchmarks/long_routes.py --compare-static-solver`` measures them).
+
+    Attributes
+    ----------
+    time_parts_s : dict
+        CPU time [s] per part: ``"forces"`` (kernel, cable, spring: the residual), ``"assembly"``
+        (values into the banded matrix), ``"factorisation"`` (factor and solve), ``"glue"`` (the rest).
+    """
+
+    name = "exucable"
+
+    def __init__(self, model, spring, time_s: float = 1.0, linear_solver: str = "banded"):
+        why = own_newton_unsupported(model, spring)
+        if why:
+            raise ValueError(f"our static Newton cannot solve this model: {why}")
+        if linear_solver not in ("banded", "splu"):
+            raise ValueError(f"linear_solver must be 'banded' or 'splu', got {linear_solver!r}")
+        self.model, self.mbs, self.spring = model, model.mbs, spring
+        self.coupling = model.coupling
+        self.time_s = float(time_s)
+        self.linear_solver = linear_solver
+        self.index = np.asarray(model.ode2_index, dtype=np.int64)   # cable coordinate k -> system row
+        n = self.n = self.index.size
+        indptr, indices = self.coupling.chain_pattern_csr()
+        self.indptr, self.indices = indptr, indices
+        rows = np.repeat(np.arange(n), np.diff(indptr))
+        # where each (row, column) entry sits in the pattern: the row's start plus the column's offset
+        # from the row's first column (the row's columns are contiguous)
+        first_col = indices[indptr[:-1]]
+
+        def entry(r, c):
+            return indptr[r] + (c - first_col[r])
+
+        # the spring's 3 × 3 blocks per node and per positions/slopes (PseudoTimeSpring's order)
+        k = np.arange(spring.n_nodes)[:, None, None, None]
+        b = np.arange(2)[None, :, None, None]
+        i3 = np.arange(3)
+        sr = (6 * k + 3 * b + i3[None, None, :, None]) + 0 * i3[None, None, None, :]
+        sc = (6 * k + 3 * b + i3[None, None, None, :]) + 0 * i3[None, None, :, None]
+        self._spring_entries = entry(sr.reshape(-1), sc.reshape(-1))
+        # the rig's held coordinates (cable order) and their constraints' multipliers (AE order)
+        sd = self.mbs.systemData
+        where = np.empty(n, dtype=np.int64)
+        where[self.index] = np.arange(n)
+        held, ae = [], []
+        for drive in (model.lead_drive, model.trail_drive):
+            if drive is None:
+                continue
+            for c in drive.constraints:
+                marker = self.mbs.GetMarker(self.mbs.GetObject(c)["markerNumbers"][1])
+                held.append(where[self.mbs.GetNodeODE2Index(marker["nodeNumber"]) + int(marker["coordinate"])])
+                ae.append(int(np.asarray(sd.GetObjectLTGAE(c))[0]))
+        self.held = np.asarray(held, dtype=np.int64)
+        self.ae = np.asarray(ae, dtype=np.int64)
+        self.n_ae = len(sd.GetAECoordinates())
+        is_held = np.zeros(n, dtype=bool)
+        is_held[self.held] = True
+        self._is_held = is_held
+        # entries in a held row or column: the eliminated system has the identity there
+        self._off = is_held[rows] | is_held[indices]
+        self._held_diagonal = entry(self.held, self.held)
+        # the end loads: constant point forces on node positions, read at each solve (load scale)
+        self._loads = []
+        for i in range(sd.NumberOfLoads()):
+            node = self.mbs.GetMarker(self.mbs.GetLoad(i)["markerNumber"])["nodeNumber"]
+            self._loads.append((i, where[self.mbs.GetNodeODE2Index(node) + np.arange(3)]))
+        self._rows = rows
+        # the force-controlled pull's sheave: a constant stiffness K on its node, force -K q
+        self._guide = None
+        if model.guide is not None:
+            node = self.mbs.GetObject(model.guide.object)["nodeNumbers"][0]
+            grows = where[self.mbs.GetNodeODE2Index(node) + np.arange(6)]
+            trip = np.asarray(self.mbs.GetObjectParameter(model.guide.object, "stiffnessMatrix")
+                              .GetPythonObject()["triplets"], dtype=float).reshape(-1, 3)
+            K, D = np.zeros((6, 6)), np.zeros((6, 6))
+            np.add.at(K, (trip[:, 0].astype(int), trip[:, 1].astype(int)), trip[:, 2])
+            trip = np.asarray(self.mbs.GetObjectParameter(model.guide.object, "dampingMatrix")
+                              .GetPythonObject()["triplets"], dtype=float).reshape(-1, 3)
+            np.add.at(D, (trip[:, 0].astype(int), trip[:, 1].astype(int)), trip[:, 2])
+            gi, gj = np.repeat(grows, 6), np.tile(grows, 6)
+            self._guide = (grows, K, entry(gi, gj), gj * (3 * HALF_BANDWIDTH + 1) + 2 * HALF_BANDWIDTH + gi - gj, D)
+        # dgbsv's band storage, Fortran order (LAPACK's own: no copy on the call): entry (i, j) at
+        # row kl + ku + i - j of column j, so at memory position 34 j + 22 + i - j; the top kl rows
+        # take the LU's fill-in
+        kl = HALF_BANDWIDTH
+        self._kl, self._ld = kl, 3 * kl + 1
+        self._band = np.zeros((self._ld, n), order="F")
+        memory = self._band.T.reshape(-1)                       # a view of the same memory
+        assert np.shares_memory(memory, self._band)
+        top, stride = 2 * kl, memory.strides[0]
+        # element e's 12 × 12 block (a, b) sits at 204 e + 22 + a + 33 b: a strided view, one per
+        # parity (consecutive elements share a node, every second one does not)
+        n_el = (n // 6) - 1
+        self._element_view = np.lib.stride_tricks.as_strided(
+            memory[top:], shape=(n_el, 12, 12), strides=(6 * self._ld * stride, stride, (self._ld - 1) * stride))
+        # the spring's 3 × 3 blocks of node k, positions (c = 0) and slopes (c = 1): 204 k + 102 c + 22 + i + 33 j
+        self._spring_view = np.lib.stride_tricks.as_strided(
+            memory[top:], shape=(spring.n_nodes, 2, 3, 3),
+            strides=(6 * self._ld * stride, 3 * self._ld * stride, stride, (self._ld - 1) * stride))
+        self._memory = memory
+        # the held coordinates' rows and columns in the band (entries beyond the matrix's edge dropped)
+        off = np.arange(-kl, kl + 1)
+        self._held_row, self._held_col = [], []
+        for h in self.held:
+            j = h + off
+            j = j[(j >= 0) & (j < n)]
+            self._held_row.append((j, j * self._ld + top + h - j))     # (columns, positions) of row h
+            self._held_col.append((j, h * self._ld + top + j - h))     # (rows, positions) of column h
+        self._held_diagonal_band = self.held * self._ld + top
+        self._residual = np.zeros(n)
+        self._last_spring = np.zeros(n)
+        self.time_parts_s = {"forces": 0.0, "assembly": 0.0, "factorisation": 0.0, "glue": 0.0}
+
+    # ---- the system's parts
+    def _load_vector(self) -> np.ndarray:
+        f = np.zeros(self.n)
+        for i, rows in self._loads:
+            f[rows] += np.asarray(self.mbs.GetLoadParameter(i, "loadVector"), dtype=float)
+        return f
+
+    def _forces(self, q, lam, loads) -> np.ndarray:
+        """ODE2 residual rows in cable order: f(q) + C_qᵀλ (f: coupling, spring, end loads)."""
+        t0 = time.process_time()
+        spring = self.spring.force(q)
+        r = self.coupling.force(q, self.time_s) + spring + loads
+        r[self.held] += lam
+        if self._guide is not None:
+            rows, K = self._guide[:2]
+            r[rows] -= K @ q[rows]
+        self._last_spring = spring
+        self.time_parts_s["forces"] += time.process_time() - t0
+        return r
+
+    def _newton_step(self, q, r, dq_held):
+        """Solve the bordered system [[-K, E], [Eᵀ, 0]] [Δq; Δλ] = [r; C] at ``q`` with the held
+        coordinates eliminated: K_ff Δq_f = -(r_f + K_fh Δq_h), Δq_h = C, Δλ = r_h + K_h· Δq
+        (K = -∂f/∂q, the left-hand-side stiffness). Returns (Δq, Δλ); raises
+        numpy.linalg.LinAlgError for a singular matrix."""
+        if self.linear_solver == "banded":
+            return self._banded_step(q, r, dq_held)
+        return self._sparse_step(q, r, dq_held)
+
+    def _banded_step(self, q, r, dq_held):
+        t0 = time.process_time()
+        blocks = self.coupling.stiffness_blocks(q, self.time_s)
+        spring = self.spring.block_values().reshape(self.spring.n_nodes, 2, 3, 3)
+        t1 = time.process_time()
+        band, view = self._band, self._element_view
+        band.fill(0.0)
+        view[0::2] = blocks[0::2]
+        view[1::2] += blocks[1::2]
+        self._spring_view[...] += spring
+        memory = self._memory
+        if self._guide is not None:
+            memory[self._guide[3]] += self._guide[1].reshape(-1)
+        rhs = -r
+        rows_k = []
+        for (cols, row_pos), (rows, col_pos), dqh in zip(self._held_row, self._held_col, dq_held):
+            rows_k.append((cols, memory[row_pos].copy()))
+            if dqh != 0.0:
+                rhs[rows] -= memory[col_pos] * dqh
+        for (_, row_pos), (_, col_pos) in zip(self._held_row, self._held_col):
+            memory[row_pos] = 0.0
+            memory[col_pos] = 0.0
+        memory[self._held_diagonal_band] = 1.0
+        rhs[self.held] = dq_held
+        t2 = time.process_time()
+        _, _, dq, info = lapack.dgbsv(self._kl, self._kl, band, rhs, overwrite_ab=True, overwrite_b=True)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"the system matrix is singular (LAPACK dgbsv info {info})")
+        t3 = time.process_time()
+        dlam = r[self.held] + np.array([k @ dq[cols] for cols, k in rows_k])
+        parts = self.time_parts_s
+        parts["forces"] += t1 - t0
+        parts["assembly"] += t2 - t1
+        parts["factorisation"] += t3 - t2
+        parts["glue"] += time.process_time() - t3
+        return dq, dlam
+
+    def _sparse_step(self, q, r, dq_held):
+        """:meth:`_newton_step` on the CSR matrix of the chain's pattern, by SuperLU."""
+        from scipy.sparse import csc_matrix
+        from scipy.sparse.linalg import splu
+
+        t0 = time.process_time()
+        values = np.array(self.coupling.stiffness_values(q, self.time_s))
+        values[self._spring_entries] += self.spring.block_values()
+        if self._guide is not None:
+            values[self._guide[2]] += self._guide[1].reshape(-1)
+        t1 = time.process_time()
+        rhs = -r
+        rhs[self.held] = 0.0
+        if np.any(dq_held):
+            full = np.zeros(self.n)
+            full[self.held] = dq_held
+            rhs -= np.bincount(self._rows, weights=values * full[self.indices], minlength=self.n)
+        rhs[self.held] = dq_held
+        reduced = np.where(self._off, 0.0, values)
+        reduced[self._held_diagonal] = 1.0
+        t2 = time.process_time()
+        # the CSR arrays read as CSC are the transpose: solve with it transposed
+        try:
+            dq = splu(csc_matrix((reduced, self.indices, self.indptr), shape=(self.n, self.n))).solve(rhs, trans="T")
+        except RuntimeError as exc:
+            raise np.linalg.LinAlgError(f"the system matrix is singular ({exc})") from exc
+        t3 = time.process_time()
+        dlam = r[self.held] + np.array([values[self.indptr[i]:self.indptr[i + 1]]
+                                        @ dq[self.indices[self.indptr[i]:self.indptr[i + 1]]] for i in self.held])
+        parts = self.time_parts_s
+        parts["forces"] += t1 - t0
+        parts["assembly"] += t2 - t1
+        parts["factorisation"] += t3 - t2
+        parts["glue"] += time.process_time() - t3
+        return dq, dlam
+
+    # ---- the interface
+    def solve(self, max_iterations, relative_tolerance, absolute_tolerance_N) -> NewtonOutcome:
+        sd = self.mbs.systemData
+        t0 = time.process_time()
+        # Exudyn's solver starts from the initial configuration (it copies it to the current one)
+        q_sys = np.array(sd.GetODE2Coordinates(configuration=exu.ConfigurationType.Initial))
+        q = q_sys[self.index]
+        lam = np.zeros(len(self.held))              # Exudyn starts Newton with zero multipliers
+        loads = self._load_vector()
+        if self._guide is not None:
+            # Exudyn's static solver evaluates the sheave's damping -D q̇ at the nodes' initial rates
+            # (a static solve never updates them): a constant force, kept so that the iterates match
+            rows, D = self._guide[0], self._guide[4]
+            rates = np.asarray(sd.GetODE2Coordinates_t(configuration=exu.ConfigurationType.Initial))[self.index]
+            loads[rows] -= D @ rates[rows]
+        # the rig holds its coordinates at the start's position (a steady model's drive does not move)
+        offset = np.zeros(len(self.held))
+        self.time_parts_s["glue"] += time.process_time() - t0
+        iterations = factorisations = 0
+        converged, message = False, ""
+        try:
+            r = self._forces(q, lam, loads)
+            c = q[self.held] - offset
+            residual = initial = float(np.sqrt(r @ r + c @ c))
+            if initial <= absolute_tolerance_N:
+                initial = 2.0 * absolute_tolerance_N     # at least one step
+            while not converged and iterations < max_iterations:
+                iterations += 1
+                try:
+                    dq, dlam = self._newton_step(q, r, c)
+                except np.linalg.LinAlgError as exc:
+                    message = f"Newton: {exc}"
+                    break
+                factorisations += 1
+                q = q - dq
+                lam = lam - dlam
+                r = self._forces(q, lam, loads)
+                c = q[self.held] - offset
+                residual = float(np.sqrt(r @ r + c @ c))
+                if residual > initial and iterations <= 1:   # Exudyn's adaptInitialResidual
+                    initial = residual
+                if residual / initial <= relative_tolerance or residual <= absolute_tolerance_N:
+                    converged = True
+                elif not (np.all(np.isfinite(q)) and np.all(np.isfinite(lam))):
+                    message = "Newton: the iterate is not finite (diverged)"
+                    break
+        except (ArithmeticError, ValueError) as exc:   # a degenerate state in the kernels
+            message = f"{type(exc).__name__}: {exc}".strip()
+            residual = float("inf")
+            r = np.full(self.n, np.nan)
+        if not converged and not message:
+            message = f"Newton did not converge in {max_iterations} iterations (residual {residual:.3g} N)"
+        t1 = time.process_time()
+        q_sys[self.index] = q
+        lam_sys = np.zeros(self.n_ae)
+        lam_sys[self.ae] = lam
+        sd.SetODE2Coordinates(q_sys)
+        sd.SetAECoordinates(lam_sys)
+        if np.all(np.isfinite(r)):
+            self._residual = np.empty(self.n)
+            self._residual[self.index] = r
+        else:
+            self._residual = np.full(self.n, np.nan)
+        self.time_parts_s["glue"] += time.process_time() - t1
+        return NewtonOutcome(converged, message, residual, iterations, factorisations)
+
+    def system_residual(self) -> np.ndarray:
+        return self._residual.copy()
+
+    def equilibrium_residual_N(self) -> float:
+        """Norm [N] of the last residual less the pseudo-time spring's force: the unregularised
+        equilibrium's residual at the state reached (what ``SteadySolver.true_residual`` computes
+        from :meth:`system_residual`, without reading the state back from Exudyn)."""
+        if not np.all(np.isfinite(self._residual)):
+            return float("nan")
+        r = self._residual[self.index] - self._last_spring
+        return float(np.sqrt(r @ r))
+
+
+def static_backend(model, spring, settings_of, choice: str):
+    """The backend for ``[solver] static_solver`` = ``choice``: ours where the model allows it
+    (:func:`own_newton_unsupported`), else Exudyn's; and why Exudyn's when ours was asked for."""
+    if choice == "exucable":
+        why = own_newton_unsupported(model, spring)
+        if not why:
+            return OwnStaticNewton(model, spring), ""
+        return ExudynStatic(model.mbs, settings_of), why
+    return ExudynStatic(model.mbs, settings_of), ""
