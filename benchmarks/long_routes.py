@@ -10,7 +10,8 @@ exucable, parses the scenario, builds the models (the rule's coarse mesh for the
 solved mesh, the start layout and both rope references included), solves steady, solves the error
 bar's coarse mesh, post-processes (tension profile, check-point loads, pressure, bends, trust),
 writes the result files and draws the three figures, each stage timed on its own (wall and CPU
-time). The parent times the whole child process (interpreter start to exit, wall and CPU). Printed
+time). The parent times the whole child process (interpreter start to exit, wall and CPU; the
+child ends as `exucable run` does, with exucable.cli.end_process where the tree has it). Printed
 per length: elements, check points, Newton iterations of the solve and of the error bar's, the CPU
 time of the whole process and of each stage with its share (on a shared, loaded machine the CPU
 times are the ones to compare), the rope references' part of the build, the solve's CPU time per
@@ -572,7 +573,13 @@ def main() -> None:
     if args.case:
         print(json.dumps(one_case(float(args.case), figures=not args.no_figures, cold=args.cold,
                                   cable_element=args.cable_element, static_solver=args.static_solver)))
-        return
+        # the child ends as `exucable run` does (exucable.cli.end_process: no interpreter
+        # finalisation); a tree from before that (--before) ends with the interpreter's exit
+        try:
+            from exucable.cli import end_process
+        except ImportError:
+            return
+        end_process(0)
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
     rows, pairs = [], []
     for L in lengths:

@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from .errors import ExucableError
 
-__all__ = ["main", "SUBCOMMANDS"]
+__all__ = ["main", "console_main", "end_process", "SUBCOMMANDS", "ENDS_WITH_OS_EXIT"]
 
 # name -> (module in exucable.commands with add_arguments(parser) and main(args) -> int, one-line help)
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
@@ -98,6 +99,41 @@ def main(argv=None) -> int:
         return 3
 
 
+#: Commands whose process, started as the ``exucable`` command, ends with ``os._exit`` once
+#: :func:`main` has returned: by then every output file is written (atomically, through
+#: exucable.io, fsynced and renamed) and the figures' helper process joined, and a normal
+#: interpreter exit would spend 0.3-0.5 s of CPU finalising the loaded extensions (Exudyn, numba's
+#: kernels; docs/decisions/0006-exit-without-finalising.md).
+ENDS_WITH_OS_EXIT = frozenset({"run", "plan"})
+
+
+def end_process(code: int) -> None:
+    """End this process at once with exit status ``code``: stdout and stderr flushed, then
+    ``os._exit`` (no interpreter finalisation, no atexit handlers). For the console entry point
+    only, after :func:`main` returned; never when exucable runs inside another program.
+
+    A stream that cannot be flushed (a closed pipe) makes the status 120 where it was 0, as the
+    interpreter's own exit does."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            if stream is not None:
+                stream.flush()
+        except (OSError, ValueError):
+            code = code or 120
+    os._exit(code)
+
+
+def console_main() -> None:
+    """The ``exucable`` command (and ``python -m exucable``): :func:`main` on the process's
+    arguments, then exit with its status; a command of :data:`ENDS_WITH_OS_EXIT` skips the
+    interpreter's finalisation (:func:`end_process`)."""
+    argv = sys.argv[1:]
+    code = main(argv)
+    if _command_in(argv) in ENDS_WITH_OS_EXIT:
+        end_process(code)
+    sys.exit(code)
+
+
 def _one_line(exc: BaseException, limit: int = 300) -> str:
     text = " ".join(str(exc).split())
     return text if len(text) <= limit else text[:limit] + " ..."
@@ -121,4 +157,4 @@ def _logged(command: str, argv) -> str:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    console_main()

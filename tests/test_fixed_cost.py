@@ -49,6 +49,25 @@ def test_a_run_of_a_planar_route_imports_only_what_it_uses(tmp_path):
     assert not modules & {"matplotlib", "dask", "distributed"}, modules & {"matplotlib", "dask", "distributed"}
 
 
+def test_the_rope_of_a_route_with_tilted_bends_imports_no_ode_integrator():
+    """Bends out of the horizontal with weight (every long route with slopes) are integrated by
+    Chebyshev collocation with numpy, not scipy.integrate, whose import (with scipy.optimize and
+    scipy.special) is 0.2-0.5 s of a run; solve_ivp stays for pieces where the tension reaches zero."""
+    code = textwrap.dedent("""
+        import json, sys
+        from exucable.geometry import Bend, Straight, centreline_from_path
+        from exucable.quasistatic.rope import solve_rope
+        route = centreline_from_path([0, 0, 0], [0.98, 0, 0.2], [Straight(50.0), Bend(15.0, 10.0, turn="up"),
+                                     Straight(50.0), Bend(15.0, 10.0, turn="left"), Straight(50.0)])
+        solve_rope(route, 0.2, 14.7, 500.0)
+        print(json.dumps(sorted(m for m in sys.modules if m.startswith("scipy."))))
+    """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    loaded = {m.split(".")[1] for m in json.loads(out.stdout.strip().splitlines()[-1])}
+    assert not loaded & {"integrate", "optimize", "special"}, loaded
+
+
 def test_a_kernel_says_whether_numba_has_it_cached(tmp_path):
     """``Kernel.is_cached`` (behind the first-run announcement and ``exucable compile --check``): False
     in an empty cache, True once a call compiled it there, and False again after a source changed."""

@@ -32,9 +32,11 @@ import numpy as np
 from exucable.errors import ModelError
 
 # scipy.integrate and scipy.optimize are imported where needed: a route of straights and
-# gravity-free or horizontal bends is integrated in closed form (_closed_form), and importing them
-# (with the scipy.spatial, scipy.sparse and scipy.special they pull in) is a third of a second of an
-# `exucable run` of such a route (the fixed cost, docs/performance.md).
+# gravity-free or horizontal bends is integrated in closed form (_closed_form), the other curved
+# pieces by Chebyshev collocation (_chebyshev_piece, numpy only), and importing them (with the
+# scipy.sparse and scipy.special they pull in) is a quarter to a third of a second of an
+# `exucable run` (the fixed cost, docs/performance.md). solve_ivp remains the fallback where the
+# collocation does not reach its tolerance or the tension reaches zero inside a piece.
 
 __all__ = ["RopeSolution", "solve_rope", "solve_rope_for_pull_force", "rope_pull_force_N", "sidewall_pressure_N_per_m"]
 
@@ -259,6 +261,108 @@ def _closed_form(curve, s_min: float, s_max: float, mu: float, w: float):
     return None
 
 
+# Chebyshev collocation of the rope ODE on a curved piece without a closed form (a bend or helix
+# with weight out of its plane). On such a piece t(s) and κn(s) are trigonometric in s and the rate
+# is smooth in T wherever the load T κn − w g⊥ does not vanish, so the tension is analytic
+# there and a polynomial of modest degree on a short interval reproduces it to rounding: the
+# piece is cut into intervals turning the tangent by at most _CHEB_MAX_TURN_RAD, T is collocated
+# at _CHEB_DEGREE + 1 Chebyshev points of each (Newton on T = T₀ + ∫ rate), and an interval whose
+# last two Chebyshev coefficients exceed _CHEB_TOLERANCE of its tension is halved. Against DOP853
+# at rtol 1e-11 the pulling force agrees to ≤ 2.4e-12 on the shipped routes (tests/test_rope.py).
+_CHEB_DEGREE = 20
+_CHEB_MAX_TURN_RAD = 0.5
+_CHEB_TOLERANCE = 1e-14
+_CHEB_MAX_HALVINGS = 6
+_CHEB_NEWTON_ITERATIONS = 30
+_CHEB_CACHE: dict = {}
+
+
+def _chebyshev_matrices(n: int):
+    """Chebyshev–Lobatto points x ∈ [−1, 1] (ascending), the map from values there to Chebyshev
+    coefficients, and the matrix giving ∫₋₁^x of the interpolant at those points."""
+    if n not in _CHEB_CACHE:
+        cheb = np.polynomial.chebyshev
+        x = -np.cos(np.pi * np.arange(n + 1) / n)
+        to_coefficients = np.linalg.inv(cheb.chebvander(x, n))
+        antiderivative = np.column_stack([cheb.chebint(np.eye(n + 1)[j], lbnd=-1.0) for j in range(n + 1)])
+        _CHEB_CACHE[n] = (x, to_coefficients, cheb.chebvander(x, n + 1) @ antiderivative @ to_coefficients)
+    return _CHEB_CACHE[n]
+
+
+def _chebyshev_interval(piece, s_min, s_max, mu, w, a, b, T_a):
+    """T on [a, b] from T(a) = ``T_a`` [N]: (node arc lengths, tensions, Chebyshev coefficients);
+    None where Newton does not converge or the coefficients do not fall below the tolerance (a
+    shorter interval may do), False where the tension does not stay positive (slack: solve_ivp's
+    event finds where it ends)."""
+    x, to_coefficients, integral = _chebyshev_matrices(_CHEB_DEGREE)
+    half = 0.5 * (b - a)
+    s = a + (x + 1.0) * half
+    s[0], s[-1] = a, b
+    u = np.clip(s, s_min, s_max) - piece.s_start_m     # as the ODE's rate: this piece's frame only
+    t = _as_rows(piece.tangent(u), s.size)
+    kn = _as_rows(piece.curvature_vector(u), s.size)
+    tz = t[:, 2]
+    g = w * tz[:, None] * t
+    g[:, 2] -= w                                           # −w (e_z − (e_z·t) t)
+    Q = half * integral
+    T = np.full(s.size, float(T_a))
+    for _ in range(_CHEB_NEWTON_ITERATIONS):
+        load = T[:, None] * kn + g
+        norm = np.sqrt(np.einsum("ij,ij->i", load, load))
+        if not np.all(norm > 0.0):
+            return None
+        rate = mu * norm + w * tz
+        d_rate = mu * np.einsum("ij,ij->i", load, kn) / norm
+        residual = T - T_a - Q @ rate
+        step = np.linalg.solve(np.eye(s.size) - Q * d_rate[None, :], -residual)
+        T = T + step
+        if np.max(np.abs(step)) <= 1e-15 * max(np.max(np.abs(T)), 1e-300):
+            break
+    else:
+        return None
+    if not np.all(T[1:] > 0.0):
+        return False
+    c = to_coefficients @ T
+    if np.max(np.abs(c[-2:])) > _CHEB_TOLERANCE * np.max(np.abs(T)):
+        return None
+    return s, T, c
+
+
+def _chebyshev_piece(piece, s_min, s_max, mu, w, s0, s1, T0):
+    """The rope ODE from ``T0`` [N] at ``s0`` to ``s1`` [m] on one curved piece by Chebyshev
+    collocation: (T(s1), [(s_lo, s_hi, fn, nodes), ...]), or None (the caller integrates the piece
+    with solve_ivp: the tension approaches zero, or the load vanishes and the rate has a kink)."""
+    turns = abs(piece.curvature_1_per_m) * (s1 - s0) / _CHEB_MAX_TURN_RAD
+    edges = np.linspace(s0, s1, max(1, math.ceil(turns)) + 1)
+    # intervals still to do, first last, each with the number of halvings that made it
+    todo = [(a, b, 0) for a, b in zip(edges[-2::-1], edges[:0:-1])]
+    out, T = [], float(T0)
+    while todo:
+        a, b, depth = todo.pop()
+        found = _chebyshev_interval(piece, s_min, s_max, mu, w, a, b, T)
+        if found is False:
+            return None
+        if found is None:
+            if depth >= _CHEB_MAX_HALVINGS:
+                return None
+            middle = 0.5 * (a + b)
+            todo += [(middle, b, depth + 1), (a, middle, depth + 1)]
+            continue
+        nodes, values, c = found
+        out.append((a, b, _chebyshev_fn(c, a, b), nodes))
+        T = float(values[-1])
+    return T, out
+
+
+def _chebyshev_fn(coefficients, a: float, b: float):
+    """T(s) [N] of one collocation interval [a, b] [m], vectorised."""
+    def fn(s):
+        x = (2.0 * np.asarray(s, dtype=float) - (a + b)) / (b - a)
+        return np.maximum(np.polynomial.chebyshev.chebval(x, coefficients), 0.0)
+
+    return fn
+
+
 class _OnePiece:
     """One piece of a centreline answering ``tangent`` and ``curvature_vector`` at centreline arc
     lengths inside it, as the centreline would (the same piece method at the same local arc
@@ -334,6 +438,14 @@ def _integrate(curve, mu_straight: float, w: float, s0: float, s1: float, traili
                     branches.append((s, s_end, plo, phi, fn, np.array([s, s_end])))
                 s = s_end
                 continue
+            if curved:
+                collocated = _chebyshev_piece(piece, s_min, s_max, mu, w, s, hi, tension)
+                if collocated is not None:
+                    tension, parts = collocated
+                    if dense:
+                        branches.extend((a, b, plo, phi, fn, nodes) for a, b, fn, nodes in parts)
+                    s = hi
+                    continue
             from scipy.integrate import solve_ivp
 
             sol = solve_ivp(rate, (s, hi), [tension], method="DOP853", rtol=_RTOL, atol=_ATOL_N,
@@ -397,7 +509,8 @@ def solve_rope(centreline, friction: float, weight_per_length_N_per_m: float = 0
 
     Integrates ``dT/ds = μ|T κn − w(e_z − (e_z·t)t)| + w(e_z·t)`` piece by piece (restarting at every piece
     boundary, where κ jumps) in closed form where it has one (straights; bends without weight or
-    horizontal ones, see ``_closed_form``), elsewhere with scipy's DOP853 at rtol 1e-11.
+    horizontal ones, see ``_closed_form``), on the other curved pieces by Chebyshev collocation
+    (``_chebyshev_piece``, to ~1e-14), elsewhere with scipy's DOP853 at rtol 1e-11.
 
     If the ODE would drive the tension negative (a downhill stretch steeper than the friction angle,
     tan θ > μ), the tension is clamped at 0: the cable runs slack there, and the tension rises again from 0
