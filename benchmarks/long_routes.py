@@ -311,9 +311,11 @@ def compare(b: dict, a: dict) -> str:
     def rel(key):
         x, y = b[key], a[key]
         return "-" if x is None or y is None else f"{y / x - 1:+.1e}"
+    same = "bit for bit" if b["pull_force_N"] == a["pull_force_N"] else "NOT bit for bit"
     return (f"{'':9s}CPU after/before: {ratios}; change of the pulling force {rel('pull_force_N')}, "
             f"of the rope with clearance's {rel('rope_clearance_pull_force_N')}; Newton "
-            f"{b['newton_iterations']}/{b['error_bar_newton_iterations']} -> {a['newton_iterations']}/{a['error_bar_newton_iterations']}")
+            f"{b['newton_iterations']}/{b['error_bar_newton_iterations']} -> {a['newton_iterations']}/{a['error_bar_newton_iterations']}"
+            f"\n{'':9s}pulling force {b['pull_force_N']!r} -> {a['pull_force_N']!r} N ({same})")
 
 
 def per_iteration(b: dict, a: dict, names=("exudyn", "compiled")) -> str:

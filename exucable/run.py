@@ -25,7 +25,7 @@ from .post.pressure import bend_table, default_window_m, pressure_profile
 from .post.tension import SteadyState, detect_steady_state, profile_stations_m
 from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, not_steady_fix, pull_force_uncertainty
 
-__all__ = ["run_scenario", "contact_profile"]
+__all__ = ["run_scenario", "contact_profile", "one_blas_thread"]
 
 
 def check_point_loads(model) -> dict | None:
@@ -75,18 +75,23 @@ def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | N
     return {"s_conduit_m": s, "normal_force_per_length_N_per_m": p, "penetration_m": pen}, peak
 
 
-def cable_tension_along_conduit(model) -> tuple[np.ndarray, np.ndarray]:
+def axis_gauge(model) -> AxisGauge:
+    """The :class:`~exucable.post.trust.AxisGauge` of ``model``'s (pull-oriented) conduit."""
+    return AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)
+
+
+def cable_tension_along_conduit(model, gauge: AxisGauge | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The cable's tension at its nodes [N] (from its loads' equilibrium, :meth:`Model.tension_N`) and
-    their places along the scenario's conduit [m]."""
+    their places along the scenario's conduit [m]; ``gauge``: :func:`axis_gauge` of the model, if made."""
     q, _ = model.coordinates()
     Le = model.layout.element_length_m
     x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
     T = model.tension_N(x_nodes)
-    _, s = AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)(q[:, :3])
+    _, s = (axis_gauge(model) if gauge is None else gauge)(q[:, :3])
     return conduit_s(model, s), T
 
 
-def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
+def _pressure(model, points, rope, gauge: AxisGauge | None = None) -> tuple[dict, list, dict | None]:
     """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.post.pressure)."""
     if points is None or rope is None:
         return {}, [], None
@@ -95,7 +100,7 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
     rope_p = rope.sidewall_pressure_N_per_m
     rope_s = conduit_s(model, rope.s_conduit_m)     # the rope is solved on the pull-oriented conduit
     prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m)
-    s_c, T_c = cable_tension_along_conduit(model)
+    s_c, T_c = cable_tension_along_conduit(model, gauge)
     lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
     bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
                        rope.tension_N, rope_p, w, lam, model.scenario.pull.direction,
@@ -111,15 +116,16 @@ def _pressure(model, points, rope) -> tuple[dict, list, dict | None]:
     return info, bends, prof
 
 
-def _with_final_contact(model, h: dict) -> dict:
+def _with_final_contact(model, h: dict, gauge: AxisGauge | None = None, tension_N=None) -> dict:
     """``h`` with the contact columns (``max_penetration_m``, ``max_axis_offset_m`` and its place) of
     the model's current state in its last row, NaN before it: a steady solve's history records the
-    forces of its pseudo-time steps only, and its last row is the converged state."""
+    forces of its pseudo-time steps only, and its last row is the converged state. ``gauge``,
+    ``tension_N``: the model's :func:`axis_gauge` and its tension profile now, if the caller has them."""
     from .model.recorder import History, record_state
 
     last = History()
-    record_state(model, float(h["time_s"][-1]), last,
-                 AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m))
+    record_state(model, float(h["time_s"][-1]), last, axis_gauge(model) if gauge is None else gauge,
+                 tension_N=tension_N)
     rows = len(h["time_s"])
     columns = {}
     for key in ("max_penetration_m", "max_axis_offset_m", "max_axis_offset_s_conduit_m"):
@@ -219,16 +225,33 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
         return solve
 
     if out_dir is None:
-        return checked_solver()(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
+        with one_blas_thread():
+            return checked_solver()(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
     # the figures' helper process is forked before anything loads Exudyn (or was, by the caller), to
     # import matplotlib beside the solve; refused input stops it at once, before anything is written
     started = plots if isinstance(plots, Figures) else Figures() if plots else contextlib.nullcontext(False)
     with started as figures:
         solve = checked_solver()
-        with owned_out_dir(out_dir) as out:
+        with owned_out_dir(out_dir) as out, one_blas_thread():
             result = solve(sc, quiet, steady_stop, refine, check_points_per_element, error_bar)
             write_results(out, result, plots=figures)
     return result
+
+
+def one_blas_thread():
+    """A context in which numpy's and scipy's BLAS run on one thread; the former limits come back on exit.
+
+    Why: a run's linear algebra is vectors and thin bands (the banded LU's half bandwidth is 11), far
+    below the size where BLAS threads pay; OpenBLAS still splits every product of more than ~10 000
+    entries over its threads, whose start-up and spin-wait cost more than they save. Measured
+    (``benchmarks/long_routes.py --lengths 10000 --no-figures``, one BLAS thread against OpenBLAS's
+    default two, one run each on a quiet machine): the 10 km run 10.83 → 8.96 s CPU, 11.34 → 8.99 s
+    wall; its rope references 1.20 → 0.51 s. The limit is process-wide while the run lasts: another
+    thread of the caller's doing linear algebra meanwhile runs on one BLAS thread too.
+    """
+    from threadpoolctl import threadpool_limits   # at call time: importing exucable changes nothing
+
+    return threadpool_limits(limits=1, user_api="blas")
 
 
 def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_per_element,
@@ -324,7 +347,10 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     points = check_point_loads(model)
     cprof, peak_line_load = contact_profile(points)
     rope = model.rope
-    pressure_info, bends, pressure_prof = _pressure(model, points, rope)
+    # one gauge of the conduit's axis for the pressure table and the final contact check (built
+    # from up to 200 000 centreline samples)
+    gauge = axis_gauge(model) if model.kernel is not None else None
+    pressure_info, bends, pressure_prof = _pressure(model, points, rope, gauge)
     has_history = bool(len(h["time_s"]))
     pull_force_N = float(np.mean(h["pull_force_N"][i0:])) if has_history else None
     warnings = list(model.mesh.warnings) if model.mesh is not None else []
@@ -346,7 +372,8 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
                             "started from the rope instead")
     # a steady solve's pseudo-time steps record forces only: the trust checks of the wall (penetration,
     # the axis beyond the wall) read the converged state's contact, or they would never run
-    trusted_h = _with_final_contact(model, h) if sp.mode == "steady" and out.status != "failed" and has_history else h
+    trusted_h = (_with_final_contact(model, h, gauge, tension_N=N)
+                 if sp.mode == "steady" and out.status != "failed" and has_history else h)
     status, flags = _assess(model, out, st, trusted_h, pull_force_N)
     if not is_loaded(sc):
         warnings.append("no load acts on the cable (no gravity, pull.back_tension 0, no pull.force): its "

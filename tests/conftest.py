@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # test modules left out of the quick tier: each runs whole simulations, sweeps, an install or numba in
 # fresh processes, and took 15 s or more of a full run (pytest --durations=0)
 HEAVY_MODULES = frozenset({
-    "test_api", "test_beam_conduit", "test_benchmarks", "test_bundle_bends", "test_bundle_dynamic", "test_bundle_jam",
+    "test_api", "test_beam_conduit", "test_benchmarks", "test_bundle_bends", "test_bundle_upbend", "test_bundle_dynamic", "test_bundle_jam",
     "test_examples", "test_fixed_cost", "test_installed", "test_plan_multibody",
     "test_run", "test_steady_start", "test_stiff_bend", "test_sweep", "test_validate",
 })

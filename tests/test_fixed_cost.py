@@ -104,3 +104,32 @@ def test_the_compile_warm_up_runs_a_bundle_so_the_cable_cable_kernel_is_compiled
     d, D = 2 * 0.015, 2 * 0.05
     rigid = 1.0 / np.sqrt(1.0 - (d / (D - d)) ** 2)
     assert 1.0 < bundle["weight_correction_factor"] < rigid * 1.02
+
+
+def _blas_threads() -> list[int]:
+    from threadpoolctl import threadpool_info
+
+    return [pool["num_threads"] for pool in threadpool_info() if pool["user_api"] == "blas"]
+
+
+def test_a_run_solves_on_one_blas_thread_and_gives_the_former_limit_back(monkeypatch):
+    """OpenBLAS's threads cost a 10 km run ~20 % of its CPU (exucable.run.one_blas_thread): the
+    solve must see one thread, and the caller's own limit must be back afterwards."""
+    import importlib
+
+    from exucable.scenario.specs import load_scenario
+
+    run_module = importlib.import_module("exucable.run")   # the package's ``run`` is the API function
+
+    seen = []
+
+    def fake_solve(*args):
+        seen.append(_blas_threads())
+        return "solved"
+
+    monkeypatch.setattr(run_module, "_solve", fake_solve)
+    before = _blas_threads()
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "scenarios" / "fast" / "paper_ex2_bend90.toml")
+    assert run_module.run_scenario(sc) == "solved"
+    assert seen and seen[0] and all(n == 1 for n in seen[0])
+    assert _blas_threads() == before

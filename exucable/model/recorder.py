@@ -57,16 +57,18 @@ def expected_drift_N_per_s(cable) -> float:
     return float(getattr(cable, "reference_drift_N_per_s", 0.0))
 
 
-def record_state(cable, t: float, history: History, gauge: AxisGauge | None = None) -> None:
+def record_state(cable, t: float, history: History, gauge: AxisGauge | None = None,
+                 tension_N: np.ndarray | None = None) -> None:
     """Append the current pulling force, trailing tension and maximum tension (from the equilibrium
     of the cable's loads, :meth:`exucable.model.build.CableInConduit.tension_N`) to ``history``, and
     (with a contact kernel) the largest penetration [m] and the cable axis's largest distance from
     the conduit's axis [m] with its place s [m] along the scenario's conduit (``gauge``:
-    :class:`exucable.post.trust.AxisGauge` of the pull-oriented conduit)."""
+    :class:`exucable.post.trust.AxisGauge` of the pull-oriented conduit). ``tension_N``: that
+    tension [N] at :func:`exucable.post.tension.profile_stations_m`'s stations, when the caller has it."""
     q, v = cable.coordinates()
     # the tension from the equilibrium of the cable's loads, at the tension profile's stations
     # (exucable.post.tension.equilibrium_tension; EA·ε spikes next to the bend ends' point loads)
-    N = cable.tension_N(profile_stations_m(cable.layout.element_length_m))
+    N = cable.tension_N(profile_stations_m(cable.layout.element_length_m)) if tension_N is None else tension_N
     trail = cable.trailing_reaction_N()
     if trail is None:
         trail = float(N[0])
