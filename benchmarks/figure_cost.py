@@ -9,20 +9,23 @@ by other jobs on a shared machine than wall time). The target is figures within 
 the rest" is the figures' CPU time that did not add to the wall time (CPU cost less wall cost): the
 helper's import of matplotlib during the solve and its drawing in several processes at once.
 
-Part 2 (skipped by ``--quick``): the figures' critical path, from CPU times, which a saturated
-machine inflates less than wall times, per mode in a fresh child process: it runs the scenario with
-a helper started before (:class:`exucable.output.figure_process.Figures`) and without figures; its
-extra CPU, the helper's warm-up (beside the solve), the helper's own drawing after the results
-arrived and its forks' (their total and the longest). On two free cores the figures add to the wall
-time about the extra CPU plus the longer of the costliest drawing process and all the drawing CPU
-over two cores, once the warm-up (about 0.6 s CPU) ends before the solve does (a fresh process's
-imports, build and solve after the fork: part 1's ``--no-plots`` CPU, less ~0.4 s of imports before it).
+Part 2 (skipped by ``--quick``): the figures' critical path, from CPU times, which a saturated machine
+inflates less than wall times, per mode in a fresh child process: it runs the scenario with a helper
+started before (:class:`exucable.output.figure_process.Figures`) and without figures; its extra CPU,
+the helper's warm-up (beside the solve), the helper's own drawing after the results arrived and its
+forks' (their total and the longest). On two free cores the figures add to the wall time about the
+extra CPU plus the longer of the costliest drawing process and all the drawing CPU over two cores, once
+the warm-up (about 0.6-0.75 s CPU, the frames included) ends before the solve does (a fresh process's
+imports, build and solve after the fork: part 1's ``--no-plots`` CPU, less ~0.4 s of imports before
+it).
 
 Part 3, in this process (skipped by ``--quick``): the parts of the figures' cost, in CPU seconds: the
-import of matplotlib's Figure and Agg canvas, then each figure drawn and written (first call, then
-the median of ``--repeat`` warm calls), from one solved result; then all figures drawn in one process
-and each in a process of its own at once (:func:`exucable.output.figure_process.draw_in_parallel`, as
-the helper does), wall and CPU (all processes) [s], medians of ``--repeat``.
+import of matplotlib's Figure and Agg canvas, then each figure drawn and written (first call, then the
+median of ``--repeat`` warm calls, on a new figure and on a frame built ahead as the helper does), from
+one solved result, and its PNG encoding at Pillow's default zlib level and at the figures' level 1;
+then all figures drawn in one process and each in a process of its own at once
+(:func:`exucable.output.figure_process.draw_in_parallel`, as the helper does), wall and CPU (all
+processes) [s], medians of ``--repeat``.
 
 ``--before TREE`` runs parts 1 and 2 also with the exucable package of the source tree TREE (``git
 archive <commit> | tar -x -C TREE``; copy ``exucable/contact/__pycache__`` into it with the sources'
@@ -108,29 +111,36 @@ def whole_process(repeat: int, modes: list[str], before: str | None = None) -> N
 
 
 def breakdown(repeat: int) -> None:
-    """CPU seconds of matplotlib's import and of each figure, in this process."""
+    """CPU seconds of matplotlib's import and of each figure, in this process: drawn on a new figure
+    and on a frame built ahead (as the helper does), building alone, and the PNG encoding at
+    Pillow's default level and at the level the figures use."""
     from exucable.run import run_scenario
     result = run_scenario(SCENARIO, None, plots=False)
     c0 = time.process_time()
     import matplotlib.backends.backend_agg  # noqa: F401
     import matplotlib.figure  # noqa: F401
     c_import = time.process_time() - c0
-    from exucable.output.figure_process import draw_figures, draw_in_parallel
+    from exucable.output.figure_process import FRAME_TICKS, build_frames, draw_figures, draw_in_parallel
     from exucable.plots import results as plots
     figures = {"pull_force.png": plots.plot_pull_force, "tension_profile.png": plots.plot_tension_profile,
                "pressure.png": plots.plot_pressure}
-    print("\n| part | CPU, first call [s] | CPU, warm median [s] | of it building the figure, no rendering [s] |"
-          "\n|---|---|---|---|")
-    print(f"| import matplotlib.figure + backend_agg | {c_import:.3f} | | |")
+    print("\n| part | CPU, first call [s] | CPU, warm median [s] | on a frame built ahead [s] | of it building the "
+          "figure, no rendering [s] | PNG encoding, Pillow's default / level 1, least [s] |\n|---|---|---|---|---|---|")
+    print(f"| import matplotlib.figure + backend_agg | {c_import:.3f} | | | | |")
     save = plots.save_figure
     with tempfile.TemporaryDirectory() as tmp:
-        total_first = total_warm = 0.0
+        totals = [0.0, 0.0, 0.0]
         for name, draw in figures.items():
-            cpu, built = [], []
+            cpu, framed, built = [], [], []
             for _ in range(repeat + 1):
                 c0 = time.process_time()
                 draw(Path(tmp) / name, result)
                 cpu.append(time.process_time() - c0)
+            for _ in range(repeat):
+                frame = plots.FRAMES[name](FRAME_TICKS)
+                c0 = time.process_time()
+                draw(Path(tmp) / name, result, frame)
+                framed.append(time.process_time() - c0)
             try:
                 plots.save_figure = lambda fig, path, **kw: path       # the figure built, not rendered
                 for _ in range(repeat):
@@ -139,13 +149,18 @@ def breakdown(repeat: int) -> None:
                     built.append(time.process_time() - c0)
             finally:
                 plots.save_figure = save
-            warm = statistics.median(cpu[1:])
-            total_first, total_warm = total_first + cpu[0], total_warm + warm
-            print(f"| {name} | {cpu[0]:.3f} | {warm:.3f} | {statistics.median(built):.3f} |")
-        print(f"| all three figures | {total_first:.3f} | {total_warm:.3f} | |")
+            encode = png_encoding(name, result, repeat)
+            warm, on_frame = statistics.median(cpu[1:]), statistics.median(framed)
+            for k, v in enumerate((cpu[0], warm, on_frame)):
+                totals[k] += v
+            print(f"| {name} | {cpu[0]:.3f} | {warm:.3f} | {on_frame:.3f} | {statistics.median(built):.3f} | "
+                  f"{encode[0]:.4f} / {encode[1]:.4f} |")
+        print(f"| all three figures | {totals[0]:.3f} | {totals[1]:.3f} | {totals[2]:.3f} | | |")
         large(result, repeat, Path(tmp))
         print("\n| all figures drawn | wall, median [s] | CPU, median [s] |\n|---|---|---|")
-        for what, draw in (("in one process", draw_figures), ("each in a process of its own, at once", draw_in_parallel)):
+        for what, draw in (("in one process", draw_figures),
+                           ("each in a process of its own, at once, on frames built ahead (as the helper)",
+                            lambda out, res: draw_in_parallel(out, res, None, build_frames()))):
             wall, cpu = [], []
             for _ in range(repeat):
                 c0, t0 = os.times(), time.perf_counter()
@@ -154,6 +169,33 @@ def breakdown(repeat: int) -> None:
                 wall.append(t1 - t0)
                 cpu.append(sum(c1[:4]) - sum(c0[:4]))       # this process and its waited-for children
             print(f"| {what} | {statistics.median(wall):.3f} | {statistics.median(cpu):.3f} |")
+
+
+def png_encoding(name: str, result, repeat: int) -> tuple[float, float]:
+    """CPU seconds of encoding figure ``name``'s pixels as PNG the way matplotlib does (Pillow, from
+    the RGBA buffer), at Pillow's default zlib level and at the figures'
+    (:data:`exucable.plots.results.PNG_KWARGS`): the least of ``4 * repeat`` interleaved encodings
+    each (a few ms: the least is the encoding's own cost, the rest is other jobs' noise)."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+    from exucable.plots import results as plots
+
+    draw = {"pull_force.png": plots.pull_force_figure, "tension_profile.png": plots.tension_profile_figure,
+            "pressure.png": plots.pressure_figure}[name]
+    fig = draw(result)
+    fig.set_dpi(plots.SAVE_DPI)
+    fig.canvas.draw()
+    rgba = np.asarray(fig.canvas.buffer_rgba())
+    levels = ({}, plots.PNG_KWARGS["pil_kwargs"])
+    cpu = [[], []]
+    for _ in range(4 * repeat):
+        for k, kwargs in enumerate(levels):
+            c0 = time.process_time()
+            Image.fromarray(rgba).save(io.BytesIO(), format="png", **kwargs)
+            cpu[k].append(time.process_time() - c0)
+    return min(cpu[0]), min(cpu[1])
 
 
 def large(result, repeat: int, tmp: Path) -> None:
@@ -203,6 +245,7 @@ def critical_path(repeat: int, mode: str) -> dict:
             run_scenario(SCENARIO, Path(tmp) / f"none{k}", plots=False, mode=mode)
             none = time.process_time() - c0
             with Figures(helper=True) as figures:
+                _wait_idle(figures._proc.pid)
                 c0 = time.process_time()
                 run_scenario(SCENARIO, Path(tmp) / f"fig{k}", plots=figures, mode=mode)
                 main = time.process_time() - c0 - none
@@ -218,8 +261,27 @@ def critical_path(repeat: int, mode: str) -> dict:
     return {k: statistics.median(v) for k, v in rows.items()}
 
 
+def _wait_idle(pid: int, settle_s: float = 0.3, timeout_s: float = 60.0) -> None:
+    """Wait until process ``pid`` has used no CPU for ``settle_s`` [s]: the helper's warm-up is over
+    and it waits for the results, as in a fresh run, whose imports, build and solve outlast it (here
+    the model's code is loaded already, and the results would come before the helper is ready).
+    Without ``/proc``, a fixed 3 s."""
+    stat = Path(f"/proc/{pid}/stat")
+    if not stat.exists():
+        time.sleep(3.0)
+        return
+    last, end = None, time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        fields = stat.read_text().rsplit(")", 1)[1].split()
+        cpu = int(fields[11]) + int(fields[12])           # utime + stime, in clock ticks
+        if cpu == last:
+            return
+        last = cpu
+        time.sleep(settle_s)
+
+
 CRITICAL_ROWS = (("main", "this process's extra CPU with figures (sending, writing beside the helper)"),
-                 ("warm_up_s", "helper: matplotlib's import and warm-up, beside the solve"),
+                 ("warm_up_s", "helper: matplotlib's import, warm-up and the figures' frames, beside the solve"),
                  ("draw_s", "helper: drawing its own figures after the results arrived"),
                  ("forks_draw_s", "the helper's forks: drawing the other figures at the same time, total"),
                  ("longest_fork_draw_s", "the helper's forks: the longest one"),
@@ -253,6 +315,7 @@ def main(argv=None) -> int:
     ap.add_argument("--before", metavar="TREE", help="also with the exucable package of source tree TREE, interleaved")
     ap.add_argument("--critical-path", metavar="MODE", help=argparse.SUPPRESS)   # a child of critical_paths
     ap.add_argument("--quick", action="store_true", help="smoke run: one round, no breakdown")
+    ap.add_argument("--no-whole", action="store_true", help="skip part 1 (the whole processes)")
     args = ap.parse_args(argv)
     if args.critical_path:
         print(json.dumps(critical_path(args.repeat, args.critical_path)))
@@ -260,7 +323,8 @@ def main(argv=None) -> int:
     if args.quick:
         args.repeat = 1
     modes = ["dynamic", "steady"] if args.steady else ["dynamic"]
-    whole_process(args.repeat, modes, args.before)
+    if not args.no_whole:
+        whole_process(args.repeat, modes, args.before)
     if not args.quick:
         critical_paths(args.repeat, modes, args.before)
         breakdown(args.repeat)

@@ -4,16 +4,19 @@ Importing matplotlib costs about as much CPU as drawing a run's three figures (`
 figure_cost.py``); in a fresh process both came after the solve and nearly doubled a short run. The
 helper is forked when the run starts (``exucable run`` forks it first thing, before anything loads
 Exudyn or numba), imports matplotlib and loads its fonts while this process imports, builds and solves
-the model, then waits. Once the results are post-processed they are sent to it through a pipe; it
-draws and writes the figures (atomically, :func:`exucable.io.save_figure`), each in a process of its
-own at once (:func:`draw_in_parallel`), while this process writes the data files and ``summary.json``;
-:meth:`Figures.write` returns once every figure is on disk. A helper given nothing to draw (bad input,
-an error) is killed at once; :class:`Figures` is a context manager, so an error or Ctrl-C stops it.
+the model, then builds each figure's frame (its figure, axes and ticks: what does not depend on the
+results, about a fifth of a figure's drawing, :func:`build_frames`) and waits. Once the results are
+post-processed they are sent to it through a pipe; it draws and writes the figures (atomically,
+:func:`exucable.io.save_figure`), each in a process of its own at once (:func:`draw_in_parallel`),
+while this process writes the data files and ``summary.json``; :meth:`Figures.write` returns once every
+figure is on disk. A helper given nothing to draw (bad input, an error) is killed at once;
+:class:`Figures` is a context manager, so an error or Ctrl-C stops it.
 
 Deterministic: the helper is a fork of this process (the same matplotlib settings) and draws with the
-same functions, so its files are byte for byte those drawn here. Whatever goes wrong in the helper (it
-died, timed out or raised) the figures are drawn here instead; an :class:`OSError` of the helper's
-write (a full disk) is raised here as it would have been.
+same functions, so its files are byte for byte those drawn here (a figure drawn on a frame built ahead
+is the same file as one drawn on a new figure). Whatever goes wrong in the helper (it died, timed out
+or raised) the figures are drawn here instead; an :class:`OSError` of the helper's write (a full disk)
+is raised here as it would have been.
 
 The helper is used only where forking is safe and pays: a POSIX system with the ``fork`` start method,
 one Python thread, not a daemonic process (a sweep's case process), no Exudyn loaded yet (a process
@@ -34,14 +37,17 @@ import time
 from pathlib import Path
 
 from ..plots.bundle import plot_cross_sections
-from ..plots.results import plot_pressure, plot_pull_force, plot_tension_profile
+from ..plots.results import FRAMES, plot_pressure, plot_pull_force, plot_tension_profile
 
-__all__ = ["Figures", "draw_figures", "draw_in_parallel", "figure_names", "helper_allowed", "HELPER_TIMEOUT_S",
-           "HELPER_DRAWS"]
+__all__ = ["Figures", "draw_figures", "draw_in_parallel", "figure_names", "helper_allowed", "build_frames",
+           "HELPER_TIMEOUT_S", "HELPER_DRAWS", "FRAME_TICKS"]
 
 #: Seconds to wait for the helper's figures before drawing them here instead. Drawing a 10 km run's
 #: three figures takes a few seconds; a helper taking this long is stuck (or the machine is).
 HELPER_TIMEOUT_S = 120.0
+#: Major ticks made ahead on each axis of a frame: the most these figures drew on a short run's
+#: axes (more are made when drawn if needed; those not needed are not drawn).
+FRAME_TICKS = 11
 
 
 def helper_allowed() -> tuple[bool, str]:
@@ -75,12 +81,26 @@ def _warm_up() -> None:
     fig.savefig(io.BytesIO(), format="png", dpi=40)
 
 
+def build_frames(ticks: int = FRAME_TICKS, until=None) -> dict:
+    """Each figure's frame (:data:`exucable.plots.results.FRAMES`: figure, axes, ``ticks`` major
+    ticks on each axis), built before the results exist; each is drawn on once. ``until``: a
+    callable checked before each frame; once it is true no more are built (the results arrived: a
+    figure without a frame is drawn on a new one, the same file, rather than wait)."""
+    frames = {}
+    for name, frame in FRAMES.items():
+        if until is not None and until():
+            break
+        frames[name] = frame(ticks)
+    return frames
+
+
 def _serve(conn) -> None:
     """The helper: warm up, wait for ``(out_dir, result)`` (or None: nothing to draw), draw, reply
     ``("ok", paths, cpu)`` (``cpu``: :attr:`Figures.helper_cpu_s`), ``("oserror", errno, strerror,
     filename)`` or ``("failed", reason)``."""
     try:
         _warm_up()
+        frames = build_frames(until=conn.poll)
         # matplotlib's objects, loaded now, stay: the collector need not walk them again while the
         # figures are drawn, nor write to their pages in the drawing forks (each write copies a page)
         gc.freeze()
@@ -90,7 +110,7 @@ def _serve(conn) -> None:
             return
         out, result = msg
         c0 = time.process_time()
-        paths = draw_in_parallel(Path(out), result, cpu)
+        paths = draw_in_parallel(Path(out), result, cpu, frames)
         cpu["draw_s"] = time.process_time() - c0
         reply = ("ok", [str(p) for p in paths], cpu)
     except EOFError:
@@ -105,7 +125,7 @@ def _serve(conn) -> None:
         conn.close()
 
 
-def _cross_sections(path, result) -> None:
+def _cross_sections(path, result, frame=None) -> None:
     x = result.cross_sections
     plot_cross_sections(path, x["panels"], x["inner_radius_m"], x["cable_radius_m"], title=result.summary.get("name", ""))
 
@@ -115,7 +135,7 @@ def figure_names(result) -> list[str]:
     return [name for name, has, _ in _FIGURES if has(result)]
 
 
-#: (file name, whether ``result`` has it, drawing function(path, result))
+#: (file name, whether ``result`` has it, drawing function(path, result, frame=None))
 _FIGURES = (("pull_force.png", lambda r: True, plot_pull_force),
             ("tension_profile.png", lambda r: r.tension_profile is not None, plot_tension_profile),
             ("pressure.png", lambda r: r.pressure_profile is not None, plot_pressure),
@@ -128,14 +148,17 @@ _DRAW = {name: draw for name, _, draw in _FIGURES}
 HELPER_DRAWS = "tension_profile.png"
 
 
-def draw_figures(out: Path, result, names=None) -> list[Path]:
+def draw_figures(out: Path, result, names=None, frames: dict | None = None) -> list[Path]:
     """Draw the run's figures into ``out`` (each written atomically); returns their paths. Called
     after the numbers are computed: a failure to draw must not hold back (or lose) a result.
-    ``names``: only these of :func:`figure_names` (default: all)."""
+    ``names``: only these of :func:`figure_names` (default: all). ``frames``: figures' frames built
+    ahead (:func:`build_frames`), each taken out of the dict as it is drawn on; the others are drawn
+    on new figures."""
     written = []
     for name in figure_names(result):
         if names is None or name in names:
-            _DRAW[name](out / name, result)
+            frame = frames.pop(name, None) if frames else None
+            _DRAW[name](out / name, result, frame=frame)
             written.append(out / name)
     return written
 
@@ -153,7 +176,7 @@ def _raise(reply: tuple) -> None:
     raise RuntimeError(reply[1])
 
 
-def _drawn_in_a_fork(out: Path, result, name: str) -> tuple[int, int] | None:
+def _drawn_in_a_fork(out: Path, result, name: str, frames: dict | None) -> tuple[int, int] | None:
     """Fork a process that draws figure ``name`` and reports through a pipe; returns (pid, the
     pipe's read end), or None if no process could be forked."""
     read_end, write_end = os.pipe()
@@ -168,7 +191,7 @@ def _drawn_in_a_fork(out: Path, result, name: str) -> tuple[int, int] | None:
         try:
             os.close(read_end)
             try:
-                draw_figures(out, result, [name])
+                draw_figures(out, result, [name], frames)
                 reply = ("ok", time.process_time())
             except BaseException as exc:  # reported; the forking process draws what is missing
                 reply = _outcome(exc)
@@ -183,7 +206,7 @@ def _drawn_in_a_fork(out: Path, result, name: str) -> tuple[int, int] | None:
     return pid, read_end
 
 
-def draw_in_parallel(out: Path, result, cpu: dict | None = None) -> list[Path]:
+def draw_in_parallel(out: Path, result, cpu: dict | None = None, frames: dict | None = None) -> list[Path]:
     """Draw the figures in processes of their own at once: each in a fork of this process but
     :data:`HELPER_DRAWS` (or, without it, the last), which is drawn here meanwhile; returns their
     paths in :func:`figure_names`' order. Drawing is CPU-bound and single-threaded, so on n free
@@ -191,21 +214,24 @@ def draw_in_parallel(out: Path, result, cpu: dict | None = None) -> list[Path]:
     cores, one fork drawing two figures took the time of both). The forks report through pipes;
     whatever a fork did not draw (it failed or died) is drawn here, and an :class:`OSError` of its
     write is raised here. ``cpu``: a dict given the forks' CPU times [s], ``forks_draw_s`` (total)
-    and ``longest_fork_draw_s``."""
+    and ``longest_fork_draw_s``. ``frames``: as :func:`draw_figures`'; a fork draws on its copy of
+    its figure's frame, and a figure drawn again here (its fork failed) on a new figure."""
     names = figure_names(result)
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     if len(names) < 2 or cores < 2:
-        return draw_figures(out, result)
+        return draw_figures(out, result, frames=frames)
     mine = HELPER_DRAWS if HELPER_DRAWS in names else names[-1]
     forks = {}
     for name in names:
         if name != mine:
-            forked = _drawn_in_a_fork(out, result, name)
+            forked = _drawn_in_a_fork(out, result, name, frames)
             if forked is not None:
                 forks[name] = forked
+                if frames:
+                    frames.pop(name, None)          # drawn on in the fork; if that fails, here on a new figure
     replies = {}
     try:
-        draw_figures(out, result, [n for n in names if n not in forks])
+        draw_figures(out, result, [n for n in names if n not in forks], frames)
     finally:
         for name, (pid, read_end) in forks.items():
             with os.fdopen(read_end, "rb") as f:
@@ -237,7 +263,7 @@ class Figures:
         self._proc = self._conn = None
         self._sent = False               # whether the helper was given results to draw
         self.helper_reason = ""          # why the figures were drawn here, if they were
-        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import and warm-up,
+        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import, warm-up and frames,
         #: beside the solve), ``draw_s`` (its drawing after the results arrived) and, where forks
         #: drew the other figures at the same time, ``forks_draw_s`` (their total) and
         #: ``longest_fork_draw_s``; empty otherwise

@@ -9,7 +9,9 @@ import numpy as np
 
 from ..io import new_figure, save_figure
 
-__all__ = ["plot_pull_force", "plot_tension_profile", "plot_pressure", "framed_figure", "thinned_scatter"]
+__all__ = ["plot_pull_force", "plot_tension_profile", "plot_pressure", "pull_force_figure", "tension_profile_figure",
+           "pressure_figure", "pull_force_frame", "tension_profile_frame", "pressure_frame", "FRAMES",
+           "framed_figure", "fit_frame", "thinned_scatter", "PNG_KWARGS"]
 
 # A fixed layout: margins [in] around the axes, room for y tick labels of up to ~8 characters and the
 # y label (left), the x tick labels and x label (bottom). Not ``bbox_inches="tight"``: that lays each
@@ -23,6 +25,14 @@ TITLE_OVERHANG_IN = 2.0
 #: The title's height in axes coordinates, given: without it matplotlib measures the x axis's tick
 #: labels once more at every draw to lift the title clear of labels on top, which these axes never have.
 TITLE_Y = 1.0
+#: How the figures are encoded: zlib level 1 instead of Pillow's default 6 writes the same pixels in
+#: about half the encoding time, for files ~5 % larger (``benchmarks/figure_cost.py``).
+PNG_KWARGS = {"pil_kwargs": {"compress_level": 1}}
+#: The axes sizes (width, height) [in] of the figures of one run.
+PULL_FORCE_AXES_IN, TENSION_AXES_IN, PRESSURE_AXES_IN = (5.425, 4.0), (5.425, 3.08), (6.2, 3.08)
+#: The pressure figure's bottom margin [in]: the x label, then the legend (two rows of 7 pt) 0.16
+#: axes heights down.
+PRESSURE_BOTTOM_IN = 0.16 * 3.08 + 0.45
 
 
 def _text_width_in(text: str, size_pt: float) -> float:
@@ -45,11 +55,12 @@ def _wrap_title(title: str, size_pt: float, width_in: float) -> list[str]:
     return textwrap.wrap(title, 10) or [""]
 
 
-def framed_figure(axes_in: tuple[float, float], title: str, title_pt: float, bottom_in: float = BOTTOM_IN):
-    """A figure whose subplot area is ``axes_in`` (width, height) [in], with the fixed margins and
-    room above for ``title`` (at ``title_pt`` points), centred on the axes as matplotlib places it.
-    A title wider than the axes widens both side margins to hold it (as a tight bounding box would),
-    up to :data:`TITLE_OVERHANG_IN`; a wider one is wrapped. Returns the figure and the title's text
+def fit_frame(fig, axes_in: tuple[float, float], title: str, title_pt: float, bottom_in: float = BOTTOM_IN) -> str:
+    """Size ``fig`` so that its subplot area is ``axes_in`` (width, height) [in], with the fixed
+    margins and room above for ``title`` (at ``title_pt`` points), centred on the axes as matplotlib
+    places it. A title wider than the axes widens both side margins to hold it (as a tight bounding
+    box would), up to :data:`TITLE_OVERHANG_IN`; a wider one is wrapped. The axes may exist already
+    (positions are fractions of the figure, applied when it is drawn). Returns the title's text
     (lines joined), to be set with ``fontsize=title_pt``."""
     import matplotlib
 
@@ -60,9 +71,60 @@ def framed_figure(axes_in: tuple[float, float], title: str, title_pt: float, bot
     pad_in = matplotlib.rcParams["axes.titlepad"] / 72.0
     top = 0.1 + pad_in + len(lines) * 1.25 * title_pt / 72.0
     w, h = left + w_axes + right, bottom_in + h_axes + top
-    fig = new_figure(figsize=(w, h))
+    fig.set_size_inches(w, h)
     fig.subplots_adjust(left=left / w, right=1.0 - right / w, bottom=bottom_in / h, top=1.0 - top / h)
-    return fig, "\n".join(lines)
+    return "\n".join(lines)
+
+
+def framed_figure(axes_in: tuple[float, float], title: str, title_pt: float, bottom_in: float = BOTTOM_IN):
+    """A new figure sized by :func:`fit_frame`; returns it and the title's text."""
+    fig = new_figure()
+    return fig, fit_frame(fig, axes_in, title, title_pt, bottom_in)
+
+
+def _prime_ticks(axes, ticks: int) -> None:
+    """Create ``ticks`` major ticks on each axis of ``axes`` now, not while drawing. A tick is five
+    artists (a fifth of a figure's drawing time goes into making them); matplotlib draws only as
+    many as there are tick locations and makes more if needed, so the picture does not change."""
+    if ticks > 0:
+        for ax in np.atleast_1d(axes):
+            ax.xaxis.get_major_ticks(ticks)
+            ax.yaxis.get_major_ticks(ticks)
+
+
+def pull_force_frame(ticks: int = 0):
+    """The pulling-force figure before any data: a figure and its two axes (pulling force above,
+    trailing tension below, sharing x), ``ticks`` major ticks made on each axis ahead. Sized when
+    drawn (:func:`pull_force_figure`)."""
+    fig = new_figure()
+    axes = fig.subplots(2, 1, sharex=True, gridspec_kw=dict(height_ratios=(2.3, 1.0)))
+    _prime_ticks(axes, ticks)
+    return fig, tuple(axes)
+
+
+def _one_axes_frame(ticks: int = 0):
+    fig = new_figure()
+    ax = fig.subplots()
+    _prime_ticks(ax, ticks)
+    return fig, ax
+
+
+def tension_profile_frame(ticks: int = 0):
+    """The tension figure before any data: a figure and its axes, ``ticks`` major ticks made on each
+    axis ahead."""
+    return _one_axes_frame(ticks)
+
+
+def pressure_frame(ticks: int = 0):
+    """The pressure figure before any data: a figure and its axes, ``ticks`` major ticks made on each
+    axis ahead."""
+    return _one_axes_frame(ticks)
+
+
+#: Each figure's file name and the function making its frame, for a process that builds the frames
+#: before the results exist (:mod:`exucable.output.figure_process`).
+FRAMES = {"pull_force.png": pull_force_frame, "tension_profile.png": tension_profile_frame,
+          "pressure.png": pressure_frame}
 
 
 def _zoom(values: np.ndarray, centre: float, references, spread: float) -> tuple[float, float]:
@@ -100,11 +162,17 @@ def thinned_scatter(x, y, y_range: tuple[float, float], size_px: tuple[float, fl
     return x[kept], y[kept]
 
 
-def plot_pull_force(path, result) -> None:
+def plot_pull_force(path, result, frame=None) -> None:
+    """:func:`pull_force_figure` written to ``path`` (atomically, :func:`exucable.io.save_figure`)."""
+    save_figure(pull_force_figure(result, frame), path, dpi=SAVE_DPI, **PNG_KWARGS)
+
+
+def pull_force_figure(result, frame=None):
     """Pulling force [N] on a scale that shows its scatter and its gap to the rope references (top),
     trailing tension [N] below it. A dynamic run is drawn against time [s] with its steady window; a
     steady-mode run is one static state, drawn against the static solve's steps (no time axis), its
-    converged force marked."""
+    converged force marked. ``frame``: a :func:`pull_force_frame` to draw on (default: a new one).
+    Returns the figure."""
     h, s = result.history, result.summary
     steady_mode = s.get("mode") == "steady"
     x = np.asarray(h["time_s"], dtype=float)
@@ -114,9 +182,9 @@ def plot_pull_force(path, result) -> None:
     if s.get("status") == "failed":
         status = f" (FAILED at t = {s.get('failed_at_s', float('nan')):.4g} s)"
     what = "steady sliding state, pulling force" if steady_mode else "pulling force"
-    fig, title = framed_figure((5.425, 4.0), f"{s.get('name', '')}: {what} "
-                               f"{'n/a' if pull is None else format(pull, '.5g')} N{status}", 10)
-    ax, low = fig.subplots(2, 1, sharex=True, gridspec_kw=dict(height_ratios=(2.3, 1.0)))
+    fig, (ax, low) = frame or pull_force_frame()
+    title = fit_frame(fig, PULL_FORCE_AXES_IN, f"{s.get('name', '')}: {what} "
+                      f"{'n/a' if pull is None else format(pull, '.5g')} N{status}", 10)
     ax.plot(x, pull_h, ".-" if steady_mode else "-", ms=3, lw=1.2, label="pulling force (leading end)")
     refs = []
     for key, style, what in (("rope_pull_force_N", "--", "rope reference"),
@@ -155,15 +223,21 @@ def plot_pull_force(path, result) -> None:
     ax.set_title(title, fontsize=10, y=TITLE_Y)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=7)
-    save_figure(fig, path)
+    return fig
 
 
-def plot_tension_profile(path, result) -> None:
+def plot_tension_profile(path, result, frame=None) -> None:
+    """:func:`tension_profile_figure` written to ``path`` (atomically)."""
+    save_figure(tension_profile_figure(result, frame), path, dpi=SAVE_DPI, **PNG_KWARGS)
+
+
+def tension_profile_figure(result, frame=None):
     """Tension [N] along the cable (arc length from the trailing end [m]) at the final time,
-    beside the rope reference."""
+    beside the rope reference. ``frame``: a :func:`tension_profile_frame` to draw on (default: a new
+    one). Returns the figure."""
     p = result.tension_profile
-    fig, title = framed_figure((5.425, 3.08), f"{result.summary.get('name', '')}: tension along the cable", 12)
-    ax = fig.subplots()
+    fig, ax = frame or tension_profile_frame()
+    title = fit_frame(fig, TENSION_AXES_IN, f"{result.summary.get('name', '')}: tension along the cable", 12)
     ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N from the equilibrium of its loads)")
     rp = result.rope_profile
     if rp is not None and "x_m" in result.extras:
@@ -173,21 +247,26 @@ def plot_tension_profile(path, result) -> None:
     ax.set_title(title, fontsize=12, y=TITLE_Y)
     ax.grid(alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    save_figure(fig, path)
+    return fig
 
 
-def plot_pressure(path, result) -> None:
+def plot_pressure(path, result, frame=None) -> None:
+    """:func:`pressure_figure` written to ``path`` (atomically)."""
+    save_figure(pressure_figure(result, frame), path, dpi=SAVE_DPI, **PNG_KWARGS)
+
+
+def pressure_figure(result, frame=None):
     """Sidewall bearing pressure [N/m] along the conduit: the check points' raw values (faint),
-    the windowed pressure and the rope's, windowed alike; bends shaded, point loads marked [N]."""
+    the windowed pressure and the rope's, windowed alike; bends shaded, point loads marked [N].
+    ``frame``: a :func:`pressure_frame` to draw on (default: a new one). Returns the figure."""
     pp, s = result.pressure_profile, result.summary
-    # below the axes: the x label, then the legend (two rows of 7 pt) 0.16 axes heights down
-    fig, title = framed_figure((6.2, 3.08), f"{s.get('name', '')}: sidewall pressure (bends shaded; point loads "
-                               "at bend ends)", 12, bottom_in=0.16 * 3.08 + 0.45)
-    ax = fig.subplots()
+    fig, ax = frame or pressure_frame()
+    title = fit_frame(fig, PRESSURE_AXES_IN, f"{s.get('name', '')}: sidewall pressure (bends shaded; point loads "
+                      "at bend ends)", 12, bottom_in=PRESSURE_BOTTOM_IN)
     top = 1.6 * max(float(np.max(pp["windowed_pressure_N_per_m"])), float(np.max(pp["rope_windowed_pressure_N_per_m"])), 1e-9)
     cp = result.contact_profile
     if cp is not None:
-        size_px = (6.2 * SAVE_DPI, 3.08 * SAVE_DPI)
+        size_px = (PRESSURE_AXES_IN[0] * SAVE_DPI, PRESSURE_AXES_IN[1] * SAVE_DPI)
         ax.plot(*thinned_scatter(cp["s_conduit_m"], cp["normal_force_per_length_N_per_m"], (0.0, top), size_px),
                 ",", color="0.6", alpha=0.5, label="check points (force / element share)")
     ax.plot(pp["s_conduit_m"], pp["windowed_pressure_N_per_m"], lw=1.8,
@@ -211,4 +290,4 @@ def plot_pressure(path, result) -> None:
     ax.set_title(title, fontsize=12, y=TITLE_Y)
     ax.grid(alpha=0.3)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
-    save_figure(fig, path, dpi=SAVE_DPI)
+    return fig
