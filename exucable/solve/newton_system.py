@@ -340,12 +340,17 @@ class OwnStaticNewton(StaticBackend):
             raise np.linalg.LinAlgError(f"the system matrix is singular (LAPACK dgbsv info {info})")
         t3 = time.process_time()
         dlam = r[self.held] + np.array([k @ dq[cols] for cols, k in rows_k])
+        self._count_time(t0, t1, t2, t3)
+        return dq, dlam
+
+    def _count_time(self, t0: float, t1: float, t2: float, t3: float) -> None:
+        """Add one step's CPU times [s] to :attr:`time_parts_s`: forces t0–t1, assembly t1–t2,
+        factorisation t2–t3, the glue after it until now."""
         parts = self.time_parts_s
         parts["forces"] += t1 - t0
         parts["assembly"] += t2 - t1
         parts["factorisation"] += t3 - t2
         parts["glue"] += time.process_time() - t3
-        return dq, dlam
 
     def _sparse_step(self, q, r, dq_held):
         """:meth:`_newton_step` on the CSR matrix of the chain's pattern, by SuperLU."""
@@ -376,11 +381,7 @@ class OwnStaticNewton(StaticBackend):
         t3 = time.process_time()
         dlam = r[self.held] + np.array([values[self.indptr[i]:self.indptr[i + 1]]
                                         @ dq[self.indices[self.indptr[i]:self.indptr[i + 1]]] for i in self.held])
-        parts = self.time_parts_s
-        parts["forces"] += t1 - t0
-        parts["assembly"] += t2 - t1
-        parts["factorisation"] += t3 - t2
-        parts["glue"] += time.process_time() - t3
+        self._count_time(t0, t1, t2, t3)
         return dq, dlam
 
     # ---- the interface
