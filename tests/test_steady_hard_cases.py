@@ -161,3 +161,20 @@ def test_the_steady_error_bar_covers_the_rigid_wall_at_tight_clearance(tmp_path)
     assert u == pytest.approx(parts["mesh_N"] + parts["solve_N"] + wall, rel=1e-12)
     assert "wall's compliance" in s["pull_force_uncertainty_method"]
     assert any("contact.stiffness" in w and "rigid wall" in w for w in s["warnings"]), s["warnings"]
+
+
+def test_several_cables_that_stall_are_sent_to_the_dynamic_run_not_to_a_coarser_mesh():
+    """Where several cables' steady solve stalls (the triangle turning over in an up-bend), the mesh
+    rule's coarsest mesh stalled too (studies/bundle_upbend_study.py): the advice names the dynamic
+    run alone, and still a larger time limit where the residual was falling."""
+    bundle = _model(2.0e8, 0.015, 1_753.0)
+    bundle.n_cables = 3
+    stalled = failure_advice(bundle, load_scale=0.0, residual_N=465.0, tolerance_N=0.00175, timed_out=False,
+                             still_converging=False, time_limit_s=60.0)
+    assert 'solver.mode = "dynamic"' in stalled and "cable.element_length" not in stalled
+    timed = failure_advice(bundle, load_scale=1.0, residual_N=0.5, tolerance_N=0.00175, timed_out=True,
+                           still_converging=True, time_limit_s=60.0)
+    assert TIME_LIMIT_KEY in timed and 'solver.mode = "dynamic"' in timed
+    single = failure_advice(_model(2.0e8, 0.015, 1_753.0), load_scale=0.0, residual_N=465.0, tolerance_N=0.00175,
+                            timed_out=False, still_converging=False, time_limit_s=60.0)
+    assert "cable.element_length" in single

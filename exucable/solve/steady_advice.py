@@ -4,7 +4,12 @@ A steady solve that fails names where it got to (the load scale λ reached, the 
 stop) and the strain the rope reference puts at the head (its largest tension over the cable's EA;
 above a few per cent, check the modulus), and advises by cause: a solve that ran out of time while
 still converging (or before anything converged) needs more time; one that stalled, a coarser mesh or
-the dynamic run.
+the dynamic run. Several cables that stall are sent to the dynamic run alone: their steady solve stalls
+where the cables rearrange across the duct (three cables through an up-bend turn their triangle over:
+a soft, at times unstable sideways mode and grazing contacts that switch), and there the mesh rule's
+coarsest mesh stalled too (`studies/bundle_upbend_study.py`, reference/README.md), while the dynamic
+pull follows the cables as they move (a short dynamic pull's state let the steady solve of that bend
+converge: `studies/bundle_settle_start.py`).
 """
 
 from __future__ import annotations
@@ -22,6 +27,10 @@ TIME_LIMIT_KEY = "solver.steady_time_limit"
 
 _MESH_FIX = ('a coarser mesh (larger `cable.element_length`, or fewer `contact.check_points_per_element`) '
              'or the dynamic run (`solver.mode = "dynamic"` with a `solver.end_time`)')
+
+_BUNDLE_FIX = ('the dynamic run (`solver.mode = "dynamic"` with a `solver.end_time`), which follows the cables '
+               'as they rearrange across the duct (where several cables\' steady solve stalls, a coarser mesh '
+               'has not helped)')
 
 
 def head_strain(model) -> tuple[float, float, float]:
@@ -61,8 +70,9 @@ def failure_advice(model, *, load_scale: float, residual_N: float, tolerance_N: 
         # a wrong modulus than a real pull
         where += (f"; a strain above {100 * LARGE_STRAIN:g} % is beyond cables' pulling limits: check "
                   "`cable.youngs_modulus`")
+    fix = _BUNDLE_FIX if getattr(model, "n_cables", 1) > 1 else _MESH_FIX
     if timed_out and (still_converging or not np.isfinite(residual_N)):
         why = "the residual was still falling" if still_converging else "nothing had converged yet"
         return (f"{where}: {why} when the time limit of {time_limit_s:g} s CPU ran out; "
-                f"fix: a larger `{TIME_LIMIT_KEY}`, or {_MESH_FIX}")
-    return f"{where}; fix: {_MESH_FIX}"
+                f"fix: a larger `{TIME_LIMIT_KEY}`, or {fix}")
+    return f"{where}; fix: {fix}"
