@@ -239,7 +239,7 @@ def lay_cable(
         o = np.zeros((len(s), 3)) if offset_m is None else np.asarray(offset_m(np.clip(s, 0.0, L)), dtype=float)
         P = extended_point(centreline, s) + o
         dP = np.gradient(P, s, axis=0, edge_order=2)
-        speed_geom = np.linalg.norm(dP, axis=1)              # dσ/ds of the offset path
+        speed_geom = np.sqrt(_dot3(dP.T, dP.T))             # dσ/ds of the offset path, |dP/ds|
         stretch = 1.0 + T / axial_stiffness_N                # dσ/dx
         if np.any(stretch <= 0.5) or np.any(stretch > 1.5):
             from ..errors import ModelError
@@ -260,40 +260,48 @@ def lay_cable(
     # the path make it bulge into the wall by up to ~L²κ/8 (0.6 mm against a 1 mm clearance on
     # Example 4's coarse mesh). Then correct: where a fitted point leaves the offset it should
     # have, move its target back by the excess and refit.
-    xi_s, _ = np.polynomial.legendre.leggauss(fit_points_per_element)
+    k = fit_points_per_element
+    xi_s, _ = np.polynomial.legendre.leggauss(k)
     xi_s = 0.5 * (xi_s + 1.0)
     xs = (x_nodes[:-1, None] + xi_s[None, :] * Le[:, None]).ravel()
     xs = np.concatenate([[0.0], xs, [cable_length_m]])
-    e_of = np.clip(np.searchsorted(x_nodes, xs, side="right") - 1, 0, n_elements - 1)
+    # the rows: the trailing node, k Gauss points in each element in turn, the leading node; each
+    # Gauss point lies inside its element (ξ in (0, 1)), so a row's element is known without a search
+    e_of = np.concatenate([[0], np.repeat(np.arange(n_elements), k), [n_elements - 1]])
     xi_of = (xs - x_nodes[e_of]) / Le[e_of]
     cols, vals = _hermite_rows(e_of, xi_of, Le)
+    n_unknowns = 2 * (n_elements + 1)
+    normal = _normal_matrix_banded(cols, vals, n_unknowns)
+    # From here on the rows are taken Gauss point by Gauss point (the first point of every element,
+    # then the second, ...; the end nodes first and last) and each coordinate direction is one
+    # contiguous row of a (3, m) array: the fit's sums over an element's points become additions of
+    # whole arrays (:func:`_fit_rhs`). Row-wise operations give the same numbers in any row order.
+    order = _point_major(n_elements, k)
+    xs, vals = xs[order], vals[order]
     ss = np.interp(xs, x, s)
-    target = np.stack([np.interp(ss, s, P[:, j]) for j in range(3)], axis=1)
-    ss_in = np.clip(ss, 0.0, L)
-    C = extended_point(centreline, ss)
-    t_c = extended_tangent(centreline, ss)
-    want = np.linalg.norm(target - C - np.sum((target - C) * t_c, axis=1)[:, None] * t_c, axis=1)
+    target = np.stack([np.interp(ss, s, P[:, j]) for j in range(3)])
+    C = np.ascontiguousarray(extended_point(centreline, ss).T)
+    t_c = np.ascontiguousarray(extended_tangent(centreline, ss).T)
+    rel = target - C
+    lat = rel - _dot3(rel, t_c) * t_c
+    want = np.sqrt(_dot3(lat, lat))
     inside = (ss > 0.0) & (ss < L)
     # scipy.linalg (loaded anyway: numba's BLAS) rather than scipy.sparse, whose import is part of
     # `exucable run`'s fixed cost (docs/performance.md)
     from scipy.linalg import cho_solve_banded, cholesky_banded
 
-    n_unknowns = 2 * (n_elements + 1)
-    factor = cholesky_banded(_normal_matrix_banded(cols, vals, n_unknowns))   # factored once
+    factor = cholesky_banded(normal, check_finite=False)   # factored once
+    vals_t = vals.T.copy()                                  # (4, m): each basis function's values
     for _ in range(correction_iterations + 1):
-        # Bᵀ target, accumulated in row order as np.add.at would, at a tenth of its cost
-        rhs = np.stack([np.bincount(cols.ravel(), (vals * target[:, j, None]).ravel(), n_unknowns)
-                        for j in range(3)], axis=1)
-        coef = cho_solve_banded((factor, False), rhs)   # (2(n+1), 3): r_k, r'_k rows
-        fitted = np.einsum("mk,mkj->mj", vals, coef[cols])                               # B coef
-        rel = fitted - C
-        lat = rel - np.sum(rel * t_c, axis=1)[:, None] * t_c
-        d = np.linalg.norm(lat, axis=1)
+        rhs = _fit_rhs(vals_t, target, n_elements, k)                              # Bᵀ target
+        coef = cho_solve_banded((factor, False), rhs.T, check_finite=False)   # (2(n+1), 3): r_k, r'_k rows
+        rel = _fit_values(vals_t, coef, n_elements, k) - C                          # B coef − C
+        lat = rel - _dot3(rel, t_c) * t_c
+        d = np.sqrt(_dot3(lat, lat))
         excess = np.where(inside & (d > want), d - want, 0.0)
         if excess.max() < 1e-7 * max(1.0, want.max()) or clearance_m is None:
             break
-        target = target - (excess / np.maximum(d, 1e-300))[:, None] * lat
-    del ss_in
+        target = target - (excess / np.maximum(d, 1e-300)) * lat
     return sliding_layout(np.diff(x_nodes), x_nodes, s_nodes, coef[0::2], coef[1::2], speed_m_per_s)
 
 
@@ -331,14 +339,70 @@ def _hermite_rows(e, xi, Le):
     return cols, vals
 
 
+def _dot3(a, b):
+    """Row-wise dot product of two (3, m) arrays, summed x + y then z, as ``np.sum(a * b, axis=1)``
+    sums the rows of (m, 3) arrays (so that the fit's numbers are those of the row-per-point form)."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _point_major(n_elements: int, k: int):
+    """The fit's rows (the trailing node, ``k`` points in each element in turn, the leading node)
+    reordered point by point: the trailing node, every element's first point, every element's
+    second, ..., the leading node."""
+    mid = 1 + np.arange(n_elements)[None, :] * k + np.arange(k)[:, None]
+    return np.concatenate([[0], mid.ravel(), [n_elements * k + 1]])
+
+
+def _fit_rhs(vals_t, target, n_elements: int, k: int):
+    """Bᵀ target, shape (3, 2(n + 1)), for the fit's rows in the order of :func:`_point_major`
+    (``vals_t`` (4, m): the Hermite values of :func:`_hermite_rows`, transposed; ``target`` (3, m)).
+
+    Each unknown's terms are added in the original row order, as ``np.bincount`` over the rows'
+    columns adds them (the same sums, bit for bit), but element by element in whole arrays instead
+    of one scattered addition per term: unknowns 2e, 2e + 1 (node e) take element e − 1's points
+    (their columns 2, 3) and then element e's (columns 0, 1)."""
+    w = vals_t[None, :, :] * target[:, None, :]               # (3, 4, m): each row's four terms
+    first, last = w[:, :, 0], w[:, :, -1]
+    mid = w[:, :, 1:-1].reshape(3, 4, k, n_elements)
+    ahead = np.zeros((3, 2, n_elements))                       # node e + 1's terms from element e
+    ahead[:, :, 0] += first[:, 2:]
+    for r in range(k):
+        ahead += mid[:, 2:, r]
+    behind = np.zeros((3, 2, n_elements))                      # node e's, continuing from element e − 1
+    behind[:, :, 0] += first[:, :2]
+    behind[:, :, 1:] = ahead[:, :, :-1]
+    for r in range(k):
+        behind += mid[:, :2, r]
+    behind[:, :, -1] += last[:, :2]
+    # unknowns 2e + i at [:, i, e]
+    return np.concatenate([behind.transpose(0, 2, 1).reshape(3, 2 * n_elements), ahead[:, :, -1] + last[:, 2:]],
+                          axis=1)
+
+
+def _fit_values(vals_t, coef, n_elements: int, k: int):
+    """B coef, shape (3, m), for the fit's rows in the order of :func:`_point_major` (``coef``
+    (2(n + 1), 3)): each row's four terms summed from zero in column order, as ``np.einsum("mk,mkj->mj",
+    vals, coef[cols])`` sums them, with element e's coefficients (rows 2e … 2e + 3 of ``coef``)
+    taken once per element instead of gathered per row."""
+    c = coef.T                                                 # (3, 2(n + 1))
+    out = np.zeros((3, vals_t.shape[1]))
+    for j in range(4):   # the end rows: the trailing node's element is the first, the leading node's the last
+        out[:, 0] += vals_t[j, 0] * c[:, j]
+        out[:, -1] += vals_t[j, -1] * c[:, 2 * n_elements - 2 + j]
+    mid = out[:, 1:-1].reshape(3, k, n_elements)
+    v = vals_t[:, 1:-1].reshape(4, k, n_elements)
+    for j in range(4):
+        mid += v[j][None] * np.ascontiguousarray(c[:, j:j + 2 * n_elements:2])[:, None, :]
+    return out
+
+
 def _normal_matrix_banded(cols, vals, n_unknowns):
     """BᵀB of the rows of :func:`_hermite_rows` in LAPACK's upper banded storage (row 3 + i − j holds
     entry (i, j), i ≤ j), as ``scipy.linalg.cholesky_banded`` takes it."""
-    ab = np.zeros((4, n_unknowns))
     a, b = np.triu_indices(4)          # column pairs of a row with cols[a] <= cols[b]
-    np.add.at(ab, ((3 + cols[:, a] - cols[:, b]).ravel(), cols[:, b].ravel()),
-              (vals[:, a] * vals[:, b]).ravel())
-    return ab
+    # the products summed into their entries in row order (as np.add.at would, bit for bit)
+    flat = (3 + cols[:, a] - cols[:, b]) * n_unknowns + cols[:, b]
+    return np.bincount(flat.ravel(), (vals[:, a] * vals[:, b]).ravel(), 4 * n_unknowns).reshape(4, n_unknowns)
 
 
 def _second_derivative_at_nodes(coef, Le):
