@@ -141,24 +141,28 @@ def contact_offsets(
     ndarray (m, 3)
         Offset vectors [m].
     """
+    from ..quasistatic.clearance import _row_norm   # at call time: its module imports scipy.linalg
+
     s = np.asarray(s_m, dtype=float)
-    t = np.atleast_2d(centreline.tangent(s))
-    kn = np.atleast_2d(centreline.curvature_vector(s))
-    ez = np.array([0.0, 0.0, 1.0])
-    w_perp = weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
-    load = np.asarray(tension_N, dtype=float)[:, None] * kn - w_perp
-    p = np.linalg.norm(load, axis=1)
-    off = np.zeros_like(load)
     if path_offset_m is not None:
         p = np.asarray(path_pressure_N_per_m, dtype=float)
         load = np.asarray(path_offset_m, dtype=float)   # only its direction is used where loaded
         off = load.copy()
+    else:
+        t = np.atleast_2d(centreline.tangent(s))
+        kn = np.atleast_2d(centreline.curvature_vector(s))
+        ez = np.array([0.0, 0.0, 1.0])
+        w_perp = weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
+        load = np.asarray(tension_N, dtype=float)[:, None] * kn - w_perp
+        p = np.linalg.norm(load, axis=1)
+        off = np.zeros_like(load)
     scale = max(p.max(), 1e-300)
     loaded = p > 1e-9 * scale
     if loaded.any():
         delta = (p[loaded] / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent)
-        size = np.maximum(np.linalg.norm(load[loaded], axis=1), 1e-300)
-        off[loaded] = load[loaded] / size[:, None] * (clearance_m + delta)[:, None]
+        bearing = load[loaded]
+        size = np.maximum(_row_norm(bearing), 1e-300)
+        off[loaded] = bearing / size[:, None] * (clearance_m + delta)[:, None]
     ds = s[1] - s[0] if len(s) > 1 else 1.0
     sigma = blend_length_m / ds
     if sigma > 0.5 and loaded.any():
@@ -169,7 +173,7 @@ def contact_offsets(
         pad = np.pad(off, ((half, half), (0, 0)), mode="edge")
         off = np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(3)], axis=1)
         # smoothing may only lift the cable off the wall, never push it further in than the load needs
-        mag = np.linalg.norm(off, axis=1)
+        mag = _row_norm(off)
         cap = np.where(loaded, clearance_m + (p / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent), clearance_m)
         too = mag > cap
         off[too] *= (cap[too] / mag[too])[:, None]
