@@ -80,7 +80,7 @@ def extended_point(centreline, s_m: np.ndarray) -> np.ndarray:
     s = np.atleast_1d(np.asarray(s_m, dtype=float))
     L = centreline.length_m
     inside = np.clip(s, 0.0, L)
-    p = np.atleast_2d(centreline.point(inside)).copy()
+    p = np.atleast_2d(centreline.point(inside))      # a new array, changed in place below
     lo, hi = s < 0.0, s > L
     if lo.any():
         p[lo] += (s[lo] - 0.0)[:, None] * np.atleast_2d(centreline.tangent(0.0))
@@ -233,15 +233,23 @@ def lay_cable(
     ds = cable_length_m / (n_elements * points_per_element)
     s_full = np.arange(s0, s0 + 1.5 * cable_length_m + ds, ds)
     x_nodes = np.linspace(0.0, cable_length_m, n_elements + 1)
-    # First on the grid's leading part up to 1.15 cable lengths (enough below ~14 % strain): every
-    # value used below is then the full grid's, bit for bit (the same points; the integral is a
-    # running sum; only the last point's one-sided slope differs, and it is not used when the
-    # cable ends before it); else the whole grid.
-    for extent in (1.15, 1.5):
+    # First on the grid's leading part, as far as the largest strain stretches the cable (with a
+    # margin: the offset path is shorter than the axis on the inside of bends), then up to 1.15
+    # cable lengths (enough below ~14 % strain): every value used below is then the full grid's,
+    # bit for bit (the same points; the integral is a running sum; only the last point's one-sided
+    # slope differs, and it is not used when the cable ends before it); else the whole grid.
+    part = s_full[:int(np.searchsorted(s_full, s0 + 1.15 * cable_length_m)) + 1]
+    T_part = np.zeros_like(part) if tension_N is None else np.asarray(tension_N(np.clip(part, 0.0, L)), dtype=float)
+    first = 1.0 + 1.5 * max(float(np.max(T_part)), 0.0) / axial_stiffness_N + 0.01
+    for extent in ((first,) if first < 1.15 else ()) + (1.15, 1.5):
         s = s_full if extent == 1.5 else s_full[:int(np.searchsorted(s_full, s0 + extent * cable_length_m)) + 1]
-        T = np.zeros_like(s) if tension_N is None else np.asarray(tension_N(np.clip(s, 0.0, L)), dtype=float)
+        if len(s) <= len(part):
+            T = T_part[:len(s)]
+        else:
+            T = np.zeros_like(s) if tension_N is None else np.asarray(tension_N(np.clip(s, 0.0, L)), dtype=float)
         o = np.zeros((len(s), 3)) if offset_m is None else np.asarray(offset_m(np.clip(s, 0.0, L)), dtype=float)
-        P = extended_point(centreline, s) + o
+        P = extended_point(centreline, s)
+        P += o
         dP = np.gradient(P, s, axis=0, edge_order=2)
         speed_geom = np.sqrt(_dot3(dP.T, dP.T))             # dσ/ds of the offset path, |dP/ds|
         stretch = 1.0 + T / axial_stiffness_N                # dσ/dx
@@ -273,15 +281,13 @@ def lay_cable(
     # Gauss point lies inside its element (ξ in (0, 1)), so a row's element is known without a search
     e_of = np.concatenate([[0], np.repeat(np.arange(n_elements), k), [n_elements - 1]])
     xi_of = (xs - x_nodes[e_of]) / Le[e_of]
-    cols, vals = _hermite_rows(e_of, xi_of, Le)
-    n_unknowns = 2 * (n_elements + 1)
-    normal = _normal_matrix_banded(cols, vals, n_unknowns)
+    _, vals = _hermite_rows(e_of, xi_of, Le)
     # From here on the rows are taken Gauss point by Gauss point (the first point of every element,
     # then the second, ...; the end nodes first and last) and each coordinate direction is one
     # contiguous row of a (3, m) array: the fit's sums over an element's points become additions of
     # whole arrays (:func:`_fit_rhs`). Row-wise operations give the same numbers in any row order.
     order = _point_major(n_elements, k)
-    xs, vals = xs[order], vals[order]
+    xs, vals_t = xs[order], vals[order].T.copy()          # vals_t (4, m): each basis function's values
     ss = np.interp(xs, x, s)
     target = np.stack([np.interp(ss, s, P[:, j]) for j in range(3)])
     C = np.ascontiguousarray(extended_point(centreline, ss).T)
@@ -294,8 +300,7 @@ def lay_cable(
     # `exucable run`'s fixed cost (docs/performance.md)
     from scipy.linalg import cho_solve_banded, cholesky_banded
 
-    factor = cholesky_banded(normal, check_finite=False)   # factored once
-    vals_t = vals.T.copy()                                  # (4, m): each basis function's values
+    factor = cholesky_banded(_normal_matrix_banded(vals_t, n_elements, k), check_finite=False)   # factored once
     for _ in range(correction_iterations + 1):
         rhs = _fit_rhs(vals_t, target, n_elements, k)                              # Bᵀ target
         coef = cho_solve_banded((factor, False), rhs.T, check_finite=False)   # (2(n+1), 3): r_k, r'_k rows
@@ -357,30 +362,37 @@ def _point_major(n_elements: int, k: int):
     return np.concatenate([[0], mid.ravel(), [n_elements * k + 1]])
 
 
+def _element_sums(w, n_elements: int, k: int, carry_from: slice, carry_to: slice):
+    """Sums over each element of the fit's row terms ``w`` (..., slots, m) (rows in the order of
+    :func:`_point_major`), shape (..., slots, n): every sum taken in the original row order from
+    zero, as ``np.bincount`` adds the terms into their entries (the same sums, bit for bit), but in
+    whole arrays instead of one scattered addition per term.
+
+    A slot stands for one entry per element; the entry of slot ``carry_to`` of element e is the one
+    of slot ``carry_from`` of element e − 1 (a node's shared by the two elements), so its sum goes
+    on from there. The trailing node's row adds to element 0 before its points, the leading node's
+    to element n − 1 after them."""
+    mid = w[..., 1:-1].reshape(w.shape[:-1] + (k, n_elements))
+    out = np.zeros(w.shape[:-1] + (n_elements,))
+    out[..., 0] += w[..., 0]
+    own = slice(0, carry_to.start) if carry_to.start > 0 else slice(carry_to.stop, None)   # carry_to: first or last
+    for r in range(k):
+        out[..., own, :] += mid[..., own, r, :]
+    out[..., carry_to, 1:] = out[..., carry_from, :-1]
+    for r in range(k):
+        out[..., carry_to, :] += mid[..., carry_to, r, :]
+    out[..., -1] += w[..., -1]
+    return out
+
+
 def _fit_rhs(vals_t, target, n_elements: int, k: int):
     """Bᵀ target, shape (3, 2(n + 1)), for the fit's rows in the order of :func:`_point_major`
-    (``vals_t`` (4, m): the Hermite values of :func:`_hermite_rows`, transposed; ``target`` (3, m)).
-
-    Each unknown's terms are added in the original row order, as ``np.bincount`` over the rows'
-    columns adds them (the same sums, bit for bit), but element by element in whole arrays instead
-    of one scattered addition per term: unknowns 2e, 2e + 1 (node e) take element e − 1's points
-    (their columns 2, 3) and then element e's (columns 0, 1)."""
-    w = vals_t[None, :, :] * target[:, None, :]               # (3, 4, m): each row's four terms
-    first, last = w[:, :, 0], w[:, :, -1]
-    mid = w[:, :, 1:-1].reshape(3, 4, k, n_elements)
-    ahead = np.zeros((3, 2, n_elements))                       # node e + 1's terms from element e
-    ahead[:, :, 0] += first[:, 2:]
-    for r in range(k):
-        ahead += mid[:, 2:, r]
-    behind = np.zeros((3, 2, n_elements))                      # node e's, continuing from element e − 1
-    behind[:, :, 0] += first[:, :2]
-    behind[:, :, 1:] = ahead[:, :, :-1]
-    for r in range(k):
-        behind += mid[:, :2, r]
-    behind[:, :, -1] += last[:, :2]
-    # unknowns 2e + i at [:, i, e]
-    return np.concatenate([behind.transpose(0, 2, 1).reshape(3, 2 * n_elements), ahead[:, :, -1] + last[:, 2:]],
-                          axis=1)
+    (``vals_t`` (4, m): the Hermite values of :func:`_hermite_rows`, transposed; ``target`` (3, m)),
+    bit for bit ``np.bincount`` over the rows' columns (:func:`_element_sums`): element e's
+    columns 2, 3 are node e + 1's unknowns, its columns 0, 1 node e's."""
+    sums = _element_sums(vals_t[None, :, :] * target[:, None, :], n_elements, k, slice(2, 4), slice(0, 2))
+    # unknowns 2e + i at [:, i, e]; the leading node's, 2n + i, at [:, 2 + i, n − 1]
+    return np.concatenate([sums[:, :2].transpose(0, 2, 1).reshape(3, 2 * n_elements), sums[:, 2:, -1]], axis=1)
 
 
 def _fit_values(vals_t, coef, n_elements: int, k: int):
@@ -400,13 +412,27 @@ def _fit_values(vals_t, coef, n_elements: int, k: int):
     return out
 
 
-def _normal_matrix_banded(cols, vals, n_unknowns):
-    """BᵀB of the rows of :func:`_hermite_rows` in LAPACK's upper banded storage (row 3 + i − j holds
-    entry (i, j), i ≤ j), as ``scipy.linalg.cholesky_banded`` takes it."""
-    a, b = np.triu_indices(4)          # column pairs of a row with cols[a] <= cols[b]
-    # the products summed into their entries in row order (as np.add.at would, bit for bit)
-    flat = (3 + cols[:, a] - cols[:, b]) * n_unknowns + cols[:, b]
-    return np.bincount(flat.ravel(), (vals[:, a] * vals[:, b]).ravel(), 4 * n_unknowns).reshape(4, n_unknowns)
+#: Column pairs (a, b), a ≤ b, of a row's four Hermite values whose products enter BᵀB: those across
+#: an element's two nodes, those of its leading node (carried into the next element's trailing node,
+#: the same entries), those of its trailing node (see :func:`_element_sums`).
+_PAIRS = ((0, 2), (0, 3), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3), (0, 0), (0, 1), (1, 1))
+
+
+def _normal_matrix_banded(vals_t, n_elements: int, k: int):
+    """BᵀB of the rows of :func:`_hermite_rows` (``vals_t`` (4, m), rows in the order of
+    :func:`_point_major`) in LAPACK's upper banded storage (row 3 + i − j holds entry (i, j), i ≤ j),
+    as ``scipy.linalg.cholesky_banded`` takes it; each entry's products summed in the original row
+    order, as ``np.add.at`` sums them (bit for bit, :func:`_element_sums`)."""
+    a, b = np.array(_PAIRS).T
+    sums = _element_sums(vals_t[a] * vals_t[b], n_elements, k, slice(4, 7), slice(7, 10))
+    ab = np.zeros((4, 2 * (n_elements + 1)))
+    e2 = 2 * np.arange(n_elements)
+    for p, (i, j) in enumerate(_PAIRS):
+        if 4 <= p < 7:      # the leading node's entries: final in the last element only
+            ab[3 + i - j, 2 * (n_elements - 1) + j] = sums[p, -1]
+        else:
+            ab[3 + i - j, e2 + j] = sums[p]
+    return ab
 
 
 def _second_derivative_at_nodes(coef, Le):
