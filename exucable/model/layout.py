@@ -654,7 +654,6 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     n_el = mesh.elements
     if sc.solver.pretension:
         s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * n_el + 1))
-        T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
         L_e = L_cable / n_el
         # blend over the length on which a tensioned beam leaves the wall, √(EJ/T), but at least
         # half an element so the nodes can follow it
@@ -667,7 +666,9 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         else:
             free = _clearance_rope_start(sc, centre, w, clearance, L_cable - lead_out)
         path = {}
-        if free is not None:
+        if free is None:
+            T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
+        else:
             # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
             # free spans across the clearance, and a start pressed onto the wall the centreline rope's
             # load points to rang for a second as those spans formed.
@@ -682,8 +683,10 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         def tension_fn(s):
             return np.interp(s, s_grid, T_grid)
 
+        off_columns = [np.ascontiguousarray(off[:, j]) for j in range(3)]   # np.interp copies strided ones per call
+
         def offset_fn(s):
-            return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
+            return np.stack([np.interp(s, s_grid, column) for column in off_columns], axis=1)
 
         cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, tension_fn,
                           offset_fn, clearance_m=clearance if with_contact else None, lead_out_m=lead_out)
