@@ -301,8 +301,7 @@ class _Chain:
         g = np.einsum("ijk,ij->ik", self.B, fx)
         r = _row_norm(d)
         over = r > self.c
-        dhat = np.zeros_like(d)
-        dhat[over] = d[over] / r[over, None]
+        dhat = np.divide(d, r[:, None], out=np.zeros_like(d), where=over[:, None])   # masked: no row gathers
         g += self.k * np.maximum(r - self.c, 0.0)[:, None] * dhat
         # tension stiffness of each segment, K = T/ℓ (I − t tᵀ), mapped to the offsets: the frames are
         # orthonormal, so B_lᵀ K B_l = T/ℓ (I − u_l u_lᵀ) with u = Bᵀ t, and B_lᵀ K B_r = T/ℓ (B_lᵀ B_r − u_l u_rᵀ)
@@ -311,8 +310,7 @@ class _Chain:
         stiff = T / ell
         ul = np.einsum("jki,jk->ji", self.B[:-1], t)
         ur = np.einsum("jki,jk->ji", self.B[1:], t)
-        ratio = np.zeros(n)
-        ratio[over] = self.c / r[over]
+        ratio = np.divide(self.c, r, out=np.zeros(n), where=over)
         # band storage: entry (row, col) at ab[3 + row − col, col]; node i's columns are 2i + q
         ab = np.zeros((7, 2 * n))
         for p in range(2):
@@ -346,8 +344,7 @@ class _Chain:
             # penalty would cut the step to a sliver (observed: 100 Newton steps of 1e-5 m).
             r = _row_norm(d)
             wall = r > self.c
-            er = np.zeros_like(d)
-            er[wall] = d[wall] / r[wall, None]
+            er = np.divide(d, r[:, None], out=np.zeros_like(d), where=wall[:, None])
             ephi = np.stack([-er[:, 1], er[:, 0]], axis=1)
             dr = np.sum(step * er, axis=1)
             dt = np.sum(step * ephi, axis=1)
