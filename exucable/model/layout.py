@@ -141,8 +141,6 @@ def contact_offsets(
     ndarray (m, 3)
         Offset vectors [m].
     """
-    from ..quasistatic.clearance import _row_norm   # at call time: its module imports scipy.linalg
-
     s = np.asarray(s_m, dtype=float)
     if path_offset_m is not None:
         p = np.asarray(path_pressure_N_per_m, dtype=float)
@@ -161,7 +159,7 @@ def contact_offsets(
     if loaded.any():
         delta = (p[loaded] / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent)
         bearing = load[loaded]
-        size = np.maximum(_row_norm(bearing), 1e-300)
+        size = np.maximum(np.sqrt(_dot3(bearing.T, bearing.T)), 1e-300)   # the rows' lengths
         off[loaded] = bearing / size[:, None] * (clearance_m + delta)[:, None]
     ds = s[1] - s[0] if len(s) > 1 else 1.0
     sigma = blend_length_m / ds
@@ -173,7 +171,7 @@ def contact_offsets(
         pad = np.pad(off, ((half, half), (0, 0)), mode="edge")
         off = np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(3)], axis=1)
         # smoothing may only lift the cable off the wall, never push it further in than the load needs
-        mag = _row_norm(off)
+        mag = np.sqrt(_dot3(off.T, off.T))
         cap = np.where(loaded, clearance_m + (p / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent), clearance_m)
         too = mag > cap
         off[too] *= (cap[too] / mag[too])[:, None]
