@@ -109,7 +109,7 @@ def add_cable(mbs, coordinates, element_length_m, properties: CableProperties, v
     # call: Exudyn writes the item's name into the one it gets.
     node = item_dict(NodePointSlope1())
     nodes = tuple(mbs.AddNode(dict(node, referenceCoordinates=c, initialVelocities=v))
-                  for c, v in zip(coords.tolist(), vel.tolist()))
+                  for c, v in zip(coords, vel))       # numpy rows: Exudyn reads them without Python floats
     element = item_dict(ObjectANCFCable(
         nodeNumbers=[0, 1],
         length=1.0,
