@@ -12,14 +12,19 @@ start and solved first).
 
 Printed per case: Newton iterations of the solved mesh and of the error bar's coarse solve, their
 pseudo-time steps tried and rejected (tried minus kept; a warm start given up counts its steps as
-rejected), where the solved mesh started, each solve's CPU time and the pulling force; then per
+rejected), the force evaluations of shortened steps (the line search of
+:meth:`exucable.solve.steady.SteadySolver.shorten_step`, no Newton iteration), where the solved mesh
+started, each solve's CPU time and the pulling force; then per
 family the largest ratio of Newton iterations between neighbours (solved mesh, coarse, both summed)
 and, over every case, the largest neighbour ratio and the spread (largest / smallest count).
 
 ``--set NAME=VALUE`` overrides a field of :class:`exucable.solve.steady.SteadySettings` for every solve
-(as in ``steady_iterations.py``); ``--only FAMILY,...`` runs some families.
+(as in ``steady_iterations.py``); ``--against NAME=VALUE`` runs each case a second time right after
+with that field changed too (B against A: the two solves' CPU ratio, interleaved in one run, and the
+pulling force's change); ``--only FAMILY,...`` runs some families.
 
     nice .venv/bin/python benchmarks/newton_spread.py [--no-10km] [--only length,angle] [--set reject_growth=4]
+    nice .venv/bin/python benchmarks/newton_spread.py --against max_backtracks=0   # the line search's effect
     nice .venv/bin/python benchmarks/newton_spread.py --quick     # smoke run: two 200 m routes
 """
 
@@ -66,27 +71,32 @@ def families(ten_km: bool = True, quick: bool = False) -> dict:
 
 
 class Runner:
-    """Whole steady runs in this process with their two solves timed (``long_routes._Timed``)."""
+    """Whole steady runs in this process with their two solves timed (``long_routes._Timed``);
+    :attr:`settings` (None: the defaults) are every solve's steady settings, with the scenario's stop
+    residual and time limit."""
 
-    def __init__(self, settings=None):
+    def __init__(self):
         import exucable.solve.steady as steady
 
+        self.settings = None
         self.timed = long_routes._Timed()
         # run.py's solved mesh has a progress bar; the error bar's coarse solve has none
         self.timed.wrap(steady, "solve_steady", lambda i, kw: "solve" if "progress" in kw else "coarse")
-        if settings is not None:
-            # run.py and the error bar take their settings from the scenario: every solve gets these,
-            # with the scenario's stop residual and time limit
-            base = steady.SteadySettings.from_solver
-            steady.SteadySettings.from_solver = classmethod(lambda cls, solver: dataclasses.replace(
-                settings, **{k: getattr(base(solver), k) for k in ("steady_residual", "time_limit_s")}))
+        # run.py and the error bar take their settings from the scenario
+        base = steady.SteadySettings.from_solver
+        steady.SteadySettings.from_solver = classmethod(lambda cls, solver: base(solver) if self.settings is None else
+                                                        dataclasses.replace(self.settings, **{
+                                                            k: getattr(base(solver), k)
+                                                            for k in ("steady_residual", "time_limit_s")}))
 
-    def case(self, kwargs: dict) -> dict:
-        """One run of ``long_routes.route_data(**kwargs)``: per solve its Newton iterations, steps tried and
-        kept, CPU [s], and the pulling force [N]."""
+    def case(self, kwargs: dict, settings=None) -> dict:
+        """One run of ``long_routes.route_data(**kwargs)`` with ``settings``: per solve its Newton
+        iterations, steps tried and kept, shortened steps' force evaluations, CPU [s], where it started;
+        the whole run's CPU [s] and the pulling force [N]."""
         from exucable.run import run_scenario
         from exucable.scenario.specs import parse_scenario
 
+        self.settings = settings
         for d in (self.timed.wall, self.timed.cpu, self.timed.solves):
             d.clear()
         sc = parse_scenario(long_routes.route_data(**kwargs), ROOT, default_name="route")
@@ -97,7 +107,7 @@ class Runner:
             out = self.timed.solves.get(key)
             row[key] = None if out is None else {
                 "newton": out.newton_iterations, "steps": out.steps, "kept": len(out.history.pull_force_N),
-                "cpu": self.timed.cpu[key], "from": out.started_from, "status": out.status}
+                "backtracks": out.backtracks, "cpu": self.timed.cpu[key], "from": out.started_from}
         return row
 
 
@@ -109,10 +119,54 @@ def neighbour_ratio(counts) -> float:
     return float(np.max(np.maximum(c[1:], c[:-1]) / np.maximum(np.minimum(c[1:], c[:-1]), 1.0)))
 
 
-def _solve_cells(s) -> str:
+def _settings(ap, items) -> tuple:
+    """``NAME=VALUE`` items -> (SteadySettings with them, their text)."""
+    from exucable.solve.steady import SteadySettings
+
+    kinds = {f.name: f.type for f in dataclasses.fields(SteadySettings)}
+    overrides = {}
+    for item in items:
+        key, _, value = item.partition("=")
+        key = key.strip().lower()
+        if key not in kinds:
+            ap.error(f"{item}: SteadySettings has no field {key!r}; fields: {', '.join(kinds)}")
+        overrides[key] = int(float(value)) if kinds[key] == "int" else float(value)
+    text = ", ".join(f"{k} = {v:g}" for k, v in overrides.items()) or "the defaults"
+    return dataclasses.replace(SteadySettings(), **overrides), text
+
+
+def _cells(s) -> str:
     if s is None:
-        return "- | - | - |"
-    return f"{s['newton']} | {s['steps']} / {s['steps'] - s['kept']} | {s['cpu']:.2f} |"
+        return "- | - | - | - |"
+    return f"{s['newton']} | {s['steps']} / {s['steps'] - s['kept']} | {s['backtracks']} | {s['cpu']:.2f} |"
+
+
+def _row(family, label, tag, r) -> str:
+    fine = r["solve"]
+    return (f"| {family} | {label} | {tag} | {r['status']} | {_cells(fine)} {fine['from'] if fine else '-'} | "
+            f"{_cells(r['coarse'])} {r['cpu']:.2f} | {r['F']:.6f} |")
+
+
+def _summary(tag: str, rows: dict) -> None:
+    """The largest neighbour ratios per family and over all, of the runs ``rows[family]``."""
+    print(f"\n{tag}:")
+    print("| family | largest neighbour ratio: solved mesh | coarse | both | Newton range, solved mesh | coarse |")
+    print("|---|---|---|---|---|---|")
+    worst, every = 0.0, []
+    for family, runs in rows.items():
+        c = np.array([[r["solve"]["newton"] if r["solve"] else 0, r["coarse"]["newton"] if r["coarse"] else 0]
+                      for r in runs])
+        ratios = (neighbour_ratio(c[:, 0]), neighbour_ratio(c[:, 1]), neighbour_ratio(c.sum(axis=1)))
+        worst = max(worst, *ratios)
+        print(f"| {family} | {ratios[0]:.2f} | {ratios[1]:.2f} | {ratios[2]:.2f} | {c[:, 0].min()}-{c[:, 0].max()} "
+              f"| {c[:, 1].min()}-{c[:, 1].max()} |")
+        if family != "length at 10 km":
+            every.extend(c.tolist())
+    if every:
+        c = np.array(every)
+        spread = lambda x: f"{x.max()} / {x.min()} = {x.max() / max(x.min(), 1):.2f}"
+        print(f"largest neighbour ratio over every family {worst:.2f}; spread (largest / smallest) of the cases "
+              f"about 1 km: solved mesh {spread(c[:, 0])}, coarse {spread(c[:, 1])}, both {spread(c.sum(axis=1))}")
 
 
 def main(argv=None) -> int:
@@ -122,56 +176,47 @@ def main(argv=None) -> int:
     ap.add_argument("--only", help="comma-separated family names (or their first word)")
     ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="override a field of exucable.solve.steady.SteadySettings")
+    ap.add_argument("--against", action="append", default=[], metavar="NAME=VALUE",
+                    help="also run each case with these SteadySettings fields (the --set ones too), right after")
     args = ap.parse_args(argv)
-    from exucable.solve.steady import SteadySettings
-
-    kinds = {f.name: f.type for f in dataclasses.fields(SteadySettings)}
-    overrides = {}
-    for item in args.set:
-        key, _, value = item.partition("=")
-        key = key.strip().lower()
-        if key not in kinds:
-            ap.error(f"--set {item}: SteadySettings has no field {key!r}; fields: {', '.join(kinds)}")
-        overrides[key] = int(float(value)) if kinds[key] == "int" else float(value)
+    settings, text = _settings(ap, args.set)
+    against, against_text = _settings(ap, args.set + args.against) if args.against else (None, "")
     table = families(ten_km=args.ten_km, quick=args.quick)
     if args.only:
         wanted = [w.strip() for w in args.only.split(",")]
         table = {k: v for k, v in table.items() if k in wanted or k.split()[0].rstrip(",") in wanted}
         if not table:
             ap.error(f"--only {args.only}: no such family; families: {', '.join(families())}")
-    runner = Runner(dataclasses.replace(SteadySettings(), **overrides) if overrides else None)
-    runner.case({"length_m": 200.0})          # warm-up: numba's kernels loaded before the first timed run
-    print(f"steady settings: {', '.join(f'{k} = {v:g}' for k, v in overrides.items()) or 'the defaults'}")
-    print("| family | case | status | Newton, solved mesh | steps tried / rejected | solve CPU [s] | from "
-          "| Newton, coarse | steps tried / rejected | coarse CPU [s] | run CPU [s] | pulling force [N] |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
-    summary, all_counts = [], []
+    runner = Runner()
+    runner.case({"length_m": 200.0}, settings)     # warm-up: numba's kernels loaded before the first timed run
+    print(f"A: steady settings {text}" + (f"; B: {against_text}" if against else ""))
+    print("| family | case | run | status | Newton, solved mesh | steps tried / rejected | shortened-step force "
+          "evaluations | solve CPU [s] | from | Newton, coarse | steps tried / rejected | shortened-step force "
+          "evaluations | coarse CPU [s] | run CPU [s] | pulling force [N] |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    rows = {"A": {}, "B": {}}
     for family, cases in table.items():
-        counts = []
         for label, kwargs in cases:
-            r = runner.case(kwargs)
-            fine, coarse = r["solve"], r["coarse"]
-            n = (fine["newton"] if fine else 0, coarse["newton"] if coarse else 0)
-            counts.append(n)
-            print(f"| {family} | {label} | {r['status']} | {_solve_cells(fine)} {fine['from'] if fine else '-'} | "
-                  f"{_solve_cells(coarse)} {r['cpu']:.2f} | {r['F']:.6f} |", flush=True)
-        c = np.array(counts)
-        summary.append((family, neighbour_ratio(c[:, 0]), neighbour_ratio(c[:, 1]), neighbour_ratio(c.sum(axis=1)),
-                        c.min(axis=0), c.max(axis=0)))
-        if family != "length at 10 km":
-            all_counts.extend(counts)
-    print()
-    print("| family | largest neighbour ratio: solved mesh | coarse | both | Newton range, solved mesh | coarse |")
-    print("|---|---|---|---|---|---|")
-    for family, rf, rc, rb, lo, hi in summary:
-        print(f"| {family} | {rf:.2f} | {rc:.2f} | {rb:.2f} | {lo[0]}-{hi[0]} | {lo[1]}-{hi[1]} |")
-    if all_counts:
-        c = np.array(all_counts)
-        worst = max(max(s[1], s[2], s[3]) for s in summary)
-        print(f"over every family: largest neighbour ratio {worst:.2f}; spread (largest / smallest) of the "
-              f"~1 km cases: solved mesh {c[:, 0].max()} / {c[:, 0].min()} = {c[:, 0].max() / max(c[:, 0].min(), 1):.2f}, "
-              f"coarse {c[:, 1].max()} / {c[:, 1].min()} = {c[:, 1].max() / max(c[:, 1].min(), 1):.2f}, both "
-              f"{c.sum(axis=1).max()} / {c.sum(axis=1).min()} = {c.sum(axis=1).max() / max(c.sum(axis=1).min(), 1):.2f}")
+            for tag, chosen in (("A", settings), ("B", against)):
+                if chosen is None:
+                    continue
+                r = runner.case(kwargs, chosen)
+                rows[tag].setdefault(family, []).append(r)
+                print(_row(family, label, tag, r), flush=True)
+                if tag == "B":
+                    a = rows["A"][family][-1]
+                    print(f"|   | B against A | | | CPU of the two solves B / A "
+                          f"{sum(r[k]['cpu'] for k in ('solve', 'coarse') if r[k]) / max(sum(a[k]['cpu'] for k in ('solve', 'coarse') if a[k]), 1e-9):.2f}"
+                          f", pulling force B / A - 1 {r['F'] / a['F'] - 1:+.1e} |", flush=True)
+    _summary(f"A ({text})", rows["A"])
+    if against:
+        _summary(f"B ({against_text})", rows["B"])
+        cpu = {t: sum(r[k]["cpu"] for runs in rows[t].values() for r in runs for k in ("solve", "coarse") if r[k])
+               for t in rows}
+        moved = max(abs(b["F"] / a["F"] - 1) for f in rows["A"] for a, b in zip(rows["A"][f], rows["B"][f]))
+        print(f"\nCPU of the two solves over every case: B / A = {cpu['B']:.2f} / {cpu['A']:.2f} s = "
+              f"{cpu['B'] / max(cpu['A'], 1e-9):.2f} (interleaved in this run); the largest relative change of a "
+              f"pulling force {moved:.1e}")
     return 0
 
 
