@@ -46,7 +46,7 @@ with c × 4. An accepted step divides c by ``rate_fall`` (by ``rate_fall_after_r
 rejection), so the steps become plain Newton steps near the solution. Why shorten first: where
 the cable leaves a wall it grazed (a bend's end), the check points just off the wall add no
 stiffness, and a nearly plain Newton step pushed the cable there millimetres into the wall (the
-residual 5-500× the step's start, on ~1 km routes at spring rates of 500-8000 s⁻²); retrying with
+residual 5-550× the step's start, on ~1 km routes at spring rates of 500-8000 s⁻²); retrying with
 a stiffer spring everywhere held the whole cable's soft axial mode for tens of steps for a
 spike at a few nodes, and the Newton count swung with whether a route's bend ends happened to
 spike (neighbouring routes 13 against 45 Newton iterations; ``benchmarks/newton_spread.py``).
@@ -187,9 +187,9 @@ class SteadySettings:
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
         iteration); 0 rejects at once. Only where the static solver can evaluate a state without a
         Newton iteration (our own, :mod:`exucable.solve.newton_system`); Exudyn's rejects at once.
-        Measured (``benchmarks/newton_spread.py``, the error bar's coarse solves of 42 routes about
-        1 km): 6: 13-25 Newton iterations, the largest ratio between neighbouring routes 1.26;
-        3: 13-26 and 1.62; 0: 13-53 and 3.46.
+        Measured (``benchmarks/newton_spread.py``'s 42 routes about 1 km, the error bar's coarse
+        solves: Newton iterations in all, the largest ratio between neighbouring routes): 6: 864,
+        1.23 (13-25 each); 4-12: 864-866, 1.23; 3: 884, 1.62; 0: 1590, 3.46 (13-53 each).
     """
 
     steady_residual: float = 1e-6
