@@ -109,7 +109,7 @@ def test_friction_opposes_relative_sliding_with_coulomb_magnitude():
     out = (np.zeros((m, 3), np.int64), np.zeros(m), np.zeros(m), np.zeros((m, 9)), np.zeros((m, 9, 9)),
            np.zeros((m, 9, 9)), np.zeros(m, np.bool_))
     count = _pair_contacts(X, U, 2, n_pts, 2, 2 * R, weight, LAW.stiffness, LAW.exponent, LAW.friction, eps ** 2,
-                           LAW.damping, LAW.damping_onset_m, True, *out)
+                           LAW.damping, LAW.damping_onset_m, True, *out, LAW.onset_layer_m)
     assert count == len(ref["t"])
     np.testing.assert_allclose(out[3][:count], ref["force"], rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(out[4][:count], ref["jac_x"], rtol=1e-10, atol=1e-9)
