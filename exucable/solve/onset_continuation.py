@@ -123,6 +123,16 @@ class OnsetContinuation:
     extrapolated_N: float = float("nan")
     layer_error_N: float = 0.0
 
+    def summary(self) -> dict:
+        """``layer_m`` (the answer's layer [m], 0: the law without one), ``extrapolated_pull_N`` and
+        ``layer_error_N`` (None where not known: one layer solved), ``stages`` (one dict per layer
+        tried); None before :meth:`descend` (the first layer did not solve)."""
+        if not self.stages:
+            return None
+        known = lambda x: float(x) if np.isfinite(x) else None     # noqa: E731  (JSON has no inf)
+        return {"layer_m": self.layer_m, "extrapolated_pull_N": known(self.extrapolated_N),
+                "layer_error_N": known(self.layer_error_N), "stages": [dict(vars(st)) for st in self.stages]}
+
     def begin(self, model) -> None:
         """The model's contact kernels at the first layer."""
         self._set(model, self.settings.layers_m()[0])

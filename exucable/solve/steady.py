@@ -772,7 +772,8 @@ class SteadySolver:
         return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
                             steps=self.steps, newton_iterations=self.newton_iterations,
                             jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from,
-                            static_solver=self.static.name)
+                            static_solver=self.static.name,
+                            onset_layer=self.onset.summary() if self.onset is not None else None)
 
     def restart_state(self):
         """The state the friction's ramp starts from: for a bundle the accepted state of smallest
