@@ -46,6 +46,9 @@ class OnsetSettings:
         Each layer is the last one divided by this [-] (> 1).
     floor_m : float
         The smallest layer above 0 [m]; after it, s = 0.
+    min_factor : float
+        The smallest factor between two layers [-] (> 1): a layer that stalls is tried again at the
+        square root of the factor, down to this (:meth:`OnsetContinuation.descend`).
     tolerance : float
         Relative difference [-] between an answer at a finite layer and the extrapolated s → 0 one
         within which the finite layer's answer stands when the next layer stalls.
@@ -54,6 +57,7 @@ class OnsetSettings:
     first_m: float = 5.0e-4
     factor: float = 2.0
     floor_m: float = 2.0e-6
+    min_factor: float = 1.05
     tolerance: float = RESOLUTION_FLOOR
 
     def __post_init__(self):
@@ -65,11 +69,14 @@ class OnsetSettings:
             raise SolverError(f"OnsetSettings.factor = {self.factor!r}: must be > 1")
         if not (0.0 < self.floor_m <= self.first_m):
             raise SolverError(f"OnsetSettings.floor_m = {self.floor_m!r}: must be in (0, first_m = {self.first_m!r}] m")
+        if not 1.0 < self.min_factor <= self.factor:
+            raise SolverError(f"OnsetSettings.min_factor = {self.min_factor!r}: must be in (1, factor = {self.factor!r}]")
         if not self.tolerance > 0.0:
             raise SolverError(f"OnsetSettings.tolerance = {self.tolerance!r}: must be > 0")
 
     def layers_m(self) -> list[float]:
-        """s₀, s₀/factor, ... down to ``floor_m``, then 0 [m]."""
+        """s₀, s₀/factor, ... down to ``floor_m``, then 0 [m]: the layers of a continuation whose
+        every layer converges."""
         out, s = [], float(self.first_m)
         while s >= self.floor_m * (1.0 - 1e-12):
             out.append(s)
@@ -80,14 +87,14 @@ class OnsetSettings:
 @dataclass
 class OnsetStage:
     """One layer's solve: layer s [m], converged?, Newton iterations and CPU time [s] of this stage,
-    the last accepted residual [N] and the pulling force [N] at its state."""
+    the last accepted residual [N] and the pulling force [N] at its state (None where it stalled)."""
 
     layer_m: float
     converged: bool
     newton_iterations: int
     cpu_s: float
-    residual_N: float
-    pull_force_N: float
+    residual_N: float | None
+    pull_force_N: float | None
 
 
 def extrapolate_to_zero(layers_m, forces_N) -> tuple[float, float]:
@@ -148,20 +155,29 @@ class OnsetContinuation:
     def _stage(self, solver, converged: bool, forces) -> None:
         now = time.process_time()
         trace = solver._trace
+        # a stalled layer's state is not an answer: no residual or pull of it
         self.stages.append(OnsetStage(self.layer_m, converged, solver.newton_iterations - self._its, now - self._cpu,
-                                      float(trace[-1]) if trace else float("nan"), float(forces(solver.model)[0])))
+                                      float(trace[-1]) if trace and converged else None,
+                                      float(forces(solver.model)[0]) if converged else None))
         self._cpu, self._its = now, solver.newton_iterations
 
     def descend(self, solver, message: str) -> tuple[str, str]:
-        """From the state ``solver`` converged to at the first layer, each smaller layer in turn by
-        its one-iteration, then exact-step continuation at full load: status and message.
+        """From the state ``solver`` converged to at the first layer, smaller layers in turn, each
+        by its one-iteration, then exact-step continuation at full load: status and message.
 
-        Leaves the solver's stored state at the last layer solved, the kernels at that layer."""
+        The layer falls by ``factor`` while its solves converge; a layer that stalls is tried again
+        closer to the last one solved (the factor's square root: a loaded contact sits at
+        δ = √(4 s φ) - s, outside the surface by most of a thick layer, and a much thinner layer can
+        leave it out of contact altogether), until the factor is below ``min_factor``. Below
+        ``floor_m`` the next layer is 0. Leaves the solver's stored state at the last layer solved,
+        the kernels at that layer."""
         from .steady import steady_forces
 
         s = self.settings
         self._stage(solver, True, steady_forces)
-        for layer in s.layers_m()[1:]:
+        factor, why = s.factor, ""
+        while self.layer_m > 0.0 and not solver.timed_out:
+            layer = 0.0 if self.layer_m <= s.floor_m * (1.0 + 1e-12) else max(self.layer_m / factor, s.floor_m)
             before, before_layer = solver.store.saved, self.layer_m
             self._set(solver.model, layer)
             ok, why = solver.relax_one_iteration(1.0, skip=solver.settings.warm_start_skipped_steps)
@@ -169,15 +185,19 @@ class OnsetContinuation:
                 solver.store.saved = before
                 ok, why = solver.relax(1.0)
             self._stage(solver, ok, steady_forces)
-            if not ok:
-                solver.store.saved = before
-                self._set(solver.model, before_layer)
-                solver.at_scale(1.0)
+            if ok:
+                factor = min(factor * factor, s.factor)
+                continue
+            solver.store.saved = before
+            self._set(solver.model, before_layer)
+            solver.at_scale(1.0)
+            factor = factor ** 0.5
+            if layer == 0.0 or factor < s.min_factor:
                 break
         done = [st for st in self.stages if st.converged]
         self.extrapolated_N, self.layer_error_N = extrapolate_to_zero([st.layer_m for st in done],
                                                                        [st.pull_force_N for st in done])
-        path = ", ".join(f"{1e6 * st.layer_m:.3g} µm: {st.pull_force_N:.6g} N" + ("" if st.converged else " (stalled)")
+        path = ", ".join(f"{1e6 * st.layer_m:.3g} µm: " + (f"{st.pull_force_N:.6g} N" if st.converged else "stalled")
                          for st in self.stages)
         note = f"{message}; contact onset layer continued ({path})"
         if self.layer_m == 0.0:
