@@ -202,8 +202,8 @@ def main(argv=None) -> int:
             above = [x for x in st_ if x["converged"] and x["layer_m"] > 0.0]
             f0 = extrapolate_to_zero([x["layer_m"] for x in above], [x["pull_force_N"] for x in above])[0] if above else float("nan")
             print(f"  {bend} {arrangement} μ_c {cf:g}: " + ", ".join(
-                f"{1e6 * x['layer_m']:.3g}: {x['pull_force_N']:.6g}{'' if x['converged'] else ' (stalled)'} "
-                f"({x['newton_iterations']}, {x['cpu_s']:.2f})" for x in st_) + f"; F₀ from the layers above 0: {f0:.6g}")
+                f"{1e6 * x['layer_m']:.3g}: " + (f"{x['pull_force_N']:.6g}" if x["converged"] else "stalled")
+                + f" ({x['newton_iterations']}, {x['cpu_s']:.2f})" for x in st_) + f"; F₀ from the layers above 0: {f0:.6g}")
     if kept is not None:
         diagnose(*kept, args.states)
     return 0
