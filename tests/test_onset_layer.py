@@ -157,3 +157,5 @@ def test_richardson_step_recovers_a_linear_dependence_and_the_layers_halve():
     assert extrapolate_to_zero(s + [0.0], f + [499.9]) == (499.9, 0.0)
     layers = OnsetSettings(first_m=4e-4, floor_m=1e-4).layers_m()
     assert layers == [4e-4, 2e-4, 1e-4, 0.0]
+    from exucable.solve.error_bar import RESOLUTION_FLOOR
+    assert OnsetSettings().tolerance == RESOLUTION_FLOOR

@@ -30,8 +30,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .error_bar import RESOLUTION_FLOOR
-
 __all__ = ["OnsetSettings", "OnsetStage", "OnsetContinuation", "extrapolate_to_zero"]
 
 
@@ -59,7 +57,9 @@ class OnsetSettings:
     factor: float = 2.0
     floor_m: float = 2.0e-6
     min_factor: float = 1.05
-    tolerance: float = RESOLUTION_FLOOR
+    # the steady error bar's floor, exucable.solve.error_bar.RESOLUTION_FLOOR (which imports the
+    # steady solve, hence not imported here; tests/test_onset_layer.py holds them equal)
+    tolerance: float = 1e-4
 
     def __post_init__(self):
         from ..errors import SolverError
@@ -153,13 +153,13 @@ class OnsetContinuation:
         if model.coupling is not None:
             model.coupling.forget_evaluation()     # a pass at the same coordinates was of the former layer
 
-    def _stage(self, solver, converged: bool, forces) -> None:
+    def _stage(self, solver, converged: bool) -> None:
         now = time.process_time()
         trace = solver._trace
         # a stalled layer's state is not an answer: no residual or pull of it
         self.stages.append(OnsetStage(self.layer_m, converged, solver.newton_iterations - self._its, now - self._cpu,
                                       float(trace[-1]) if trace and converged else None,
-                                      float(forces(solver.model)[0]) if converged else None))
+                                      float(solver.model.steady_forces()[0]) if converged else None))
         self._cpu, self._its = now, solver.newton_iterations
 
     def descend(self, solver, message: str) -> tuple[str, str]:
@@ -172,10 +172,8 @@ class OnsetContinuation:
         leave it out of contact altogether), until the factor is below ``min_factor``. Below
         ``floor_m`` the next layer is 0. Leaves the solver's stored state at the last layer solved,
         the kernels at that layer."""
-        from .steady import steady_forces
-
         s = self.settings
-        self._stage(solver, True, steady_forces)
+        self._stage(solver, True)
         factor, why = s.factor, ""
         while self.layer_m > 0.0 and not solver.timed_out:
             layer = 0.0 if self.layer_m <= s.floor_m * (1.0 + 1e-12) else max(self.layer_m / factor, s.floor_m)
@@ -185,7 +183,7 @@ class OnsetContinuation:
             if not ok and not solver.timed_out:
                 solver.store.saved = before
                 ok, why = solver.relax(1.0)
-            self._stage(solver, ok, steady_forces)
+            self._stage(solver, ok)
             if ok:
                 factor = min(factor * factor, s.factor)
                 continue
