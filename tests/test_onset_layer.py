@@ -159,3 +159,74 @@ def test_richardson_step_recovers_a_linear_dependence_and_the_layers_halve():
     assert layers == [4e-4, 2e-4, 1e-4, 0.0]
     from exucable.solve.error_bar import RESOLUTION_FLOOR
     assert OnsetSettings().tolerance == RESOLUTION_FLOOR
+
+
+class _FakeSolver:
+    """The parts of SteadySolver the continuation drives: a model whose pull is F(s) = 500 N + 1e5 N/m · s
+    (linear: Richardson's step is exact), whose solves converge at layers in ``converges(s)``."""
+
+    class _Model:
+        def __init__(self):
+            self.layer, self.coupling = None, None
+            self.kernel = self
+
+        def set_onset_layer(self, s):
+            self.layer = s
+
+        def steady_forces(self):
+            return 500.0 + 1e5 * self.layer, 0.0, 0.0
+
+    class _Store:
+        saved = ("state",)
+
+    def __init__(self, converges):
+        from exucable.solve.steady import SteadySettings
+
+        self.model, self.store, self.settings = self._Model(), self._Store(), SteadySettings()
+        self.converges, self.timed_out, self.newton_iterations, self._trace = converges, False, 0, [1e-5]
+        self.tried = []
+
+    def relax_one_iteration(self, lam, skip=0):
+        self.tried.append(self.model.layer)
+        self.newton_iterations += 10
+        return self.converges(self.model.layer), "stalled"
+
+    def relax(self, lam):
+        return self.converges(self.model.layer), "stalled"
+
+    def at_scale(self, lam):
+        pass
+
+
+def _descend(converges, **settings):
+    from exucable.solve.onset_continuation import OnsetContinuation
+
+    solver = _FakeSolver(converges)
+    onset = OnsetContinuation(OnsetSettings(**settings))
+    onset.begin(solver.model)
+    status, message = onset.descend(solver, "first layer solved")
+    return onset, solver, status, message
+
+
+def test_the_continuation_reaches_the_law_without_a_layer():
+    onset, solver, status, _ = _descend(lambda s: True, first_m=4e-4, floor_m=1e-4)
+    assert status == "ok" and onset.layer_m == 0.0 and solver.model.layer == 0.0
+    assert [st.layer_m for st in onset.stages] == [4e-4, 2e-4, 1e-4, 0.0]
+    assert onset.stages[-1].pull_force_N == 500.0 and onset.layer_error_N == 0.0
+
+
+def test_a_stalled_layer_is_retried_nearer_and_a_finite_layer_stands_within_the_floor():
+    """The layer 50 µm stalls, s = 0 never converges: 200 → 100 → (50 stalls) → 70.7 (the factor's
+    square root) → 35.4 (the factor back to 2) ... → 0.4 µm (the floor) → (0 stalls). The answer at the
+    last layer solved is kept only where its distance to the extrapolation, here exactly
+    1e5 N/m · s, is within 1e-4 of it."""
+    onset, solver, status, message = _descend(lambda s: s not in (0.0, 5e-5), first_m=2e-4, floor_m=4e-7)
+    assert solver.tried[:4] == [1e-4, 5e-5, pytest.approx(1e-4 / 2 ** 0.5), pytest.approx(0.5e-4 / 2 ** 0.5)]
+    assert solver.tried[-2:] == [pytest.approx(4e-7), 0.0]
+    assert onset.layer_m == pytest.approx(4e-7) and solver.model.layer == onset.layer_m      # back at the floor
+    assert onset.extrapolated_N == pytest.approx(500.0, rel=1e-12)
+    assert onset.layer_error_N == pytest.approx(1e5 * 4e-7, rel=1e-6)        # 0.04 N < 1e-4 · 500 N
+    assert status == "ok" and "the answer at the onset layer 0.4 µm" in message
+    # a floor where the layer's error is larger than 1e-4 of the answer: failed, saying so
+    onset, _, status, message = _descend(lambda s: s > 0.0, first_m=2e-4, floor_m=1e-4)
+    assert status == "failed" and onset.layer_error_N == pytest.approx(10.0) and "100 µm" in message
