@@ -57,3 +57,45 @@ def test_a_bundle_restarts_from_its_best_state_one_cable_from_the_start():
     one = SteadySolver(build_model(duct(1)))
     one.best = (1.0, best)
     assert one.restart_state() is one.start
+
+
+
+def _step_m(solver, c):
+    """The largest nodal move [m] along and across the cables' tangents of a one-iteration step at
+    spring rate ``c`` [1/s²] from the start, at the spring's axial share now."""
+    ok, _, _ = solver.pseudo_step(c, solver.one_iteration_settings)
+    assert ok
+    model = solver.model
+    q0 = solver.store.saved[0][model.ode2_index]
+    dq = (np.array(model.mbs.systemData.GetODE2Coordinates())[model.ode2_index] - q0).reshape(-1, 6)[:, :3]
+    slope = (model.layout.coordinates.reshape(-1) + q0).reshape(-1, 6)[:, 3:]
+    t = slope / np.linalg.norm(slope, axis=1, keepdims=True)
+    along = np.einsum("ki,ki->k", dq, t)
+    return float(np.abs(along).max()), float(np.linalg.norm(dq - along[:, None] * t, axis=1).max())
+
+
+def test_a_bundles_rejections_take_back_the_axial_release():
+    # the 100 m route's stall: steps accepted and rejected in turn, each accepted one releasing the
+    # spring's axial share by 4; with a rejection only quadrupling the rate the share fell to
+    # 0.25^23 = 1.4e-14 and a retried step stayed 28 mm long along the cables with the spring a
+    # million times stiffer (7 nm across). stiffen() takes one release back per rejection.
+    solver = SteadySolver(build_bundle_model(duct(3)))
+    s = solver.settings
+    c = solver.c0
+    for _ in range(23):
+        c /= s.rate_fall_after_reject                 # accepted after a rejection (relax_one_iteration)
+        solver.spring.axial_share *= s.axial_release
+        c = solver.stiffen(c)                         # the next one rejected
+    assert solver.spring.axial_share == s.axial_share
+    c = 1e3 * solver.c0
+    along, across = _step_m(solver, c)
+    solver.spring.axial_share = s.axial_share * s.axial_release ** 23
+    along_released, _ = _step_m(solver, c)
+    assert along_released > 1e-4                     # the start's axial misfit, nothing holding it
+    assert along < 1e-3 * along_released and across < 1e-6
+
+
+def test_one_cables_rejection_only_stiffens_the_rate():
+    solver = SteadySolver(build_model(duct(1)))
+    solver.spring.axial_share = 1e-6
+    assert solver.stiffen(2.0) == 8.0 and solver.spring.axial_share == 1e-6

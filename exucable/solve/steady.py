@@ -638,7 +638,7 @@ class SteadySolver:
                 # coarse solve took 54 Newton iterations instead of 23: the next steps diverged)
                 after_reject = True
             if residual > limit or not ok:
-                c *= 4.0
+                c = self.stiffen(c)
                 after_reject = True
                 if c > 1e6 * self.c0:
                     break
@@ -657,6 +657,24 @@ class SteadySolver:
             previous = residual
         return False, (f"one-iteration pseudo-time steps: no equilibrium after {budget} "
                        f"steps{f' ({message})' if message else ''}")
+
+    def stiffen(self, c: float) -> float:
+        """The spring rate [1/s²] after a rejected or failed pseudo-time step at rate ``c``: 4c, and
+        for several cables the axial share raised back by 1/``axial_release`` (at most to
+        ``axial_share``), so that the retried step is shorter along the cables too.
+
+        Why: each accepted step multiplies the axial share by ``axial_release``, so after tens of
+        them the spring holds nothing along the cables (0.25²³ = 1.4e-14 on the 100 m three-cable
+        route), and 4c alone left the steps 28 mm long along the tangent with the spring a million
+        times stiffer (across it, 7 nm), and every retried step was rejected: in a bend of radius R
+        an axial step u moves the nodes off their curve by up to u²/2R (78 µm at 28 mm and 5 m),
+        several times the contacts' loaded penetration (reference/README.md, "The 100 m route: the
+        spring released along the cables"; ``tests/test_bundle_continuation.py``). One cable's steps keep 4c alone (its rejected
+        steps are shortened first, :meth:`shorten_step`)."""
+        if self.bundle:
+            s = self.settings
+            self.spring.axial_share = min(s.axial_share, self.spring.axial_share / s.axial_release)
+        return 4.0 * c
 
     def shorten_step(self, residual_N: float, limit_N: float) -> float:
         """Go back along the one-iteration step just made (its true residual ``residual_N`` above
@@ -703,7 +721,7 @@ class SteadySolver:
             ok, message, leftover = self.pseudo_step(c, exact)
             if not ok:
                 stuck.record(exact, leftover)
-                c *= 4.0
+                c = self.stiffen(c)
                 if c > 1e6 * self.c0:
                     return False, stuck.why(message, lam, best, self.tolerance_N, self.exact_settings)
                 continue
