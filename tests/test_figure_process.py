@@ -115,6 +115,20 @@ def test_drawing_processes_forked_ahead_draw_the_same_files(tmp_path):
 
 @needs_fork
 @needs_proc_children
+def test_the_drawing_processes_of_a_helper_given_nothing_end_with_it():
+    """A failed run kills its helper without results: the drawing processes it forked ahead, waiting
+    for the results, end too."""
+    if len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("one core: the helper forks no drawing process")
+    with Figures(helper=True) as figures:
+        helper = figures._proc.pid
+        assert _wait_for(lambda: len(_children(helper)) == 2), "no drawing processes forked"
+        drawers = _children(helper)
+    assert _wait_for(lambda: all(_ended(pid) for pid in drawers), 10.0)
+
+
+@needs_fork
+@needs_proc_children
 def test_the_helper_of_a_run_that_died_ends_by_itself(tmp_path):
     """The run killed before it sent its results: the helper (which held the run's end of their
     pipe too, and so waited for ever) ends."""
