@@ -116,7 +116,14 @@ def _serve(conn, main_end=None) -> None:
         main_end.close()
     drawers = {}
     try:
-        _warm_up()
+        # matplotlib's import makes some 10^5 objects, freeing next to none: the collector's passes
+        # over them and over the run's objects (whose pages each pass copies here) are a tenth of
+        # the warm-up's CPU (benchmarks/figure_cost.py)
+        gc.disable()
+        try:
+            _warm_up()
+        finally:
+            gc.enable()
         # matplotlib's objects, loaded now, stay: the collector need not walk them again while the
         # figures are drawn, nor write to their pages in the drawing processes (each write copies a page)
         gc.freeze()
