@@ -100,7 +100,8 @@ def _cumtrapz(y, x):
 
 
 def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_per_m, bending_length_m: float,
-                        element_length_m: float, window_m: float, max_capture_m: float | None = None) -> tuple[float, float]:
+                        element_length_m: float, window_m: float, max_capture_m: float | None = None,
+                        s_sorted: bool = False) -> tuple[float, float]:
     """The point load at one end of a bend and its place (module docstring): (P [N], e [m]).
 
     Parameters
@@ -122,6 +123,9 @@ def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_pe
     max_capture_m : float, optional
         Upper bound of the capture window H, and how far inside the bend the landing is looked
         for (half the bend, so both ends stay apart).
+    s_sorted : bool
+        The caller has checked that ``s_m`` increases (:func:`bend_table`, once for all its bends'
+        ends instead of once per end: a pass over every check point of the route).
     """
     s = np.asarray(s_m, dtype=float)
     F = np.asarray(force_N, dtype=float)
@@ -131,7 +135,7 @@ def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_pe
     # from the bend's body (half its length in) outwards: the cable may land well inside the bend
     # (a free span across the clearance under gravity)
     inside = max_capture_m if max_capture_m is not None else bending_length_m + H
-    s, F = _near_end(s, F, s_end_m, max(H + bending_length_m + window_m / 2, inside + H, window_m / 2))
+    s, F = _near_end(s, F, s_end_m, max(H + bending_length_m + window_m / 2, inside + H, window_m / 2), s_sorted)
     u = inward * (s - s_end_m)                       # > 0 inside the bend
     near = np.flatnonzero((u >= -(H + bending_length_m + window_m / 2)) & (u <= inside))
     near = near[np.argsort(-u[near])]
@@ -175,13 +179,14 @@ def bend_end_point_load(s_m, force_N, s_end_m: float, inward: int, pressure_N_pe
     return P, float(s_end_m + inward * (u_end - ze))
 
 
-def _near_end(s, F, s_end_m: float, reach_m: float):
+def _near_end(s, F, s_end_m: float, reach_m: float, s_sorted: bool = False):
     """The sorted points ``s`` [m] (forces ``F``) within ``reach_m`` of ``s_end_m``, and one more
     on each side: all that :func:`bend_end_point_load` looks at (its selections lie within the
     reach; the first point past its window is at most the next one out), as contiguous slices, so
     that its sums run over the same numbers in the same order as over the whole route (Example 4:
-    78 400 points on the route, a few thousand near an end). Unsorted input is returned whole."""
-    if s.size < 2 or not np.all(s[1:] >= s[:-1]):
+    78 400 points on the route, a few thousand near an end). Unsorted input is returned whole;
+    ``s_sorted``: the caller knows ``s`` increases."""
+    if s.size < 2 or not (s_sorted or np.all(s[1:] >= s[:-1])):
         return s, F
     margin = reach_m * (1.0 + 1e-9) + 1e-9          # beyond the rounding of u = ±(s − s_end)
     i0 = max(int(np.searchsorted(s, s_end_m - margin, side="left")) - 1, 0)
@@ -228,6 +233,7 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
     """
     s_pts, cum = _cumulative_points(s_m, force_N)
     f_pts = np.diff(cum)                             # the forces in the order of s_pts
+    s_sorted = bool(s_pts.size < 2 or np.all(s_pts[1:] >= s_pts[:-1]))   # argsort's order: NaN would break it
     rs, rc = _rope_cumulative(rope_s_m, rope_pressure_N_per_m)
     ro = np.argsort(rope_s_m)
     rope_T = (np.asarray(rope_s_m, dtype=float)[ro], np.asarray(rope_tension_N, dtype=float)[ro])
@@ -261,7 +267,8 @@ def bend_table(pieces, s_m, force_N, cable_s_m, cable_tension_N, rope_s_m, rope_
                 np.sqrt(bending_stiffness_N_m2 / max(T_here, 1e-12)))
             lams.append(lam)
             ends[name] = bend_end_point_load(s_pts, f_pts, s_end, inward, body_pressure, lam,
-                                             element_length_m, window_m, max_capture_m=0.5 * (b.s1 - b.s0))
+                                             element_length_m, window_m, max_capture_m=0.5 * (b.s1 - b.s0),
+                                             s_sorted=s_sorted)
         t_start = (float(np.interp(b.s0, *cab_T)), float(np.interp(b.s1, *cab_T)))
         r_start = (float(np.interp(b.s0, *rope_T)), float(np.interp(b.s1, *rope_T)))
         entry, exit_ = ("start", "end") if direction == "forward" else ("end", "start")
