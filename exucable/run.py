@@ -41,11 +41,12 @@ def check_point_loads(model) -> dict | None:
     s = np.asarray(pts.s_conduit_m, dtype=float)
     keep = np.isfinite(s) & (s >= 0.0) & (s <= L)
     s = conduit_s(model, s)   # along the scenario's own conduit, not the pull-oriented one
-    order = np.argsort(s[keep])
-    return {"s_conduit_m": s[keep][order],
-            "normal_force_N": np.asarray(pts.normal_force_N, dtype=float)[keep][order],
-            "normal_force_per_length_N_per_m": np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order],
-            "penetration_m": np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)}
+    kept = np.flatnonzero(keep)
+    rows = kept[np.argsort(s[kept])]   # the kept points in order of s: one gather per column
+    return {"s_conduit_m": s[rows],
+            "normal_force_N": np.asarray(pts.normal_force_N, dtype=float)[rows],
+            "normal_force_per_length_N_per_m": np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[rows],
+            "penetration_m": np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[rows], nan=0.0), 0.0)}
 
 
 def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | None, float]:

@@ -74,6 +74,7 @@ class SnapshotRecorder:
     def __init__(self, model, times_s):
         self.model = model
         self.pending = [float(t) for t in sorted(times_s)]
+        # per file and column, one array per snapshot, joined by tables()
         self.rows = {name: {c: [] for c in cols} for name, cols in SNAPSHOT_FILES.items()}
         q, v = model.coordinates()
         a = self._accelerations()
@@ -90,7 +91,7 @@ class SnapshotRecorder:
 
     @property
     def recorded_s(self) -> list[float]:
-        return list(self.rows["snapshot_times.csv"]["time_s"])
+        return [float(t) for part in self.rows["snapshot_times.csv"]["time_s"] for t in part]
 
     def step(self, t: float, pull_force_N: float) -> None:
         """Called at the end of every solver step (time t [s]) with the pulling force there [N]."""
@@ -120,7 +121,7 @@ class SnapshotRecorder:
     def _append(self, name, **columns):
         n = max(np.size(v) for v in columns.values())
         for c, v in columns.items():
-            self.rows[name][c].extend(np.broadcast_to(np.asarray(v), (n,)).tolist())
+            self.rows[name][c].append(np.array(np.broadcast_to(np.asarray(v), (n,))))   # a copy: v may be a view of the state
 
     def _record(self, t, q, v, step, pull_force_N, a=None, reactions=None):
         """One snapshot of state (t, q, v); ``a`` the nodal accelerations (None: a static state) and
@@ -165,7 +166,5 @@ class SnapshotRecorder:
 
     def tables(self) -> dict[str, dict]:
         """file name -> {column: array}; integer columns stay integer."""
-        out = {}
-        for name, cols in self.rows.items():
-            out[name] = {c: np.asarray(v) for c, v in cols.items()}
-        return out
+        return {name: {c: np.concatenate(parts) if parts else np.asarray([]) for c, parts in cols.items()}
+                for name, cols in self.rows.items()}
