@@ -56,9 +56,15 @@ def default_window_m(centreline) -> float:
 
 
 def _cumulative_points(s_m, force_N):
-    order = np.argsort(s_m)
-    s = np.asarray(s_m, dtype=float)[order]
-    c = np.concatenate([[0.0], np.cumsum(np.asarray(force_N, dtype=float)[order])])
+    s, f = np.asarray(s_m, dtype=float), np.asarray(force_N, dtype=float)
+    # points in strictly increasing order (the run's check points come sorted) have one sorting
+    # permutation, the identity; with ties argsort's own order of them decides the sums' rounding
+    if not np.all(s[1:] > s[:-1]):
+        order = np.argsort(s_m)
+        s, f = s[order], f[order]
+    c = np.empty(len(s) + 1)
+    c[0] = 0.0
+    np.cumsum(f, out=c[1:])
     return s, c
 
 
