@@ -6,8 +6,9 @@ scipy.sparse and scipy.special it loads) was a tenth of a second of every ``exuc
 (the fixed cost, docs/performance.md); numba is loaded by the contact kernel anyway.
 
 The samples are cut into blocks of ~n^(1/3) consecutive samples, and the blocks into groups of
-~n^(1/3) blocks. A block's (group's) samples lie within its radius ρ (the largest distance of a member
-from its centre sample) of that centre, so none of them is nearer to a query point p than |p − c| − ρ.
+~n^(1/3) blocks. A block's samples lie within its radius ρ (the largest distance of a member from its
+centre sample) of that centre, a group's within the largest |c_block − c_group| + ρ_block of its
+blocks, so none of them is nearer to a query point p than |p − c| − ρ.
 A query takes as its best so far the previous query's answer (the points of a cable come in order
 along it) or, if nearer, the nearest group centre (itself a sample); it then opens only the groups,
 and in them the blocks, whose bound does not exceed the best so far, and scans those blocks'
@@ -82,7 +83,12 @@ class NearestSample:
         centre, radius = _spans(c, starts)
         per_group = max(1, math.isqrt(len(starts) - 1) + 1)  # ~n^(1/3) blocks a group
         group_blocks = np.arange(0, len(starts), per_group)
-        group_centre, group_radius = _spans(c, starts[group_blocks])
+        group_centre, _ = _spans(c, starts[group_blocks], radii=False)
+        # a group's radius bounded through its blocks' (|c_b − c_g| + ρ_b ≥ any member's distance):
+        # a bound is all the search needs, and it takes a distance per block, not per sample
+        reach = np.linalg.norm(c[centre] - c[np.repeat(group_centre, np.diff(np.append(group_blocks, len(starts))))],
+                               axis=1) + radius
+        group_radius = np.maximum.reduceat(reach, group_blocks)
         self.samples_m = c
         self._start = np.append(starts, n).astype(np.int64)
         self._centre = centre.astype(np.int64)
@@ -109,11 +115,14 @@ def _cube_root_up(n: int) -> int:
     return k
 
 
-def _spans(samples, starts):
-    """Centre sample (the middle one) and radius (the largest distance of a member from it) of each
-    run of consecutive ``samples`` beginning at ``starts`` (the last run ends with the samples)."""
+def _spans(samples, starts, radii: bool = True):
+    """Centre sample (the middle one) and radius (the largest distance of a member from it; None
+    unless ``radii``) of each run of consecutive ``samples`` beginning at ``starts`` (the last run
+    ends with the samples)."""
     n = len(samples)
     counts = np.diff(np.append(starts, n))
     centre = np.minimum(starts + counts // 2, n - 1)
+    if not radii:
+        return centre, None
     spread = np.linalg.norm(samples - samples[np.repeat(centre, counts)], axis=1)
     return centre, np.maximum.reduceat(spread, starts)
