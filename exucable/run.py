@@ -21,7 +21,7 @@ from .output.outdir import owned_out_dir
 from .output.results import RunResult, write_results
 from .output.summary import RunSummary
 from .scenario.specs import Scenario, load_scenario
-from .post.pressure import bend_table, default_window_m, pressure_profile
+from .post.pressure import bend_table, default_window_m, pressure_profile, sorted_point_loads
 from .post.tension import SteadyState, detect_steady_state, profile_stations_m
 from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, not_steady_fix, pull_force_uncertainty
 
@@ -100,13 +100,15 @@ def _pressure(model, points, rope, gauge: AxisGauge | None = None) -> tuple[dict
     w = default_window_m(centre)
     rope_p = rope.sidewall_pressure_N_per_m
     rope_s = conduit_s(model, rope.s_conduit_m)     # the rope is solved on the pull-oriented conduit
-    prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m)
+    summed = sorted_point_loads(points["s_conduit_m"], points["normal_force_N"])   # for both tables
+    prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m,
+                            sorted_loads=summed)
     s_c, T_c = cable_tension_along_conduit(model, gauge)
     lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
     bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
                        rope.tension_N, rope_p, w, lam, model.scenario.pull.direction,
                        bending_stiffness_N_m2=model.scenario.cable.bending_stiffness_N_m2,
-                       element_length_m=float(np.max(model.layout.element_length_m)))
+                       element_length_m=float(np.max(model.layout.element_length_m)), sorted_loads=summed)
     i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
     info = {"pressure_window_m": w,
             "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
