@@ -81,19 +81,28 @@ def axis_gauge(model) -> AxisGauge:
     return AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)
 
 
-def cable_tension_along_conduit(model, gauge: AxisGauge | None = None) -> tuple[np.ndarray, np.ndarray]:
+def cable_tension_along_conduit(model, gauge: AxisGauge | None = None,
+                                profile_tension_N=None) -> tuple[np.ndarray, np.ndarray]:
     """The cable's tension at its nodes [N] (from its loads' equilibrium, :meth:`Model.tension_N`) and
-    their places along the scenario's conduit [m]; ``gauge``: :func:`axis_gauge` of the model, if made."""
+    their places along the scenario's conduit [m]; ``gauge``: :func:`axis_gauge` of the model, if made;
+    ``profile_tension_N``: the tension now at :func:`exucable.post.tension.profile_stations_m`'s
+    stations (k per element from each node, and the leading end), if known: every k-th value is a
+    node's (the same stations, the same numbers)."""
     q, _ = model.coordinates()
     Le = model.layout.element_length_m
-    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
-    T = model.tension_N(x_nodes)
+    if profile_tension_N is not None:
+        T = np.asarray(profile_tension_N, dtype=float)
+        T = T[::(len(T) - 1) // len(Le)]
+    else:
+        T = model.tension_N(np.concatenate([[0.0], np.cumsum(Le)]))
     _, s = (axis_gauge(model) if gauge is None else gauge)(q[:, :3])
     return conduit_s(model, s), T
 
 
-def _pressure(model, points, rope, gauge: AxisGauge | None = None) -> tuple[dict, list, dict | None]:
-    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.post.pressure)."""
+def _pressure(model, points, rope, gauge: AxisGauge | None = None,
+              profile_tension_N=None) -> tuple[dict, list, dict | None]:
+    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.post.pressure);
+    ``profile_tension_N``: as :func:`cable_tension_along_conduit` takes it."""
     if points is None or rope is None:
         return {}, [], None
     centre = model.scenario.build_conduit().centreline
@@ -103,7 +112,7 @@ def _pressure(model, points, rope, gauge: AxisGauge | None = None) -> tuple[dict
     summed = sorted_point_loads(points["s_conduit_m"], points["normal_force_N"])   # for both tables
     prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m,
                             sorted_loads=summed)
-    s_c, T_c = cable_tension_along_conduit(model, gauge)
+    s_c, T_c = cable_tension_along_conduit(model, gauge, profile_tension_N)
     lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
     bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
                        rope.tension_N, rope_p, w, lam, model.scenario.pull.direction,
@@ -353,7 +362,7 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     # one gauge of the conduit's axis for the pressure table and the final contact check (built
     # from up to 200 000 centreline samples)
     gauge = axis_gauge(model) if model.kernel is not None else None
-    pressure_info, bends, pressure_prof = _pressure(model, points, rope, gauge)
+    pressure_info, bends, pressure_prof = _pressure(model, points, rope, gauge, profile_tension_N=N)
     has_history = bool(len(h["time_s"]))
     pull_force_N = float(np.mean(h["pull_force_N"][i0:])) if has_history else None
     warnings = list(model.mesh.warnings) if model.mesh is not None else []
