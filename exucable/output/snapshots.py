@@ -154,8 +154,12 @@ class SnapshotRecorder:
         pts = m.kernel.points(q.reshape(-1), np.nan_to_num(v).reshape(-1))
         e = pts.element
         pen = np.nan_to_num(np.asarray(pts.penetration_m, dtype=float), nan=-np.inf)
-        max_pen = np.full(n_el, -np.inf)
-        np.maximum.at(max_pen, e, pen)
+        k = len(e) // n_el if n_el else 0
+        if k and len(e) == k * n_el:
+            max_pen = pen.reshape(n_el, k).max(axis=1)    # the kernel's points: element-major, k each
+        else:
+            max_pen = np.full(n_el, -np.inf)
+            np.maximum.at(max_pen, e, pen)
         normal = np.bincount(e, pts.normal_force_N, n_el)
         friction = np.bincount(e, pts.friction_force_N, n_el)
         self._append("snapshot_contact.csv", time_s=t, element=np.arange(n_el),
