@@ -92,7 +92,11 @@ def cable_tension_along_conduit(model, gauge: AxisGauge | None = None,
     Le = model.layout.element_length_m
     if profile_tension_N is not None:
         T = np.asarray(profile_tension_N, dtype=float)
-        T = T[::(len(T) - 1) // len(Le)]
+        per_element, rest = divmod(len(T) - 1, len(Le))
+        if rest or not per_element:
+            raise ValueError(f"profile_tension_N: {len(T)} values are not k stations on each of {len(Le)} "
+                             "elements and the leading end (exucable.post.tension.profile_stations_m)")
+        T = T[::per_element]
     else:
         T = model.tension_N(np.concatenate([[0.0], np.cumsum(Le)]))
     _, s = (axis_gauge(model) if gauge is None else gauge)(q[:, :3])
