@@ -5,10 +5,11 @@ A result file's floats are written in their shortest round-trip form, the one ``
 finds it with David Gay's ``dtoa`` at ~0.3-0.45 µs a value, numpy's Dragon4 (``arr.astype(str)``,
 the same strings) at ~0.8-1 µs: at 10 km a steady run writes ~750 000 values, 0.3 s of CPU time.
 This module finds the same digits with Ryu (Ulf Adams, "Ryū: fast float-to-string conversion",
-PLDI 2018, Sect. 3, and the reference implementation's ``d2s.c``: the shortest decimal in the
-double's rounding interval, the closest one when several are as short, ties to even), compiled with
-numba, at a tenth of that; the layout of ``repr`` around those digits (:func:`_put_double`) is
-Python's ``float_repr_style = 'short'``: positional when −4 < decpt ≤ 16, else ``d.ddde±XX``.
+PLDI 2018, and the reference implementation's ``d2s.c``: the shortest decimal in the double's
+rounding interval, the closest one when several are as short, ties to even), compiled with numba, at
+about a fifth of that (75-90 ns a value); the layout of ``repr`` around those digits
+(:func:`_put_double`) is Python's ``float_repr_style = 'short'``: positional when −4 < decpt ≤ 16,
+else ``d.ddde±XX``.
 ``tests/test_numbers_text.py`` checks the strings against ``repr`` on random bit patterns, every
 binade's ends, subnormals, integers, ±0, ±inf and NaN.
 """
