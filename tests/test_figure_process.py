@@ -90,20 +90,25 @@ needs_proc_children = pytest.mark.skipif(not Path(f"/proc/{os.getpid()}/task/{os
                                          reason="reads a process's children from Linux's /proc")
 
 
+def _drawing_processes_forked(figures) -> tuple[int, list[int]]:
+    """The helper's id and, once it has forked them after its warm-up, its two drawing processes'."""
+    if len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("one core: the helper forks no drawing process")
+    helper = figures._proc.pid
+    assert _wait_for(lambda: len(_children(helper)) == 2), "no drawing processes forked"
+    return helper, _children(helper)
+
+
 @needs_fork
 @needs_proc_children
 def test_drawing_processes_forked_ahead_draw_the_same_files(tmp_path):
     """A helper given the results after its warm-up has forked a drawing process for each figure but
     its own, each with its frame built; they draw byte for byte what one process draws, report their
     frames' CPU beside the solve, and every process of the figures has ended when the run goes on."""
-    if len(os.sched_getaffinity(0)) < 2:
-        pytest.skip("one core: the helper forks no drawing process")
     from exucable.output import figure_process as fp
 
     with Figures(helper=True) as figures:
-        helper = figures._proc.pid
-        assert _wait_for(lambda: len(_children(helper)) == 2), "no drawing processes forked"
-        drawers = _children(helper)
+        helper, drawers = _drawing_processes_forked(figures)
         helper_paths = write_results(tmp_path / "helper", _result(), plots=figures)
     here = fp.draw_figures(tmp_path / "here", _result())
     assert [p.name for p in helper_paths if p.suffix == ".png"] == [p.name for p in here]
@@ -118,12 +123,8 @@ def test_drawing_processes_forked_ahead_draw_the_same_files(tmp_path):
 def test_the_drawing_processes_of_a_helper_given_nothing_end_with_it():
     """A failed run kills its helper without results: the drawing processes it forked ahead, waiting
     for the results, end too."""
-    if len(os.sched_getaffinity(0)) < 2:
-        pytest.skip("one core: the helper forks no drawing process")
     with Figures(helper=True) as figures:
-        helper = figures._proc.pid
-        assert _wait_for(lambda: len(_children(helper)) == 2), "no drawing processes forked"
-        drawers = _children(helper)
+        _, drawers = _drawing_processes_forked(figures)
     assert _wait_for(lambda: all(_ended(pid) for pid in drawers), 10.0)
 
 
