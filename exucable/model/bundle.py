@@ -574,8 +574,14 @@ class BundleModel:
         blocks.append(-J.data)
         return np.concatenate(rows), np.concatenate(cols), np.concatenate(blocks)
 
+    @property
+    def steady_force_supported(self) -> bool:
+        """Whether :meth:`steady_force` can assemble the residual: the cables' elastic forces are the
+        compiled element's (``solver.cable_element = "compiled"``), not Exudyn's objects."""
+        return self.wall_couplings[0].cable_forces is not None
+
     def _need_compiled(self) -> None:
-        if self.wall_couplings[0].cable_forces is None:
+        if not self.steady_force_supported:
             raise ModelError("solver.cable_element", 'the bundle\'s residual outside Exudyn needs the compiled '
                              'cable element; set solver.cable_element = "compiled"')
 

@@ -170,6 +170,12 @@ class SteadySettings:
         Pseudo-time steps (accepted and rejected) a warm start may take, the stall rule
         (``max_one_iteration_stall``) included, before the solve starts again from the rope start [-]
         (a warm start that converges took at most 10 on the long routes).
+    bundle_relax_steps : int
+        Several cables: steps of the dynamic relaxation (:mod:`exucable.solve.relax`) at most, run
+        where the one-iteration continuation from the start fails [-]; 0 skips it (the module's notes).
+    bundle_relax_within : float
+        Residual, in stop tolerances, at which the dynamic relaxation hands its state to the
+        one-iteration continuation [-].
     """
 
     steady_residual: float = 1e-6
@@ -190,6 +196,8 @@ class SteadySettings:
     time_limit_s: float = 60.0
     warm_start_skipped_steps: int = 3
     max_warm_start_steps: int = 20
+    bundle_relax_steps: int = 100000
+    bundle_relax_within: float = 30.0
 
     def __post_init__(self):
         for f in fields(self):
@@ -509,6 +517,7 @@ class SteadySolver:
         self.bundle = getattr(model, "n_cables", 1) > 1
         self.best = (np.inf, None)       # the smallest true residual [N] of an accepted step and its state
         self.friction_only = False       # the load ramp scales the friction only (a bundle's first ramp)
+        self.relaxation = None           # a bundle's dynamic relaxation (exucable.solve.relax.RelaxOutcome), if run
 
     def out_of_time(self) -> bool:
         """Whether the solve has used up its CPU time (:attr:`SteadySettings.time_limit_s`)."""
@@ -627,6 +636,30 @@ class SteadySolver:
         return False, (f"one-iteration pseudo-time steps: no equilibrium after {budget} "
                        f"steps{f' ({message})' if message else ''}")
 
+    def relax_dynamic(self, why: str) -> tuple[bool, str]:
+        """Several cables, where the one-iteration continuation from the start failed (``why``):
+        dynamic relaxation (:func:`exucable.solve.relax.relax_bundle`) from the start at full load to
+        ``bundle_relax_within`` stop tolerances, then the one-iteration continuation from the relaxed
+        state, which is the start of every phase after: converged?, and why not."""
+        from .relax import RelaxSettings, relax_bundle
+
+        s = self.settings
+        self.at_scale(1.0)
+        self.store.saved = self.start
+        self.store.restore_as_initial()
+        left = s.time_limit_s - (time.process_time() - self._cpu_start)
+        out = relax_bundle(self.model, RelaxSettings(residual_N=s.bundle_relax_within * self.tolerance_N,
+                                                     max_steps=s.bundle_relax_steps, time_limit_s=max(left, 1e-3)))
+        self.relaxation = out
+        self.store.save()
+        self.start = self.store.saved
+        note = (f"{why}; then dynamic relaxation: {out.steps} steps, {out.restarts} restarts, residual "
+                f"{out.residual_N:.3g} N ({out.message})")
+        if self.out_of_time():
+            return False, note
+        ok, message = self.relax_one_iteration(1.0)
+        return ok, note if ok else f"{note}; from there: {message}"
+
     def relax(self, lam: float) -> tuple[bool, str]:
         """Pseudo-time steps (inexact far from the steady state, exact near it) at load scale
         ``lam`` [-] from the stored state until the equilibrium residual is below the tolerance:
@@ -734,6 +767,9 @@ class SteadySolver:
         if not ok:
             self.store.saved = self.start
             ok, first_message = self.relax_one_iteration(1.0)
+            if (not ok and self.bundle and self.settings.bundle_relax_steps and not self.timed_out
+                    and model.steady_force_supported):
+                ok, first_message = self.relax_dynamic(first_message)
             if not ok and not self.timed_out:
                 self.store.saved = self.start
                 ok, first_message = self.relax(1.0)
@@ -741,6 +777,10 @@ class SteadySolver:
         if ok:
             message = (f"{self.accepted} pseudo-time steps from the coarse mesh's state" if started_from != "rope"
                        else f"{self.accepted} pseudo-time steps{warm_note}")
+            if self.relaxation is not None:
+                r = self.relaxation
+                message += (f" (after the one-iteration steps from the rope start failed, from the state of a "
+                            f"dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s CPU, residual {r.residual_N:.3g} N)")
         else:
             status, message = self.ramp_loads(first_message)
             if status != "ok" and self.bundle and not self.timed_out:
