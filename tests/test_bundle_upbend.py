@@ -1,5 +1,5 @@
 """Three cables through an up-bend in steady mode (studies/bundle_upbend_study.py, reference/README.md
-"Three cables through an up-bend: where the steady solve stalls").
+"Three cables through an up-bend: where the steady solve stalled").
 
 A 30° up-bend of 5 m radius between two 3 m straights, three cables of 30 mm in a 100 mm duct,
 μ 0.3, 300 N back tension, gravity: the same bend turned down solves in about a second of CPU; turned

@@ -2,7 +2,7 @@
 
 The steady solve's pseudo-time continuation (:mod:`exucable.solve.steady`) takes implicit steps, each
 a Newton problem. Where several cables share a duct those steps stall (reference/README.md, "Three
-cables through an up-bend: where the steady solve stalls"): a soft, sometimes unstable sideways mode of
+cables through an up-bend: where the steady solve stalled"): a soft, sometimes unstable sideways mode of
 a cable resting on others and grazing contacts that switch on and off keep each Newton update within
 the contacts' micrometre scale. Dynamic relaxation (Day 1965; Underwood 1983, "Dynamic relaxation",
 in *Computational Methods for Transient Analysis*, ch. 5; Barnes 1999, "Form finding and analysis of

@@ -54,6 +54,13 @@ with gravity and the end forces ramped to zero the cables float in the duct, the
 singular, and the ramp stalled at load scale 0 (one 90° bend at 4000 N back tension: with friction
 alone from the best state it converged at λ = 0.5). The loads' ramp from the start stays first:
 a keystone laid in a straight drops into a cradle that way, and not from the best state.
+And where the one-iteration steps from the start fail, a bundle is first relaxed by a fictitious
+explicit dynamics on the same residual (:mod:`exucable.solve.relax`, :meth:`SteadySolver.relax_dynamic`)
+to ``bundle_relax_within`` stop tolerances, and every phase after runs from the relaxed state: the
+implicit steps stalled at newtons where the cables must rearrange across the duct (three cables in an
+up-bend: the triangle turns over onto the upper wall), and the relaxation, like a physical settle, moves
+off the unstable balances on the way (reference/README.md, the up-bend study: 12 of 12 cases solve, 5
+failed at the 60 s limit before).
 
 A solve may instead start warm, from a state near its steady state (``warm_start``: the coarse mesh's
 solved state subdivided, :func:`exucable.solve.start.nested_start`). The phases above assume the rope
@@ -773,6 +780,10 @@ class SteadySolver:
             if not ok and not self.timed_out:
                 self.store.saved = self.start
                 ok, first_message = self.relax(1.0)
+                if not ok and self.relaxation is not None:
+                    r = self.relaxation
+                    first_message += (f" (from the state of a dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s "
+                                      f"CPU, residual {r.residual_N:.3g} N: {r.message})")
             first_message += warm_note
         if ok:
             message = (f"{self.accepted} pseudo-time steps from the coarse mesh's state" if started_from != "rope"
