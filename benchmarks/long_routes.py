@@ -73,25 +73,28 @@ BEND_ANGLE_DEG = 15.0
 BEND_RADIUS_M = 10.0
 
 
-def route_path(length_m: float) -> list[dict]:
-    """Straights and 15° bends adding up to ``length_m`` [m], one bend per ~350 m (at least one),
-    turning left, up, right, down in turn (the straights after an up or down bend slope)."""
+def route_path(length_m: float, bend_angle_deg: float = BEND_ANGLE_DEG, bend_spacing_m: float = BEND_SPACING_M,
+               turns: tuple = ("left", "up", "right", "down")) -> list[dict]:
+    """Straights and bends of ``bend_angle_deg`` [°] (radius 10 m) adding up to ``length_m`` [m], one
+    bend per ~``bend_spacing_m`` [m] (at least one), turning as ``turns`` in turn (by default left,
+    up, right, down: the straights after an up or down bend slope)."""
     import math
 
-    turns = ["left", "up", "right", "down"]
-    n_bends = max(1, int(round(length_m / BEND_SPACING_M)))
-    arc = math.radians(BEND_ANGLE_DEG) * BEND_RADIUS_M
+    n_bends = max(1, int(round(length_m / bend_spacing_m)))
+    arc = math.radians(bend_angle_deg) * BEND_RADIUS_M
     straight = (length_m - n_bends * arc) / (n_bends + 1)
     path = [{"straight": straight}]
     for i in range(n_bends):
-        path.append({"bend": BEND_ANGLE_DEG, "radius": BEND_RADIUS_M, "turn": turns[i % 4]})
+        path.append({"bend": bend_angle_deg, "radius": BEND_RADIUS_M, "turn": turns[i % len(turns)]})
         path.append({"straight": straight})
     return path
 
 
-def route_data(length_m: float, cable_element: str | None = None, static_solver: str | None = None) -> dict:
+def route_data(length_m: float, cable_element: str | None = None, static_solver: str | None = None,
+               friction: float = 0.2, back_tension_N: float = 500.0, **route) -> dict:
     """The scenario (as a TOML-like dict) of a route of ``length_m`` [m], steady mode;
-    ``cable_element``, ``static_solver``: those ``[solver]`` keys (None: the default)."""
+    ``cable_element``, ``static_solver``: those ``[solver]`` keys (None: the default); ``friction`` [-]
+    and ``back_tension_N`` [N]: the pull's; ``route``: :func:`route_path`'s bend keywords."""
     import math
 
     area = math.pi * CABLE_RADIUS_M ** 2
@@ -104,9 +107,9 @@ def route_data(length_m: float, cable_element: str | None = None, static_solver:
         "name": f"long-route-{length_m:g}m",
         "cable": {"radius": CABLE_RADIUS_M, "mass_per_length": MASS_PER_LENGTH_KG_PER_M,
                   "youngs_modulus": AXIAL_STIFFNESS_N / area},
-        "conduit": {"inner_radius": DUCT_INNER_RADIUS_M, "path": route_path(length_m)},
-        "contact": {"friction": 0.2},
-        "pull": {"speed": 0.1, "back_tension": 500.0},
+        "conduit": {"inner_radius": DUCT_INNER_RADIUS_M, "path": route_path(length_m, **route)},
+        "contact": {"friction": friction},
+        "pull": {"speed": 0.1, "back_tension": back_tension_N},
         "gravity": {"g": 9.81},
         "solver": solver,
     }

@@ -32,6 +32,7 @@ SCRIPTS = {
     "benchmarks/naive_baseline.py": "| | whole process [s] | simulation [s]",
     "benchmarks/newton_cost.py": "| case | check points | steps | Newton its",
     "benchmarks/newton_floor.py": "| part (CPU per call, median) | before [ms] | after [ms]",
+    "benchmarks/newton_spread.py": "| family | largest neighbour ratio: solved mesh |",
     "benchmarks/newton_trace.py": "| accepted steps | rejected attempts",
     "benchmarks/run_examples.py": "| example | status | wall [s]",
     "benchmarks/steady_error_bar.py": "| case | elements (coarse) | F [N] | u [N] (u/F)",

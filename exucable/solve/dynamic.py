@@ -44,6 +44,7 @@ class SolveOutcome:
     wall_time_s: float
     started_from: str = "rope"   # a steady solve's start that converged: "rope" or "coarse mesh"
     static_solver: str | None = None   # a steady solve's static solver: "exucable" or "exudyn"
+    backtracks: int = 0          # a steady solve's force evaluations of shortened steps (no Newton iteration)
 
 
 class Progress:

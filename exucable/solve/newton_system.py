@@ -288,6 +288,18 @@ class OwnStaticNewton(StaticBackend):
             f[rows] += np.asarray(self.mbs.GetLoadParameter(i, "loadVector"), dtype=float)
         return f
 
+    def _constant_forces(self) -> np.ndarray:
+        """The forces that do not depend on the iterate, cable order [N]: the end loads, and the
+        sheave's damping -D q̇ at the nodes' initial rates (Exudyn's static solver evaluates it there,
+        a static solve never updates them: kept so that the iterates match)."""
+        loads = self._load_vector()
+        if self._guide is not None:
+            rows, D = self._guide[0], self._guide[4]
+            rates = np.asarray(self.mbs.systemData.GetODE2Coordinates_t(
+                configuration=exu.ConfigurationType.Initial))[self.index]
+            loads[rows] -= D @ rates[rows]
+        return loads
+
     def _forces(self, q, lam, loads) -> np.ndarray:
         """ODE2 residual rows in cable order: f(q) + C_qᵀλ (f: coupling, spring, end loads)."""
         t0 = time.process_time()
@@ -401,13 +413,7 @@ class OwnStaticNewton(StaticBackend):
                          else start, dtype=float)
         q = q_sys[self.index]
         lam = np.zeros(len(self.held))              # Exudyn starts Newton with zero multipliers
-        loads = self._load_vector()
-        if self._guide is not None:
-            # Exudyn's static solver evaluates the sheave's damping -D q̇ at the nodes' initial rates
-            # (a static solve never updates them): a constant force, kept so that the iterates match
-            rows, D = self._guide[0], self._guide[4]
-            rates = np.asarray(sd.GetODE2Coordinates_t(configuration=exu.ConfigurationType.Initial))[self.index]
-            loads[rows] -= D @ rates[rows]
+        loads = self._constant_forces()
         # the rig holds its coordinates at the start's position (a steady model's drive does not move)
         offset = np.zeros(len(self.held))
         self.time_parts_s["glue"] += time.process_time() - t0
@@ -461,6 +467,24 @@ class OwnStaticNewton(StaticBackend):
 
     def system_residual(self) -> np.ndarray:
         return self._residual.copy()
+
+    def evaluate_at(self, q_sys) -> None:
+        """Make the system's ODE2 coordinates ``q_sys`` the state reached, without a Newton
+        iteration: its residual becomes the last one (:meth:`equilibrium_residual_N`), the rig's
+        multipliers those that balance its held rows (the reaction there is whatever holds them).
+        ``q_sys`` must hold the rig's coordinates where a solve leaves them (as any point between
+        two states a solve reached does). One force evaluation: what a shortened step costs
+        (``SteadySolver.relax_one_iteration``)."""
+        q_sys = np.array(q_sys, dtype=float)
+        r = self._forces(q_sys[self.index], np.zeros(len(self.held)), self._constant_forces())
+        lam_sys = np.zeros(self.n_ae)
+        lam_sys[self.ae] = -r[self.held]
+        r[self.held] = 0.0
+        sd = self.mbs.systemData
+        sd.SetODE2Coordinates(q_sys)
+        sd.SetAECoordinates(lam_sys)
+        self._residual = np.empty(self.n)
+        self._residual[self.index] = r
 
     def equilibrium_residual_N(self) -> float:
         """Norm [N] of the last residual less the pseudo-time spring's force: the unregularised

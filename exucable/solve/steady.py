@@ -14,7 +14,9 @@ contact law, smooth wall, broad phase, gravity, back tension), built by
 
 and solved from the pre-tensioned start (the rope solution) by static solves: Exudyn's Newton method
 on our own assembled system where the model allows it, else Exudyn's static solver
-(``[solver] static_solver``, :mod:`exucable.solve.newton_system`; the same iterates to round-off).
+(``[solver] static_solver``, :mod:`exucable.solve.newton_system`; the same iterates to round-off,
+but that ours also shortens a step whose residual spikes before rejecting it, which Exudyn's cannot:
+``SteadySettings.max_backtracks``).
 
 Why pseudo-time steps: the start is near equilibrium, but a full Newton step from it overshoots
 into the wall (Hertz contact is stiff, 1e5-1e6 N/m per node, the free spans are soft), and the
@@ -37,9 +39,19 @@ First, though, the same continuation is tried with one Newton iteration per pseu
 steered by the true residual (:meth:`SteadySolver.relax_one_iteration`): after each step the
 unregularised residual is the static solver's residual at the new state minus the spring's force
 there, so no step need be solved exactly to know how far the state is from equilibrium. A step
-whose residual grows more than ``reject_growth``-fold is undone and retried with c × 4; an accepted
-step divides c by ``rate_fall`` (by ``rate_fall_after_reject`` right after a rejection), so the
-steps become plain Newton steps near the solution. The solve stops once that residual is below the
+whose residual grows more than ``reject_growth``-fold is first shortened, halved up to
+``max_backtracks`` times along itself (a line search: one force evaluation each, no Newton
+iteration), and kept at the first length within that growth; if none is, it is undone and retried
+with c × 4. An accepted step divides c by ``rate_fall`` (by ``rate_fall_after_reject`` right after a
+rejection), so the steps become plain Newton steps near the solution. Why shorten first: where
+the cable leaves a wall it grazed (a bend's end), the check points just off the wall add no
+stiffness, and a nearly plain Newton step pushed the cable there millimetres into the wall (the
+residual 5-550× the step's start, on ~1 km routes at spring rates of 500-8000 s⁻²); retrying with
+a stiffer spring everywhere held the whole cable's soft axial mode for tens of steps for a
+spike at a few nodes, and the Newton count swung with whether a route's bend ends happened to
+spike (neighbouring routes 13 against 45 Newton iterations; ``benchmarks/newton_spread.py``).
+The shortened step keeps the step's direction; the spring then falls as after a rejection. The
+solve stops once that residual is below the
 tolerance: Example 4 in 17 Newton iterations instead of 36, its pulling force 1e-9 (not 7e-7) from
 the one at 1/1000 of the stop tolerance (reference/README.md, "Speed"). Where it does not converge within its budget, the
 exact-step continuation above runs from the start.
@@ -183,6 +195,14 @@ class SteadySettings:
     bundle_relax_within : float
         Residual, in stop tolerances, at which the dynamic relaxation hands its state to the
         one-iteration continuation [-].
+    max_backtracks : int
+        Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
+        it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
+        iteration); 0 rejects at once. Only where the static solver can evaluate a state without a
+        Newton iteration (our own, :mod:`exucable.solve.newton_system`); Exudyn's rejects at once.
+        Measured (``benchmarks/newton_spread.py``'s 42 routes about 1 km, the error bar's coarse
+        solves: Newton iterations in all, the largest ratio between neighbouring routes): 6: 864,
+        1.23 (13-25 each); 4-12: 864-866, 1.23; 3: 884, 1.62; 0: 1590, 3.46 (13-53 each).
     """
 
     steady_residual: float = 1e-6
@@ -205,6 +225,7 @@ class SteadySettings:
     max_warm_start_steps: int = 20
     bundle_relax_steps: int = 100000
     bundle_relax_within: float = 30.0
+    max_backtracks: int = 6
 
     def __post_init__(self):
         for f in fields(self):
@@ -500,6 +521,7 @@ class SteadySolver:
         self.start = self.store.saved
         self.newton_iterations = 0
         self.jacobian_updates = 0
+        self.backtracks = 0       # force evaluations of shortened one-iteration steps (shorten_step)
         self.steps = 0            # pseudo-time steps tried (rejected and failed ones included)
         self.accepted = 0         # pseudo-time steps kept (the history's rows)
         scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
@@ -622,7 +644,13 @@ class SteadySolver:
             residual = self.true_residual() if ok else np.inf
             # a bundle's steps are held to the best residual, not the last: drifting up by 2x per
             # step went 496 -> 22 000 N on the 100 m route
-            if residual > s.reject_growth * (min(previous, self.best[0]) if self.bundle else previous) or not ok:
+            limit = s.reject_growth * (min(previous, self.best[0]) if self.bundle else previous)
+            if ok and residual > limit:
+                residual = self.shorten_step(residual, limit)
+                # a shortened step kept: the spring falls as after a rejection (by 8 instead, 10 km's
+                # coarse solve took 54 Newton iterations instead of 23: the next steps diverged)
+                after_reject = True
+            if residual > limit or not ok:
                 c *= 4.0
                 after_reject = True
                 if c > 1e6 * self.c0:
@@ -666,6 +694,28 @@ class SteadySolver:
             return False, note
         ok, message = self.relax_one_iteration(1.0)
         return ok, note if ok else f"{note}; from there: {message}"
+
+    def shorten_step(self, residual_N: float, limit_N: float) -> float:
+        """Go back along the one-iteration step just made (its true residual ``residual_N`` above
+        ``limit_N`` [N]), halving its length up to ``max_backtracks`` times, until the true residual
+        is within ``limit_N``: the residual [N] at the state left there (still above ``limit_N`` when
+        no length was within it: the step is then rejected). Each length costs one force evaluation
+        (:attr:`backtracks`), no Newton iteration; a static solver that cannot evaluate a state on
+        its own (Exudyn's) leaves the step as it is."""
+        evaluate = getattr(self.static, "evaluate_at", None)
+        if evaluate is None:
+            return residual_N
+        q_end = np.array(self.mbs.systemData.GetODE2Coordinates())
+        q_start = self.store.saved[0]
+        alpha, residual = 1.0, residual_N
+        for _ in range(self.settings.max_backtracks):
+            alpha *= 0.5
+            evaluate(q_start + alpha * (q_end - q_start))
+            self.backtracks += 1
+            residual = self.true_residual()
+            if residual <= limit_N:
+                break
+        return residual
 
     def relax(self, lam: float) -> tuple[bool, str]:
         """Pseudo-time steps (inexact far from the steady state, exact near it) at load scale
@@ -816,7 +866,7 @@ class SteadySolver:
         return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
                             steps=self.steps, newton_iterations=self.newton_iterations,
                             jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from,
-                            static_solver=self.static.name)
+                            static_solver=self.static.name, backtracks=self.backtracks)
 
     def restart_state(self):
         """The state the friction's ramp starts from: for a bundle the accepted state of smallest
