@@ -51,6 +51,17 @@ def test_a_hanging_spring_chain_relaxes_to_its_closed_form(kind, damping):
     assert out.steps > 0 and out.mass_updates >= 1
 
 
+def test_masses_too_light_are_made_heavier():
+    """Masses a fifth of the bound: the central difference is unstable, the relaxation goes back to its
+    best state with the masses doubled until it is not, and still reaches the closed form."""
+    force, K, free, exact = chain_problem()
+    M = block_gershgorin_masses(*K, safety=1.2)
+    out = relax(force, lambda q: 0.2 * M, np.zeros_like(exact), free, RelaxSettings(residual_N=1e-9, time_limit_s=30.0))
+    assert out.converged, out.message
+    assert out.mass_scale >= 4.0
+    assert np.max(np.abs(out.q - exact)) < 1e-10
+
+
 def test_the_masses_bound_the_stiffness():
     """Eq. (DR 3): every eigenvalue of M⁻¹K below 4/α, for blocks that are not symmetric on their own
     (a symmetric K with random off-diagonal blocks)."""

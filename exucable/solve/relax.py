@@ -75,6 +75,12 @@ class RelaxSettings:
         Steps without the smallest residual halving after which the relaxation stops [-].
     time_limit_s : float
         CPU time [s] at most.
+    blow_up : float
+        A residual this many times the smallest one met (or not finite) counts as unstable [-]: the
+        relaxation goes back to the state of smallest residual and on from rest with masses twice as
+        heavy (a contact closed stiffer than the masses covered).
+    max_heavier : int
+        Doublings of the masses at most before the relaxation stops as unstable [-].
     """
 
     residual_N: float = 1e-2
@@ -85,6 +91,8 @@ class RelaxSettings:
     max_steps: int = 100000
     stall_steps: int = 5000
     time_limit_s: float = 60.0
+    blow_up: float = 1e4
+    max_heavier: int = 4
 
     def __post_init__(self):
         if self.damping not in ("kinetic", "viscous"):
@@ -120,6 +128,8 @@ class RelaxOutcome:
         Kinetic-damping restarts [-].
     mass_updates : int
         Evaluations of the masses (stiffness passes) [-].
+    mass_scale : float
+        Factor on the masses at the end [-]: 2^k after k instabilities (``RelaxSettings.blow_up``).
     cpu_s : float
         CPU time [s].
     trace : list of (int, float)
@@ -134,6 +144,7 @@ class RelaxOutcome:
     restarts: int
     mass_updates: int
     cpu_s: float
+    mass_scale: float
     trace: list
 
 
@@ -243,6 +254,7 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
 
     f = np.asarray(force(q), dtype=float)
     r = float(np.linalg.norm(f[free]))
+    mass_scale, heavier = 1.0, 0
     M = masses(q)
     Minv = _inverse(M)
     updates = 1
@@ -259,9 +271,27 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
         if r <= s.residual_N:
             message = f"residual {r:.3g} N after {steps} steps"
             break
-        if not np.isfinite(r):
-            message = f"the residual is not finite after {steps} steps (the masses too light?)"
-            break
+        if not np.isfinite(r) or r > s.blow_up * best_r:
+            # unstable: a contact closed stiffer than the masses cover (or a follower force's flutter);
+            # back to the best state, from rest, with heavier masses
+            if heavier >= s.max_heavier:
+                message = (f"unstable after {steps} steps with the masses {mass_scale:g}x the bound's "
+                           f"(smallest residual {best_r:.3g} N)")
+                break
+            heavier += 1
+            mass_scale *= 2.0
+            q = best_q.copy()
+            f = np.asarray(force(q), dtype=float)
+            r = float(np.linalg.norm(f[free]))
+            v[:] = 0.0
+            ke_prev = 0.0
+            from_rest = True
+            M = mass_scale * masses(q)
+            Minv = _inverse(M)
+            updates += 1
+            since_update = 0
+            trace.append((steps, r))
+            continue
         if steps >= s.max_steps:
             message = f"{s.max_steps} steps"
             break
@@ -272,7 +302,7 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
             message = f"the CPU time limit of {s.time_limit_s:g} s (smallest residual {best_r:.3g} N)"
             break
         if since_update >= s.refresh_steps:
-            M_new = masses(q)
+            M_new = mass_scale * masses(q)
             updates += 1
             # the momentum M v is kept across the update
             p = np.einsum("bij,bj->bi", M, v.reshape(nb, 3)).reshape(-1)
@@ -294,7 +324,7 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
             v[:] = 0.0
             ke_prev = 0.0
             from_rest = True
-            M = masses(q)
+            M = mass_scale * masses(q)
             Minv = _inverse(M)
             updates += 1
             since_update = 0
@@ -313,7 +343,8 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
         if r < best_r:
             best_r, best_q = r, q.copy()
     return RelaxOutcome(q=best_q, residual_N=best_r, converged=best_r <= s.residual_N, message=message, steps=steps,
-                        restarts=restarts, mass_updates=updates, cpu_s=time.process_time() - t0, trace=trace)
+                        restarts=restarts, mass_updates=updates, cpu_s=time.process_time() - t0, trace=trace,
+                        mass_scale=mass_scale)
 
 
 def bundle_masses(model, safety: float, reference_penetration_m: float, contacts_per_point: float = 2.0,
