@@ -48,7 +48,28 @@ import numpy as np
 
 from ..errors import SolverError
 
-__all__ = ["RelaxSettings", "RelaxOutcome", "block_gershgorin_masses", "relax", "bundle_masses", "relax_bundle"]
+__all__ = ["check_settings", "RelaxSettings", "RelaxOutcome", "block_gershgorin_masses", "relax", "bundle_masses", "relax_bundle"]
+
+
+def check_settings(settings, skip=()) -> None:
+    """Refuse, naming the field, a settings dataclass's number that is not one: its ``int`` fields
+    whole numbers >= 0, the others finite numbers > 0 (fields named in ``skip`` left out).
+
+    Raises
+    ------
+    SolverError
+    """
+    name = type(settings).__name__
+    for f in fields(settings):
+        if f.name in skip:
+            continue
+        value = getattr(settings, f.name)
+        if f.type == "int":
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise SolverError(f"{name}.{f.name} = {value!r}: must be a whole number >= 0")
+        elif isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+                or not np.isfinite(value) or value <= 0:
+            raise SolverError(f"{name}.{f.name} = {value!r}: must be a finite number > 0")
 
 
 @dataclass(frozen=True)
@@ -97,13 +118,7 @@ class RelaxSettings:
     def __post_init__(self):
         if self.damping not in ("kinetic", "viscous"):
             raise SolverError(f"RelaxSettings.damping = {self.damping!r}: must be 'kinetic' or 'viscous'")
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name == "damping":
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-                    or not np.isfinite(value) or value <= 0:
-                raise SolverError(f"RelaxSettings.{f.name} = {value!r}: must be a finite number > 0")
+        check_settings(self, skip=("damping",))
         if self.mass_safety < 1.0:
             raise SolverError(f"RelaxSettings.mass_safety = {self.mass_safety!r}: must be >= 1 (Eq. DR 3's bound)")
 
@@ -267,6 +282,16 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
     since_update = 0
     from_rest = True
     message = ""
+
+    def restart():
+        """The motion from rest at the current state, its masses taken there."""
+        nonlocal v, M, Minv, ke_prev, from_rest, since_update, updates
+        v = np.zeros(n)
+        ke_prev, from_rest, since_update = 0.0, True, 0
+        M = mass_scale * masses(q)
+        Minv = _inverse(M)
+        updates += 1
+        trace.append((steps, r))
     while True:
         if r <= s.residual_N:
             message = f"residual {r:.3g} N after {steps} steps"
@@ -283,14 +308,7 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
             q = best_q.copy()
             f = np.asarray(force(q), dtype=float)
             r = float(np.linalg.norm(f[free]))
-            v[:] = 0.0
-            ke_prev = 0.0
-            from_rest = True
-            M = mass_scale * masses(q)
-            Minv = _inverse(M)
-            updates += 1
-            since_update = 0
-            trace.append((steps, r))
+            restart()
             continue
         if steps >= s.max_steps:
             message = f"{s.max_steps} steps"
@@ -321,14 +339,7 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
         if s.damping == "kinetic" and ke < ke_prev and not from_rest:
             # the kinetic energy peaked: restart from rest at q (the step past the peak not taken)
             restarts += 1
-            v[:] = 0.0
-            ke_prev = 0.0
-            from_rest = True
-            M = mass_scale * masses(q)
-            Minv = _inverse(M)
-            updates += 1
-            since_update = 0
-            trace.append((steps, r))
+            restart()
             continue
         from_rest = False
         ke_prev = ke

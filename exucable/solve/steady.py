@@ -88,7 +88,7 @@ depend on the start (``tests/test_nested_start.py``).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import exudyn as exu
@@ -98,6 +98,7 @@ from .dynamic import History, Progress, SolveOutcome, quiet_sparse
 from ..post.tension import TensionStations, profile_stations_m
 from .steady_advice import TIME_LIMIT_KEY, failure_advice
 from .newton_system import ExudynStatic, static_backend
+from .relax import check_settings
 
 __all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
 
@@ -228,14 +229,7 @@ class SteadySettings:
     max_backtracks: int = 6
 
     def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.type == "int":
-                if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-                    raise SolverError(f"SteadySettings.{f.name} = {value!r}: must be a whole number >= 0")
-            elif isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
-                    or not np.isfinite(value) or value <= 0:
-                raise SolverError(f"SteadySettings.{f.name} = {value!r}: must be a finite number > 0")
+        check_settings(self)
 
     @classmethod
     def from_solver(cls, solver) -> "SteadySettings":
