@@ -96,12 +96,12 @@ class RelaxSettings:
         Steps without the smallest residual halving after which the relaxation stops [-].
     time_limit_s : float
         CPU time [s] at most.
-    blow_up : float
-        A residual this many times the smallest one met (or not finite) counts as unstable [-]: the
-        relaxation goes back to the state of smallest residual and on from rest with masses twice as
-        heavy (a contact closed stiffer than the masses covered).
     max_heavier : int
-        Doublings of the masses at most before the relaxation stops as unstable [-].
+        Where the residual grows past any finite number (unstable: a contact closed stiffer than the
+        masses covered), the relaxation goes back to the state of smallest residual and on from rest with
+        masses twice as heavy, this many times at most before it stops [-]. Only the overflow counts: a
+        residual growing 1e4-fold was a keystone falling into a cradle (tests/test_bundle_jam.py), no
+        instability.
     """
 
     residual_N: float = 1e-2
@@ -112,7 +112,6 @@ class RelaxSettings:
     max_steps: int = 100000
     stall_steps: int = 5000
     time_limit_s: float = 60.0
-    blow_up: float = 1e4
     max_heavier: int = 4
 
     def __post_init__(self):
@@ -144,7 +143,7 @@ class RelaxOutcome:
     mass_updates : int
         Evaluations of the masses (stiffness passes) [-].
     mass_scale : float
-        Factor on the masses at the end [-]: 2^k after k instabilities (``RelaxSettings.blow_up``).
+        Factor on the masses at the end [-]: 2^k after k instabilities (``RelaxSettings.max_heavier``).
     cpu_s : float
         CPU time [s].
     trace : list of (int, float)
@@ -296,7 +295,7 @@ def relax(force, masses, q0, free, settings: RelaxSettings = RelaxSettings()) ->
         if r <= s.residual_N:
             message = f"residual {r:.3g} N after {steps} steps"
             break
-        if not np.isfinite(r) or r > s.blow_up * best_r:
+        if not np.isfinite(r):
             # unstable: a contact closed stiffer than the masses cover (or a follower force's flutter);
             # back to the best state, from rest, with heavier masses
             if heavier >= s.max_heavier:
