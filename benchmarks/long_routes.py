@@ -14,7 +14,8 @@ time). The parent times the whole child process (interpreter start to exit, wall
 child ends as `exucable run` does, with exucable.cli.end_process where the tree has it). Printed
 per length: elements, check points, Newton iterations of the solve and of the error bar's, the CPU
 time of the whole process and of each stage with its share (on a shared, loaded machine the CPU
-times are the ones to compare), the rope references' part of the build, the solve's CPU time per
+times are the ones to compare), the build's parts (the rope references, the start layout's fine grid
+and fit, its contact offsets, Exudyn's cable items, the contact coupling), the solve's CPU time per
 Newton iteration, peak memory (ru_maxrss) and the pulling force against the rope with clearance;
 the share of everything outside the two steady solves (CPU time); then the exponent p of a
 least-squares fit CPU time ∝ L^p (whole process, the solves, the rest), measured in this one run.
@@ -177,6 +178,8 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_el
     from exucable.run import run_scenario
     from exucable.scenario.specs import parse_scenario
     import exucable.model.build as build
+    import exucable.model.coupling as coupling
+    import exucable.model.layout as layout
     import exucable.quasistatic.clearance as clearance
     import exucable.quasistatic.rope as rope
     import exucable.solve.start as start
@@ -194,12 +197,16 @@ def one_case(length_m: float, figures: bool = True, cold: bool = False, cable_el
     for module, name in ((rope, "solve_rope"), (rope, "rope_pull_force_N"), (rope, "solve_rope_for_pull_force"),
                          (clearance, "solve_rope_with_clearance")):
         timed.wrap(module, name, lambda i, kw: "references_s")
+    # the build's other parts (BUILD_PARTS), each looked up at call time by its caller
+    for (module, name), key in zip(((layout, "lay_cable"), (layout, "contact_offsets"), (build, "add_cable"),
+                                    (coupling, "ContactCoupling")), BUILD_PARTS):
+        timed.wrap(module, name, lambda i, kw, key=key: key)
     res = run_scenario(sc, None, plots=False)
     clock.lap("run_s")
     s = res.summary
     wall = {k: clock.wall[k] for k in ("import_s", "parse_s")}
     cpu = {k: clock.cpu[k] for k in ("import_s", "parse_s")}
-    for k in ("build_s", "references_s", "solve_s", "error_bar_s"):
+    for k in ("build_s", "references_s", "solve_s", "error_bar_s") + BUILD_PARTS:
         wall[k], cpu[k] = timed.wall.get(k, 0.0), timed.cpu.get(k, 0.0)
     wall["post_s"] = clock.wall["run_s"] - wall["build_s"] - wall["solve_s"] - wall["error_bar_s"]
     cpu["post_s"] = clock.cpu["run_s"] - cpu["build_s"] - cpu["solve_s"] - cpu["error_bar_s"]
@@ -259,6 +266,10 @@ def in_child(length_m: float, figures: bool, cold: bool = False, tree: str | Non
 
 
 STAGES = ("import_s", "parse_s", "build_s", "solve_s", "error_bar_s", "post_s", "write_s", "figures_s")
+#: the build's parts timed besides the rope references: the start layout's fine grid and fit
+#: (lay_cable), the start's contact offsets, Exudyn's cable items (add_cable), the contact coupling
+BUILD_PARTS = ("layout_s", "offsets_s", "items_s", "coupling_s")
+BUILD_PART_NAMES = ("start layout (lay_cable)", "its contact offsets", "Exudyn's cable items", "contact coupling")
 
 
 def report(r: dict) -> str:
@@ -275,7 +286,8 @@ def report(r: dict) -> str:
             f"{r['error_bar_newton_iterations']})  "
             f"peak RSS {r['peak_rss_MB']:5.0f} MB\n"
             f"{'':9s}CPU per stage [s]: {stages}  (outside them: interpreter start and exit "
-            f"{whole - sum(cpu[k] for k in STAGES):5.2f}); of the build, the rope references {cpu['references_s']:6.2f}\n"
+            f"{whole - sum(cpu[k] for k in STAGES):5.2f}); of the build, the rope references {cpu['references_s']:6.2f}, "
+            + ", ".join(f"{n} {cpu.get(k, 0.0):5.2f}" for n, k in zip(BUILD_PART_NAMES, BUILD_PARTS)) + "\n"
             f"{'':9s}solve's CPU per Newton iteration {1e3 * cpu['solve_s'] / n:6.1f} ms (wall {1e3 * r['solve_s'] / n:6.1f} ms), "
             f"of which contact kernel (wall) {1e3 * r['kernel_s'] / n:6.1f} ms;  "
             f"F {'-' if F is None else f'{F:.1f}'} N, vs rope with clearance {vs}"
@@ -305,9 +317,10 @@ def compare(b: dict, a: dict) -> str:
     def parts(r):
         cpu, whole = r["cpu_s"], r["process_cpu_s"]
         solves = cpu["solve_s"] + cpu["error_bar_s"]
-        return whole, solves, whole - solves, cpu["build_s"], cpu["references_s"], cpu["post_s"] + cpu["write_s"]
+        return ((whole, solves, whole - solves, cpu["build_s"], cpu["references_s"])
+                + tuple(cpu.get(k, 0.0) for k in BUILD_PARTS) + (cpu["post_s"] + cpu["write_s"],))
 
-    names = ("whole", "solves", "outside the solves", "build", "rope references", "post + write")
+    names = ("whole", "solves", "outside the solves", "build", "rope references") + BUILD_PART_NAMES + ("post + write",)
     ratios = "  ".join(f"{n} {x:.2f} -> {y:.2f} s ({y / x if x else float('nan'):.2f})"
                        for n, x, y in zip(names, parts(b), parts(a)))
 

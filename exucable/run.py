@@ -541,7 +541,8 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         pull_force_N=report["pull_force_N"],
         trailing_tension_N=report["trailing_tension_N"],
         max_tension_N=report["max_tension_N"],
-        bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")},
+        bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")}
+        | {"onset_layer": out.onset_layer},
         steps=out.steps,
         newton_iterations=out.newton_iterations,
         wall_time_s=out.wall_time_s,

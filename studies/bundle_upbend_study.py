@@ -19,7 +19,12 @@ penetration among them: grazing contacts), and the cables' places across the duc
 top cable's net lateral load there is printed too: T κ of its own tension (T_b/3 plus its weight
 times the rise: it touches no wall) against its weight.
 
-    nice .venv/bin/python studies/bundle_upbend_study.py [--limit 60] [--quick]
+Every solve goes through the smooth contact onset continued from 0.5 mm to 0, as the bundle's steady
+solve does (:mod:`exucable.solve.onset_continuation`); per case the layers' pulls, Newton iterations
+and CPU follow the table, with the first layer ``--onset`` [m] (the solve's default) or, with
+``--no-onset``, the law of one cable throughout (the stall).
+
+    nice .venv/bin/python studies/bundle_upbend_study.py [--limit 60] [--quick] [--onset 5e-4 | --no-onset]
 
 ``--quick``: the up-bend and the down-bend only (triangular, frictionless between the cables), with a
 5 s CPU limit, and the diagnosis of what the up-bend reached in it.
@@ -37,6 +42,7 @@ import exudyn as exu
 import exucable as xc
 from exucable.model.bundle import build_bundle_model, bundle_cross_sections
 from exucable.solve import steady as st
+from exucable.solve.onset_continuation import OnsetSettings, extrapolate_to_zero
 
 R_CABLE, R_DUCT, DENSITY, MU, BACK_N, G = 0.015, 0.05, 2000.0, 0.3, 300.0, 9.81
 BEND_RADIUS, ANGLE, STRAIGHT = 5.0, 30.0, 3.0
@@ -69,10 +75,10 @@ class RecordingSolver(st.SteadySolver):
         self.accepted_states.append((lam, residual, q.copy(), ae.copy()))
 
 
-def run_case(bend, arrangement, cf, limit):
+def run_case(bend, arrangement, cf, limit, onset=None):
     sc = scenario(bend, arrangement, cf, limit)
     model = build_bundle_model(sc)
-    solver = RecordingSolver(model, st.SteadySettings.from_solver(sc.solver))
+    solver = RecordingSolver(model, st.SteadySettings.from_solver(sc.solver), onset=onset)
     c0 = time.process_time()
     out = solver.solve()
     cpu = time.process_time() - c0
@@ -168,7 +174,10 @@ def main(argv=None) -> int:
     p.add_argument("--limit", type=float, default=60.0, help="each solve's CPU time limit [s]")
     p.add_argument("--states", type=int, default=6, help="accepted states to diagnose")
     p.add_argument("--quick", action="store_true", help="the up- and down-bend only, 5 s CPU each")
+    p.add_argument("--onset", type=float, default=OnsetSettings().first_m, help="the first onset layer [m]")
+    p.add_argument("--no-onset", action="store_true", help="the law of one cable throughout (no onset layer)")
     args = p.parse_args(argv)
+    onset = None if args.no_onset else OnsetSettings(first_m=args.onset)
     cases = CASES
     if args.quick:
         cases, args.limit, args.states = [("up", "triangular", 0.0), ("down", "triangular", 0.0)], 5.0, 3
@@ -177,13 +186,25 @@ def main(argv=None) -> int:
     print("\n| bend | arrangement | cable friction | status | solve CPU [s] | Newton its | smallest residual recorded at full load [N] "
           "| stop [N] | pull [N] |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    kept = None
+    kept, layers = None, []
     for bend, arrangement, cf in cases:
-        model, solver, out, cpu, smallest, pull = run_case(bend, arrangement, cf, args.limit)
+        model, solver, out, cpu, smallest, pull = run_case(bend, arrangement, cf, args.limit, onset)
         print(f"| {bend} | {arrangement} | {cf:g} | {out.status} | {cpu:.2f} | {out.newton_iterations} | {smallest:.3g} "
               f"| {solver.tolerance_N:.3g} | {pull:.6g} |", flush=True)
+        if out.onset_layer is not None:
+            layers.append(((bend, arrangement, cf), out.onset_layer))
         if (bend, arrangement, cf) == ("up", "triangular", 0.0):
             kept = (model, solver)
+    if layers:
+        print("\nthe onset layer's continuation, per case: layer [µm]: pull [N] (Newton iterations, CPU [s]); "
+              "F₀ extrapolated from the last two layers above 0")
+        for (bend, arrangement, cf), o in layers:
+            st_ = o["stages"]
+            above = [x for x in st_ if x["converged"] and x["layer_m"] > 0.0]
+            f0 = extrapolate_to_zero([x["layer_m"] for x in above], [x["pull_force_N"] for x in above])[0] if above else float("nan")
+            print(f"  {bend} {arrangement} μ_c {cf:g}: " + ", ".join(
+                f"{1e6 * x['layer_m']:.3g}: " + (f"{x['pull_force_N']:.6g}" if x["converged"] else "stalled")
+                + f" ({x['newton_iterations']}, {x['cpu_s']:.2f})" for x in st_) + f"; F₀ from the layers above 0: {f0:.6g}")
     if kept is not None:
         diagnose(*kept, args.states)
     return 0

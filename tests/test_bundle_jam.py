@@ -183,11 +183,13 @@ def test_a_cradle_in_the_jam_range_slides_cradled_and_says_it_could_wedge():
 def test_laid_as_the_keystone_the_steady_bundle_does_not_stay_wedged(monkeypatch):
     """Started in the jam itself (a 2 m horizontal straight with gravity, D/d 3.05, the cables laid as
     the keystone at its frictionless balance ψ = 76.5°, G = 6.3 w), the steady solve does not hold it
-    (it is unstable, and sliding friction gives no hold across the duct): the middle cable drops
-    between the outer ones, the straight reads cradled (7 of its 9 planes; the 2 by the eye, which
-    holds the leading ends as laid, triangular), no plane side by side, no jam, status ok, the
-    pull within 5 % of the calculators' cradle (measured +3.7 %: the eye holds the leading ends in
-    the keystone as laid) rather than the keystone's w_c = 2N/3w = 4.3."""
+    (it is unstable, and sliding friction gives no hold across the duct): no plane side by side, no
+    jam, status ok, the pull within 5 % of the calculators' cradle rather than the keystone's
+    w_c = 2N/3w = 4.3. Where the middle cable ends is the path's choice between two steady states:
+    through the contact onset layer (the bundle's steady solve) the outer cables close under it, a
+    triangle in all 9 planes (+0.57 % on the formula); with the law of one cable throughout it
+    dropped between them, cradled in 7 of 9 (+3.7 %; reference/README.md, "Through a smooth contact
+    onset")."""
     import exucable.model.bundle as bundle_model
 
     def keystone_offsets(count, arrangement, inner_radius_m, cable_radius_m):
@@ -202,7 +204,7 @@ def test_laid_as_the_keystone_the_steady_bundle_does_not_stay_wedged(monkeypatch
     b = res.summary.bundle
     assert res.status == "ok" and b["jam"] is False
     (straight,) = b["sections"]
-    assert straight["arrangement"] == "cradled" and "side_by_side" not in straight["arrangements_seen"]
+    assert straight["arrangement"] in ("cradled", "triangular") and "side_by_side" not in straight["arrangements_seen"]
     formula = 3 * res.model.rope.pull_force_N
     assert res.pull_force_N == pytest.approx(formula, rel=0.05)
 

@@ -140,3 +140,42 @@ def test_internal_damping_does_not_change_steady_tension():
         forces[tau] = run_scenario(sc, None, quiet=True).summary["pull_force_N"]
     assert forces[0.25e-3] == pytest.approx(forces[1e-3], rel=5e-4)
     assert forces[4e-3] == pytest.approx(forces[1e-3], rel=5e-4)
+
+
+def test_items_from_shortened_dicts_are_the_interface_classes_items():
+    """add_cable and add_gravity pass Exudyn dicts without the class defaults (cable.item_dict); the
+    items Exudyn makes of them are those of the full interface objects, entry for entry."""
+    from exudyn.itemInterface import LoadMassProportional, MarkerBodyMass, NodePointSlope1, ObjectANCFCable
+    from exucable.model.cable import INTEGRATION
+
+    rng = np.random.default_rng(0)
+    coords, vel, lengths = rng.standard_normal((4, 6)), rng.standard_normal((4, 6)), rng.uniform(0.5, 1.0, 3)
+    p = CableProperties(mass_per_length_kg_per_m=0.3, axial_stiffness_N=1e5, bending_stiffness_N_m2=2e-3,
+                        axial_damping_N_s=0.1, bending_damping_N_m2_s=0.0, integration="lobatto")
+    ours = exu.SystemContainer().AddSystem()
+    cable = add_cable(ours, coords, lengths, p, vel, draw_radius_m=0.01)
+    add_gravity(ours, cable, [0.0, 0.0, -9.81])
+    full = exu.SystemContainer().AddSystem()
+    nodes = [full.AddNode(NodePointSlope1(referenceCoordinates=list(c), initialVelocities=list(v)))
+             for c, v in zip(coords, vel)]
+    for i, L in enumerate(lengths):
+        e = full.AddObject(ObjectANCFCable(
+            nodeNumbers=[nodes[i], nodes[i + 1]], length=L, massPerLength=0.3, axialStiffness=1e5,
+            bendingStiffness=2e-3, axialDamping=0.1, bendingDamping=0.0,
+            useReducedOrderIntegration=INTEGRATION["lobatto"],
+            visualization={"show": True, "radius": 0.01, "color": [-1.0, -1.0, -1.0, -1.0]}))
+        full.AddLoad(LoadMassProportional(markerNumber=full.AddMarker(MarkerBodyMass(bodyNumber=e)),
+                                          loadVector=[0.0, 0.0, -9.81]))
+
+    def plain(v):   # item indices (NodeIndex, ObjectIndex, ...) compare by identity: their numbers
+        if isinstance(v, list):
+            return [plain(x) for x in v]
+        return int(v) if type(v).__name__.endswith("Index") else v
+
+    def same(a, b):
+        return a.keys() == b.keys() and all(np.array_equal(plain(a[k]), plain(b[k])) for k in a)
+
+    for get, count in ((lambda m, i: m.GetNode(i), 4), (lambda m, i: m.GetObject(i), 3),
+                       (lambda m, i: m.GetMarker(i), 3), (lambda m, i: m.GetLoad(i), 3)):
+        for i in range(count):
+            assert same(get(ours, i), get(full, i)), (get(ours, i), get(full, i))

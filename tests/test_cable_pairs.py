@@ -61,13 +61,18 @@ def test_jacobian_matches_central_differences(backend):
     q = bundle_q(np.random.default_rng(5))
     k = kernel(backend)
     J = k.evaluate(q).jacobian.toarray()
-    h = 1e-9    # central differences: truncation ~h² |Q'''|, round-off ~1e-16 |Q|/h; both < 1e-7 relative here
-    fd = np.empty_like(J)
+    assert np.abs(J - central_differences(k, q)).max() <= 1e-6 * np.abs(J).max()
+
+
+def central_differences(k, q, h=1e-9):
+    """∂Q/∂q of kernel ``k`` at ``q`` by central differences of step h [m]: truncation ~h² |Q'''|,
+    round-off ~1e-16 |Q|/h; both < 1e-7 relative on these bundles."""
+    fd = np.empty((q.size, q.size))
     for i in range(q.size):
         dq = np.zeros_like(q)
         dq[i] = h
         fd[:, i] = (k.evaluate(q + dq, False).generalized_force - k.evaluate(q - dq, False).generalized_force) / (2 * h)
-    assert np.abs(J - fd).max() <= 1e-6 * np.abs(J).max()
+    return fd
 
 
 def test_parallel_cables_hertz_force_per_length():
@@ -109,7 +114,7 @@ def test_friction_opposes_relative_sliding_with_coulomb_magnitude():
     out = (np.zeros((m, 3), np.int64), np.zeros(m), np.zeros(m), np.zeros((m, 9)), np.zeros((m, 9, 9)),
            np.zeros((m, 9, 9)), np.zeros(m, np.bool_))
     count = _pair_contacts(X, U, 2, n_pts, 2, 2 * R, weight, LAW.stiffness, LAW.exponent, LAW.friction, eps ** 2,
-                           LAW.damping, LAW.damping_onset_m, True, *out)
+                           LAW.damping, LAW.damping_onset_m, True, *out, LAW.onset_layer_m)
     assert count == len(ref["t"])
     np.testing.assert_allclose(out[3][:count], ref["force"], rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(out[4][:count], ref["jac_x"], rtol=1e-10, atol=1e-9)

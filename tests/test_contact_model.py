@@ -169,7 +169,7 @@ def test_the_couplings_sparsity_pattern_is_numpys_unique_of_the_element_blocks(n
     rows, cols = block_sparsity(n_elements)
     n = 6 * (n_elements + 1)
     unique, inverse = np.unique(rows.astype(np.int64) * n + cols, return_inverse=True)
-    got_rows, got_cols, got_inverse = _chain_pattern(rows, cols, n_elements)
+    got_rows, got_cols, got_inverse = _chain_pattern(n_elements)
     np.testing.assert_array_equal(got_rows, unique // n)
     np.testing.assert_array_equal(got_cols, unique % n)
     np.testing.assert_array_equal(got_inverse, inverse.reshape(-1))

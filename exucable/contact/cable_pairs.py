@@ -9,7 +9,9 @@ conduit's wall replaced by another cable's axis:
 - a check point P of cable a meets cable b (a < b) at the closest point C = (1 - t) B0 + t B1 of
   the nearest segment [B0, B1] of b's polyline (t clamped to [0, 1]); d = |P - C|,
   δ = 2r - d (two cables of radius r), n = (P - C)/d;
-- f_n = w K δ^e with w = (the point's share of the element length)/h_ref, as at the wall; the
+- f_n = w K φ^e with w = (the point's share of the element length)/h_ref, as at the wall, and
+  φ = φ_s(δ) the penetration blended over the law's onset layer s (δ itself for s = 0, the points
+  touching for δ > -s; :func:`~exucable.contact.law.onset_blend`); the
   normal force on P is +f_n n, on B0 and B1 -(1 - t) f_n n and -t f_n n (action and reaction);
 - friction -μ_c f_n v_τ/√(|v_τ|² + ε²) on the relative velocity v = U_P - (1 - t) U0 - t U1,
   v_τ = (I - n nᵀ) v, with the cables' own coefficient μ_c (``contact.cable_friction``), shared
@@ -54,7 +56,7 @@ import numpy as np
 
 from .checkpoints import hermite_unit
 from .jitcache import njit
-from .law import ContactLaw
+from .law import ContactLaw, onset_blend
 from .steady import hermite_unit_derivative
 
 __all__ = ["CableContactKernel", "CableContactResult", "pair_contacts_reference", "cable_check_points"]
@@ -128,7 +130,7 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
         w of each check point [-].
     law : ContactLaw
         ``stiffness``, ``exponent``, ``friction`` (the cables' μ_c), ``regularisation_velocity_m_per_s``,
-        ``damping`` C and ``damping_onset_m`` δ_d.
+        ``damping`` C, ``damping_onset_m`` δ_d and ``onset_layer_m`` s.
 
     Returns
     -------
@@ -140,6 +142,7 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
     U = np.asarray(U, dtype=float)
     K, ex, mu = law.stiffness, law.exponent, law.friction
     C, dd = law.damping, law.damping_onset_m
+    layer = law.onset_layer_m
     eps2 = law.regularisation_velocity_m_per_s ** 2
     I3 = np.eye(3)
     rows = {k: [] for k in ("index", "t", "penetration_m", "force", "jac_x", "jac_u", "edge")}
@@ -155,8 +158,9 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
                     continue
                 d = np.sqrt(d2)
                 delta = gap - d
-                if not delta > 0.0 or d <= 0.0:
+                if not delta > -layer or d <= 0.0:
                     continue
+                phi, dphi = (float(x) for x in onset_blend(delta, layer))
                 B0, B1 = Xb[j], Xb[j + 1]
                 P = X[i]
                 e = B1 - B0
@@ -176,8 +180,8 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
                 dn = Pn @ dr / d                                                  # ∂n/∂x (3, 9)
                 g = A.T @ n                                                       # ∂d/∂x
                 w = weight[p]
-                f = w * K * delta ** ex
-                df = -w * K * ex * delta ** (ex - 1.0) * g                        # ∂f/∂x
+                f = w * K * phi ** ex
+                df = -w * K * ex * phi ** (ex - 1.0) * dphi * g                   # ∂f/∂x
                 swap = np.concatenate([np.zeros(3), n, -n])                       # ∂(Aᵀn)/∂t
                 H = A.T @ dn + np.outer(swap, dt)                                 # ∂²d/∂x²
                 u = np.concatenate([U[i], U[b * n_points + j], U[b * n_points + j + 1]])
@@ -185,7 +189,7 @@ def pair_contacts_reference(X, U, n_cables, n_points, window, gap, weight, law: 
                 dfu = np.zeros(9)                                                 # ∂f/∂u
                 if C > 0.0:
                     rate = -(n @ v)                                               # δ̇
-                    on, don = (1.0, 0.0) if dd <= 0.0 else ((delta / dd, 1.0 / dd) if delta < dd else (1.0, 0.0))
+                    on, don = (1.0, 0.0) if dd <= 0.0 else ((phi / dd, dphi / dd) if phi < dd else (1.0, 0.0))
                     f = f + w * C * on * rate
                     if not f > 0.0:
                         continue                                                  # the damping lets go
@@ -243,7 +247,7 @@ def _segment_distance2(X, j, px, py, pz):
 
 @njit(**_JIT)
 def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps2, C, dd, jacobian,
-                   index, tpar, pen, force, jac_x, jac_u, edge):
+                   index, tpar, pen, force, jac_x, jac_u, edge, layer):
     """Compiled :func:`pair_contacts_reference`; fills the output arrays, returns the contact count."""
     m = 0
     # the search's blocks: G consecutive segments of a polyline inside a bounding ball (centre,
@@ -313,8 +317,14 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 previous = best_j
                 d = np.sqrt(best_d2)
                 delta = gap - d
-                if not delta > 0.0 or d <= 0.0:
+                if not delta > -layer or d <= 0.0:
                     continue
+                # φ_s(δ), dφ_s/dδ (law.onset_blend)
+                phi, dphi = delta, 1.0
+                if layer > 0.0:
+                    if delta < layer:
+                        y = delta + layer
+                        phi, dphi = y * y / (4.0 * layer), y / (2.0 * layer)
                 j = best_j
                 t = best_t
                 for k in range(3):
@@ -335,7 +345,7 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                     g[3 + k] = -(1.0 - t) * n[k]
                     g[6 + k] = -t * n[k]
                 w = weight[p]
-                f = w * K * delta ** ex
+                f = w * K * phi ** ex
                 for k in range(3):
                     u[k] = U[i, k]
                     u[3 + k] = U[ob + j, k]
@@ -345,8 +355,8 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 vn = n[0] * v[0] + n[1] * v[1] + n[2] * v[2]
                 on, don = 1.0, 0.0
                 if C > 0.0:
-                    if dd > 0.0 and delta < dd:
-                        on, don = delta / dd, 1.0 / dd
+                    if dd > 0.0 and phi < dd:
+                        on, don = phi / dd, dphi / dd
                     f = f + w * C * on * (-vn)
                     if not f > 0.0:
                         continue
@@ -383,7 +393,7 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                         s_n = n[0] * dr[0, l] + n[1] * dr[1, l] + n[2] * dr[2, l]
                         for k in range(3):
                             dn[k, l] = (dr[k, l] - n[k] * s_n) / d
-                    coef = -w * K * ex * delta ** (ex - 1.0)
+                    coef = -w * K * ex * phi ** (ex - 1.0) * dphi
                     ud0, ud1, ud2 = u[3] - u[6], u[4] - u[7], u[5] - u[8]      # U0 - U1
                     for l in range(9):
                         df[l] = coef * g[l]
@@ -591,6 +601,16 @@ class CableContactKernel:
         from dataclasses import replace
         self.law = replace(self.base_law, friction=scale * self.base_law.friction)
 
+    def set_onset_layer(self, layer_m: float) -> None:
+        """The contact onset's layer s [m] (:func:`~exucable.contact.law.onset_blend`; 0: the law
+        without one), kept by :meth:`set_friction_scale`."""
+        from dataclasses import replace
+        layer = float(layer_m)
+        if not 0.0 <= layer < self.radius_m:
+            raise ValueError(f"onset layer {layer!r} m must be in [0, the cable radius {self.radius_m:g} m)")
+        self.base_law = replace(self.base_law, onset_layer_m=layer)
+        self.law = replace(self.law, onset_layer_m=layer)
+
     def points(self, q, q_t=None):
         """Check point positions [m] and velocities [m/s], each (n_cables·n_points, 3): the
         steady-sliding V ∂r/∂x, or with the nodal rates ``q_t`` (a dynamic state) S q̇."""
@@ -613,7 +633,7 @@ class CableContactKernel:
                            float(law.stiffness), float(law.exponent), float(law.friction),
                            float(law.regularisation_velocity_m_per_s) ** 2, float(law.damping),
                            float(law.damping_onset_m), bool(jacobian),
-                           index, t, pen, force, jx, ju, edge)
+                           index, t, pen, force, jx, ju, edge, float(law.onset_layer_m))
         keep = (lambda a: a[:m].copy()) if copy else (lambda a: a[:m])
         out = {"index": keep(index), "t": keep(t), "penetration_m": keep(pen), "force": keep(force), "edge": keep(edge)}
         out["jac_x"] = keep(jx) if jacobian else np.zeros((0, 9, 9))

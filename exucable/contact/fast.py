@@ -55,7 +55,7 @@ def _search_kernel(q, length, n1, n2, n3, n4, seg, off, cand, tab, nearest, open
 def _points_kernel(q, qt, length, n1, n2, n3, n4, r1, r2, r3, r4, steady_speed, omega, seg, off,
                    cand, gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
                    inv_href, tab, sel, open_first, open_last, smooth, seg_piece, pieces, seg_phi,
-                   n_newton, inv_onset, out_seg, out_p, out_v, out_res, out_f, out_g, out_hf):
+                   n_newton, inv_onset, layer, out_seg, out_p, out_v, out_res, out_f, out_g, out_hf):
     """Per check point state for post-processing, by the same steps as :func:`_contact_kernel`:
     nearest segment (-1 without candidates), P, v, residual P - Pc (NaN without candidates),
     weighted normal force w f_n, |v_τ|² and μ w f_n/√(|v_τ|² + ε²).
@@ -98,7 +98,7 @@ def _points_kernel(q, qt, length, n1, n2, n3, n4, r1, r2, r3, r4, steady_speed, 
             continue
         closest_points(tab, seg, cand, c0, c1, sel, open_first, open_last, smooth, seg_piece, pieces,
                         seg_phi, n_newton)
-        normals(tab, n_k, gap, -1.0)
+        normals(tab, n_k, gap, -1.0, layer)
         normal_force(tab, omega, n_k, le * inv_href, stiffness, damping, exponent,
                       exponent_mode, inv_onset)
         friction(tab, n_k, mu_k, dmu, inv_vs2, eps2)
@@ -117,10 +117,11 @@ def _points_kernel(q, qt, length, n1, n2, n3, n4, r1, r2, r3, r4, steady_speed, 
 def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, off, cand,
                     gap, stiffness, damping, exponent, exponent_mode, mu_k, dmu, inv_vs2, eps2,
                     inv_href, jacobian, force, jq, jqt, tab, sel, acc, open_first, open_last,
-                    smooth, seg_piece, pieces, seg_phi, n_newton, inv_onset, held_ramp, hold, delta_out):
+                    smooth, seg_piece, pieces, seg_phi, n_newton, inv_onset, held_ramp, hold, delta_out, layer):
     """Generalized contact force and its 12×12 Jacobian blocks; returns (n_in_contact, max δ).
 
-    ``delta_out[e, k]`` receives every point's penetration δ [m] (0 out of contact). With ``hold``
+    ``delta_out[e, k]`` receives every point's penetration δ [m] (0 out of contact; the blended
+    φ_s(δ) with an onset ``layer`` s > 0 [m], :func:`.kernel_parts.normals`). With ``hold``
     the damping onset is ``held_ramp[e, k]`` instead of g(δ) (see :class:`FastKernel`)."""
     n_k = n1.shape[0]
     n_contact = 0
@@ -137,7 +138,7 @@ def _contact_kernel(q, qt, length, n1, n2, n3, n4, pair_t, pair_ab, omega, seg, 
         positions(q, b, le, n1, n2, n3, n4, tab[PX], tab[PY], tab[PZ])  # Eq. 2
         closest_points(tab, seg, cand, c0, c1, sel, open_first, open_last, smooth, seg_piece, pieces,
                         seg_phi, n_newton)
-        n_touch, max_d2 = normals(tab, n_k, gap, max_d2)
+        n_touch, max_d2 = normals(tab, n_k, gap, max_d2, layer)
         d_out[:] = tab[DELTA, :n_k]
         if n_touch == 0:
             continue
@@ -331,7 +332,7 @@ class FastKernel:
             cand, self.gap, *self._law_arguments(),
             self.inv_href, bool(jacobian), force, jq, jqt, self._tab, self._sel, self._acc,
             self.open_first, self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
-            NEWTON_ITERATIONS, self._inverse_onset(), onset, hold, penetration)
+            NEWTON_ITERATIONS, self._inverse_onset(), onset, hold, penetration, float(self.law.onset_layer_m))
         if not jacobian:
             jq = jqt = None
         return force, jq, jqt, int(n_contact), float(max_pen), penetration
@@ -371,7 +372,8 @@ class FastKernel:
                        self.omega, self.seg, off, cand, self.gap,
                        *self._law_arguments(), self.inv_href, self._tab, self._sel, self.open_first,
                        self.open_last, self.smooth, self.seg_piece, self.pieces, self.seg_phi,
-                       NEWTON_ITERATIONS, self._inverse_onset(), segment, p, v, res, f, g, hf)
+                       NEWTON_ITERATIONS, self._inverse_onset(), float(self.law.onset_layer_m),
+                       segment, p, v, res, f, g, hf)
         acting = f > 0.0
         slip = np.where(acting, np.sqrt(g), 0.0)
         return {"segment": segment, "position_m": p, "velocity_m_per_s": v, "residual_m": res,

@@ -6,7 +6,7 @@ Same equations as the numpy reference in :mod:`exucable.contact.numpy_kernel` (p
 - :func:`positions`: P = S(ξ) q_e (Eq. 2) and, with other tables, the velocity (Eq. 8);
 - :func:`nearest_segments`, :func:`refine_smooth`, :func:`closest_points`: the narrow phase, onto the
   segments and then onto the exact bends and helices (:func:`segment_sectors` tabulates their sectors);
-- :func:`normals`: δ and n (Eqs. 14-15); :func:`normal_force`, :func:`onset_ramp`, :func:`held_onset_ramp`,
+- :func:`normals`: δ and n (Eqs. 14-15), δ blended over the onset layer s (:func:`~exucable.contact.law.onset_blend`); :func:`normal_force`, :func:`onset_ramp`, :func:`held_onset_ramp`,
   :func:`normal_force_with_ramp`: v_n, v_τ and the Hertz force with damping (Eqs. 16-18);
 - :func:`friction`: μ(|v_τ|) and the force on the cable (Eqs. 19-23);
 - :func:`add_generalized_force`: Q_e = Σ_k S_kᵀ F_k; :func:`point_jacobians`: ∂F/∂P and ∂F/∂v;
@@ -32,7 +32,7 @@ __all__ = ["FASTMATH", "JIT_OPTIONS", "PAIRS", "positions", "nearest_segments", 
            "exponent_mode_of", "PX", "PY", "PZ", "BEST", "RX", "RY", "RZ", "AX", "AY", "AZ", "NX",
            "NY", "NZ", "INVD", "DELTA", "TOUCH", "VX", "VY", "VZ", "VN", "G", "F", "WACT", "DDPOW",
            "TX", "TY", "TZ", "MU", "DMU", "SR", "HF", "FX", "MVX", "MTX", "KD", "WC", "FM", "C2", "GV",
-           "MUS", "J0", "BEYOND", "RAMP", "DRAMP", "ROWS"]
+           "MUS", "J0", "BEYOND", "RAMP", "DRAMP", "DPHI", "ROWS"]
 
 # Reassociation lets LLVM vectorise the sums over check points; no-NaN/no-inf assumptions are left
 # out on purpose (a point without candidate segments carries an infinite distance).
@@ -64,7 +64,8 @@ KD, WC, FM, C2, GV, MUS = 40, 41, 42, 43, 44, 45  # scalar factors of the Jacobi
 J0 = 46  # rows 46..63: ∂F/∂P (9, row-major) then ∂F/∂v (9)
 BEYOND = 64  # 1 where the nearest segment is an open end's and the point lies past it
 RAMP, DRAMP = 65, 66  # damping onset g(δ) and dg/dδ
-ROWS = 67
+DPHI = 67  # dφ_s/dδ of the blended penetration φ_s(δ) in row DELTA (1 without an onset layer)
+ROWS = 68
 
 
 @njit(inline="always", **JIT_OPTIONS)
@@ -353,8 +354,12 @@ def _max_finite(x, n):
 
 
 @njit(inline="always", **JIT_OPTIONS)
-def normals(tab, n_k, gap, max_d2):
-    """δ (Eq. 14) and n (Eq. 15) of every point; returns (points with δ > 0, running max d²)."""
+def normals(tab, n_k, gap, max_d2, layer):
+    """δ (Eq. 14) and n (Eq. 15) of every point; returns (points with δ > -s, running max d²).
+
+    Row DELTA holds the penetration the law acts on: max(δ, 0) for an onset layer s = 0, else the
+    blend φ_s(δ) of :func:`exucable.contact.law.onset_blend` (0 where the point does not touch),
+    row DPHI its derivative dφ_s/dδ. The layer needs s < gap."""
     best = tab[BEST]
     rx = tab[RX]
     ry = tab[RY]
@@ -366,17 +371,40 @@ def normals(tab, n_k, gap, max_d2):
     delta = tab[DELTA]
     touch = tab[TOUCH]
     gap2 = gap * gap
-    for k in range(n_k):
-        d2 = best[k]
-        hit = d2 > gap2  # δ > 0 without a square root (no candidate segment: d² = inf)
-        d = math.sqrt(d2 if hit else gap2)  # out of contact any finite d keeps n finite
-        inv_d = 1.0 / d
-        nx[k] = rx[k] * inv_d  # outward from the axis
-        ny[k] = ry[k] * inv_d
-        nz[k] = rz[k] * inv_d
-        invd[k] = inv_d
-        delta[k] = max(d - gap, 0.0)  # guards the square root against rounding
-        touch[k] = 1.0 if hit else 0.0
+    dphi = tab[DPHI]
+    if layer > 0.0:
+        lo = gap - layer
+        lo2 = lo * lo
+        quarter = 0.25 / layer
+        for k in range(n_k):
+            d2 = best[k]
+            hit = d2 > lo2  # δ > -s without a square root
+            d = math.sqrt(d2 if hit else gap2)  # out of contact any finite d keeps n finite
+            inv_d = 1.0 / d
+            nx[k] = rx[k] * inv_d
+            ny[k] = ry[k] * inv_d
+            nz[k] = rz[k] * inv_d
+            invd[k] = inv_d
+            x = d - gap
+            y = min(max(x + layer, 0.0), 2.0 * layer)
+            blend = x < layer
+            on = 1.0 if hit else 0.0
+            delta[k] = on * (y * y * quarter if blend else x)
+            dphi[k] = on * (2.0 * y * quarter if blend else 1.0)
+            touch[k] = on
+    else:
+        for k in range(n_k):
+            d2 = best[k]
+            hit = d2 > gap2  # δ > 0 without a square root (no candidate segment: d² = inf)
+            d = math.sqrt(d2 if hit else gap2)  # out of contact any finite d keeps n finite
+            inv_d = 1.0 / d
+            nx[k] = rx[k] * inv_d  # outward from the axis
+            ny[k] = ry[k] * inv_d
+            nz[k] = rz[k] * inv_d
+            invd[k] = inv_d
+            delta[k] = max(d - gap, 0.0)  # guards the square root against rounding
+            dphi[k] = 1.0
+            touch[k] = 1.0 if hit else 0.0
     n_touch = 0.0
     for k in range(n_k):
         n_touch += touch[k]
@@ -393,8 +421,10 @@ def normal_force(tab, omega, n_k, weight_scale, stiffness, damping, exponent, ex
 
 @njit(inline="always", **JIT_OPTIONS)
 def onset_ramp(tab, n_k, inv_onset):
-    """Damping onset g(δ) = min(δ/δ_d, 1) and dg/dδ of every point ((1, 0) for δ_d = 0)."""
+    """Damping onset g(φ) = min(φ/δ_d, 1) and dg/dδ of every point ((1, 0) for δ_d = 0); φ is row
+    DELTA, the blended penetration (δ without an onset layer), dφ/dδ row DPHI."""
     delta = tab[DELTA]
+    dphi = tab[DPHI]
     rr = tab[RAMP]
     drr = tab[DRAMP]
     if inv_onset > 0.0:
@@ -402,7 +432,7 @@ def onset_ramp(tab, n_k, inv_onset):
             x = delta[k] * inv_onset
             below = x < 1.0
             rr[k] = x if below else 1.0
-            drr[k] = inv_onset if below else 0.0
+            drr[k] = inv_onset * dphi[k] if below else 0.0
     else:
         for k in range(n_k):
             rr[k] = 1.0
@@ -438,21 +468,22 @@ def normal_force_with_ramp(tab, omega, n_k, weight_scale, stiffness, damping, ex
     fr = tab[F]
     wr = tab[WACT]
     ddr = tab[DDPOW]
-    # δ^e into the force row and its derivative, one loop per case (a branch on the exponent
-    # inside the loop would stop vectorisation)
+    dphi = tab[DPHI]
+    # φ^e into the force row and its derivative dφ^e/dδ = e φ^(e-1) dφ/dδ, one loop per case (a
+    # branch on the exponent inside the loop would stop vectorisation); φ = δ without an onset layer
     if exponent_mode == 1:  # e = 1.5, the project's value: no pow
         for k in range(n_k):
             sq = math.sqrt(delta[k])
             fr[k] = delta[k] * sq
-            ddr[k] = 1.5 * sq
+            ddr[k] = 1.5 * sq * dphi[k]
     elif exponent_mode == 2:  # e = 1
         for k in range(n_k):
             fr[k] = delta[k]
-            ddr[k] = 1.0
+            ddr[k] = dphi[k]
     else:
         for k in range(n_k):
             fr[k] = delta[k] ** exponent
-            ddr[k] = exponent * delta[k] ** (exponent - 1.0)
+            ddr[k] = exponent * delta[k] ** (exponent - 1.0) * dphi[k]
     rr = tab[RAMP]
     for k in range(n_k):
         vn = nx[k] * vx[k] + ny[k] * vy[k] + nz[k] * vz[k]  # Eq. 16, = δ̇

@@ -14,7 +14,8 @@ from ..scenario.fields import default_of
 
 import numpy as np
 
-__all__ = ["ContactLaw", "normal_force_magnitude", "friction_coefficient", "damping_ramp", "damping_onset"]
+__all__ = ["ContactLaw", "normal_force_magnitude", "friction_coefficient", "damping_ramp", "damping_onset",
+           "onset_blend"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +47,12 @@ class ContactLaw:
         f_n = K_n δ^e + C_n g δ̇ with g = min(δ/δ_d, 1) (default: the scenario's
         ``contact.damping_onset``). 0 is the paper's Eq. 18, whose damping force jumps to C_n δ̇
         at first touch.
+    onset_layer_m : float
+        Thickness s [m] of a smooth contact onset (docs/theory.md, "A smooth contact onset"): the
+        law acts on the blended penetration φ_s(δ) of :func:`onset_blend` instead of max(δ, 0),
+        so that contact begins at δ = -s with zero force and slope and is the Hertz law itself
+        from δ = s on. 0 (default) is the law above, bit for bit; the several cables' steady solve
+        continues s toward 0 (:mod:`exucable.solve.onset_continuation`).
 
     Notes
     -----
@@ -71,6 +78,7 @@ class ContactLaw:
     # 1 % of the paper's 0.1 m/s; a scenario sets 1 % of its own pull speed (scenarios/README.md)
     regularisation_velocity_m_per_s: float = 1.0e-3
     damping_onset_m: float = default_of("contact.damping_onset")
+    onset_layer_m: float = 0.0
 
     def __post_init__(self):
         # The kernel is below the scenario layer, which reports bad user input with its own
@@ -84,6 +92,7 @@ class ContactLaw:
             ("regularisation_velocity_m_per_s", self.regularisation_velocity_m_per_s > 0.0,
              "must be > 0"),
             ("damping_onset_m", self.damping_onset_m >= 0.0, "must be >= 0"),
+            ("onset_layer_m", self.onset_layer_m >= 0.0, "must be >= 0 (0: contact starts at δ = 0)"),
         ]
         for name, ok, message in checks:
             value = getattr(self, name)
@@ -103,14 +112,46 @@ class ContactLaw:
         return 0.0 if self.static_friction is None else self.static_friction - self.friction
 
 
+def onset_blend(penetration_m, layer_m: float):
+    """Blended penetration φ_s(δ) [m] and dφ_s/dδ [-] of a smooth contact onset of thickness s.
+
+    φ_s(δ) = 0 for δ <= -s, (δ + s)²/(4s) for -s < δ < s, δ for δ >= s (docs/theory.md, "A smooth
+    contact onset"): C¹, so the Hertz force K φ_s^e is C¹ in δ (C² at δ = -s for e = 1.5, where
+    it grows as (δ + s)³), and its stiffness at the contact surface δ = 0 is K e (s/4)^(e-1)/2
+    instead of 0. For s = 0: (max(δ, 0), 1), the law without the layer.
+
+    Parameters
+    ----------
+    penetration_m : array_like
+        Penetration δ [m] (negative: a gap).
+    layer_m : float
+        s >= 0 [m].
+
+    Returns
+    -------
+    phi : ndarray
+        φ_s(δ) [m].
+    dphi : ndarray
+        dφ_s/dδ [-].
+    """
+    d = np.asarray(penetration_m, dtype=float)
+    if layer_m <= 0.0:
+        return np.maximum(d, 0.0), np.ones_like(d)
+    s = float(layer_m)
+    x = np.clip(d + s, 0.0, 2.0 * s)
+    blend = d < s
+    return np.where(blend, x * x / (4.0 * s), d), np.where(blend, x / (2.0 * s), 1.0)
+
+
 def normal_force_magnitude(law: ContactLaw, penetration_m, penetration_rate_m_per_s):
-    """Unweighted normal force max(0, K_n δ^e + C_n δ̇) [N] (Eq. 18, never pulling).
+    """Unweighted normal force max(0, K_n φ^e + C_n g(φ) δ̇) [N] (Eq. 18, never pulling), φ the
+    penetration blended over the law's onset layer (:func:`onset_blend`; δ itself for s = 0).
 
     Parameters
     ----------
     law : ContactLaw
     penetration_m : array_like
-        Penetration δ [m]; entries <= 0 give zero force.
+        Penetration δ [m]; entries <= -s give zero force.
     penetration_rate_m_per_s : array_like
         Penetration rate δ̇ = n·v [m/s].
 
@@ -121,8 +162,8 @@ def normal_force_magnitude(law: ContactLaw, penetration_m, penetration_rate_m_pe
     """
     delta = np.asarray(penetration_m, dtype=float)
     rate = np.asarray(penetration_rate_m_per_s, dtype=float)
-    touching = delta > 0.0
-    d = np.where(touching, delta, 0.0)
+    touching = delta > -law.onset_layer_m
+    d = np.where(touching, onset_blend(delta, law.onset_layer_m)[0], 0.0)
     raw = law.stiffness * d ** law.exponent + law.damping * damping_ramp(law, d)[0] * rate
     return np.where(touching & (raw > 0.0), raw, 0.0)
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .broadphase import candidates_all_pairs, candidates_all_segments, element_aabbs
-from .law import ContactLaw, damping_ramp, friction_coefficient
+from .law import ContactLaw, damping_ramp, friction_coefficient, onset_blend
 from .smooth import refine_closest_points
 
 __all__ = ["ReferenceKernel"]
@@ -62,6 +62,8 @@ def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian, held_on
     ``p_res`` = P - Pc (NaN rows for points without a segment); ``axis_inside`` = segment axis
     where the projection is inside the segment, 0 where it is clamped to a vertex;
     ``held_onset`` (optional, one per point): the damping onset g, held, instead of g(δ).
+    The law acts on the blended penetration φ = φ_s(δ) of the law's onset layer s
+    (:func:`~exucable.contact.law.onset_blend`; δ itself for s = 0), a point touching for δ > -s.
     """
     m = p_res.shape[0]
     out = {
@@ -79,7 +81,8 @@ def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian, held_on
         d = np.sqrt(np.sum(p_res * p_res, axis=1))
         delta = d - gap  # Eq. 14
     out["delta"] = delta
-    touch = np.nonzero(delta > 0.0)[0]  # NaN compares False: no segment, no contact
+    layer = law.onset_layer_m
+    touch = np.nonzero(delta > -layer)[0]  # NaN compares False: no segment, no contact
     pos = d > 0.0
     out["normal"][pos] = p_res[pos] / d[pos, None]
     if touch.size == 0:
@@ -88,16 +91,17 @@ def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian, held_on
     n = p_res[touch] / dt[:, None]  # Eq. 15
     vt_ = v[touch]
     vn = np.sum(n * vt_, axis=1)  # Eq. 16
-    dl = delta[touch]
+    dl, dphi = onset_blend(delta[touch], layer)
     if held_onset is None:
         ramp, dramp = damping_ramp(law, dl)
+        dramp = dramp * dphi
     else:
         ramp, dramp = held_onset[touch], np.zeros_like(dl)
     raw = law.stiffness * dl**law.exponent + law.damping * ramp * vn  # Eq. 18 (with the onset)
     act = raw > 0.0
     idx = touch[act]
     n, vt_, vn, dl, dt, raw = n[act], vt_[act], vn[act], dl[act], dt[act], raw[act]
-    ramp, dramp = ramp[act], dramp[act]
+    ramp, dramp, dphi = ramp[act], dramp[act], dphi[act]
     wt = w[idx]
     f = wt * raw
     tau = vt_ - vn[:, None] * n  # Eq. 17
@@ -120,7 +124,7 @@ def _point_law(p_res, v, axis_inside, w, law: ContactLaw, gap, jacobian, held_on
     mmat = (proj - nn) / dt[:, None, None]  # ∂n/∂P
     mv = np.einsum("kij,kj->ki", mmat, vt_)
     mt = np.einsum("kij,kj->ki", mmat, tau)
-    df_dp = wt[:, None] * ((law.stiffness * law.exponent * dl ** (law.exponent - 1.0)
+    df_dp = wt[:, None] * ((law.stiffness * law.exponent * dl ** (law.exponent - 1.0) * dphi
                             + law.damping * dramp * vn)[:, None] * n
                            + (law.damping * ramp)[:, None] * mv)
     df_dv = (wt * law.damping * ramp)[:, None] * n
@@ -234,8 +238,9 @@ class ReferenceKernel:
         nodes[:-1] += force_e[:, 0:2].reshape(n_el, 6)
         nodes[1:] += force_e[:, 2:4].reshape(n_el, 6)
         delta = law["delta"]
+        layer = k.law.onset_layer_m
         with np.errstate(invalid="ignore"):
-            n_contact = int(np.count_nonzero(delta > 0.0))
+            n_contact = int(np.count_nonzero(delta > -layer))
         finite = delta[np.isfinite(delta)]
         max_pen = float(finite.max()) if finite.size else -np.inf
         jq = jqt = None
@@ -251,5 +256,6 @@ class ReferenceKernel:
             else:
                 jqt = jv_blocks
         with np.errstate(invalid="ignore"):
-            penetration = np.where(delta > 0.0, delta, 0.0).reshape(n_el, n_k)
+            # the blended penetration φ_s(δ) the law acted on (δ itself for s = 0)
+            penetration = np.where(delta > -layer, onset_blend(delta, layer)[0], 0.0).reshape(n_el, n_k)
         return force, jq, jqt, n_contact, max_pen, penetration

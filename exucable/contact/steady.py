@@ -133,6 +133,18 @@ class SteadySlidingKernel(ContactKernel):
         base = self._base_law
         law = replace(base, friction=scale * base.friction,
                       static_friction=None if base.static_friction is None else scale * base.static_friction)
+        self._use(law)
+
+    def set_onset_layer(self, layer_m: float) -> None:
+        """The contact onset's layer s [m] (:func:`~exucable.contact.law.onset_blend`; 0: the law
+        without one), kept by :meth:`set_friction_scale`; s must stay below the clearance R - r."""
+        layer = float(layer_m)
+        if not 0.0 <= layer < self.gap_m:
+            raise ValueError(f"onset layer {layer!r} m must be in [0, the clearance R - r = {self.gap_m:g} m)")
+        self._base_law = replace(self._base_law, onset_layer_m=layer)
+        self._use(replace(self.law, onset_layer_m=layer))
+
+    def _use(self, law) -> None:
         self.law = law
         self._last_point_state = None      # its forces were of the former law
         if isinstance(self._impl, _SteadyFast):
@@ -279,7 +291,7 @@ def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, basis, pair
                    omega, seg, off, cand, gap, stiffness, damping, exponent, exponent_mode, mu_k,
                    dmu, inv_vs2, eps2, inv_href, jacobian, force, jq, scratch, tab, sel, acc,
                    acc16, open_first, open_last, smooth, seg_piece, pieces, seg_phi, n_newton,
-                   inv_onset):
+                   inv_onset, layer):
     """As :func:`exucable.contact.fast._contact_kernel`, with v = V S'(ξ) q_e.
 
     ``basis`` (7, n_k): Bernstein values B_m(ξ_k) (:func:`bernstein`); ``coeff`` (26, 7): the
@@ -304,7 +316,7 @@ def _steady_kernel(q, length, n1, n2, n3, n4, d1, d2, d3, d4, speed, basis, pair
             refine_smooth(tab[PX], tab[PY], tab[PZ], seg, sel, tab[BEST], tab[RX], tab[RY],
                            tab[RZ], tab[AX], tab[AY], tab[AZ], seg_piece, pieces, seg_phi,
                            n_newton)
-        n_touch, max_d2 = normals(tab, n_k, gap, max_d2)
+        n_touch, max_d2 = normals(tab, n_k, gap, max_d2, layer)
         if n_touch == 0:
             continue
         n_contact += n_touch
@@ -376,7 +388,7 @@ class _SteadyFast:
             law.regularisation_velocity_m_per_s**2, f.inv_href, bool(jacobian), force, jq,
             self._unused_work, f._tab, f._sel, f._acc, self._unused_work, f.open_first, f.open_last,
             f.smooth, f.seg_piece, f.pieces, f.seg_phi, NEWTON_ITERATIONS,
-            1.0 / law.damping_onset_m if law.damping_onset_m > 0.0 else 0.0)
+            1.0 / law.damping_onset_m if law.damping_onset_m > 0.0 else 0.0, float(law.onset_layer_m))
         if not jacobian:
             return force, None, None, int(n_contact), float(max_pen)
         return force, jq, np.zeros_like(jq), int(n_contact), float(max_pen)

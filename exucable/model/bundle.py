@@ -302,6 +302,12 @@ class _Walls:
             k.set_friction_scale(scale)
         self.between.set_friction_scale(scale)
 
+    def set_onset_layer(self, layer_m: float) -> None:
+        """Every contact's onset layer s [m] (:mod:`exucable.solve.onset_continuation`)."""
+        for k in self.walls:
+            k.set_onset_layer(layer_m)
+        self.between.set_onset_layer(layer_m)
+
     def point_segments(self, q) -> np.ndarray:
         q = np.asarray(q, dtype=float).reshape(-1)
         return np.concatenate([k.point_segments(q[i * self.n:(i + 1) * self.n]) for i, k in enumerate(self.walls)])

@@ -29,12 +29,14 @@ from .generic import add_user_force_object
 __all__ = ["ContactCoupling"]
 
 
-def _chain_pattern(rows, cols, n_elements: int):
+def _chain_pattern(n_elements: int, with_inverse: bool = True):
     """The distinct (row, column) pairs of a chain's element blocks in row-major order, and the
-    index of each block entry among them: what ``np.unique(rows·n + cols, return_inverse=True)``
-    gives, without sorting 144 entries per element. Element e's 12 × 12 block spans nodes e and
-    e + 1 (coordinates 6e … 6e + 11), so the row of node k's coordinates holds the columns of
-    nodes max(k − 1, 0) … min(k + 1, n_nodes − 1), contiguous."""
+    index of each block entry among them, in the order of :func:`exucable.contact.block_sparsity`:
+    what ``np.unique(rows·n + cols, return_inverse=True)`` of its rows and columns gives, without
+    sorting (or forming) 144 entries per element. Element e's 12 × 12 block spans nodes e and e + 1
+    (coordinates 6e … 6e + 11), so the row of node k's coordinates holds the columns of nodes
+    max(k − 1, 0) … min(k + 1, n_nodes − 1), contiguous; entry (a, b) of element e's block is row
+    6e + a, column 6e + b. ``with_inverse=False``: the pairs only (the inverse None)."""
     n_nodes = n_elements + 1
     node = np.arange(n_nodes)
     first = np.maximum(node - 1, 0)                      # first column node of each row node
@@ -42,9 +44,15 @@ def _chain_pattern(rows, cols, n_elements: int):
     row_width = np.repeat(width, 6)                      # per row (6 per node)
     row_start = np.concatenate([[0], np.cumsum(row_width)])
     col_start = np.repeat(6 * first, 6)
-    inverse = row_start[rows] + (cols - col_start[rows])
+    # an entry's index: its row's start + (its column − the row's first column)
+    shift = row_start[:-1] - col_start                   # per row
+    inverse = None
+    if with_inverse:
+        element_row = 6 * np.arange(n_elements)[:, None] + np.arange(12)[None, :]
+        inverse = ((shift[element_row] + 6 * np.arange(n_elements)[:, None])[:, :, None]
+                   + np.arange(12)[None, None, :]).reshape(-1)
     unique_rows = np.repeat(np.arange(6 * n_nodes), row_width)
-    unique_cols = (np.arange(row_start[-1]) - np.repeat(row_start[:-1], row_width)) + np.repeat(col_start, row_width)
+    unique_cols = np.arange(row_start[-1]) - np.repeat(shift, row_width)
     return unique_rows, unique_cols, inverse
 
 
@@ -78,8 +86,6 @@ class ContactCoupling:
     """
 
     def __init__(self, mbs, nodes, reference_coordinates, kernel, cable_forces=None):
-        from ..contact import block_sparsity
-
         self.kernel = kernel
         self.cable_forces = cable_forces
         self.cable_time_s = 0.0
@@ -89,17 +95,11 @@ class ContactCoupling:
         self.n = self.q_ref.size
         if self.n != kernel.n_coordinates:
             raise ValueError("kernel and cable disagree on the number of coordinates")
-        rows, cols = block_sparsity(kernel.n_elements)
-        unique_rows, unique_cols, self._inverse = _chain_pattern(rows, cols, kernel.n_elements)
+        unique_rows, unique_cols, _ = _chain_pattern(kernel.n_elements, with_inverse=False)
         self._n_unique = unique_rows.size
         self._csr = (np.concatenate([[0], np.cumsum(np.bincount(unique_rows, minlength=self.n))]).astype(np.int64),
                      unique_cols.astype(np.int64))
-        # the triplets (row, column, value) handed to Exudyn, rows and columns filled once; a row is
-        # also one 24-byte record, so that dropping the zero values is one gather of records
-        self._triplets = np.zeros((self._n_unique, 3))
-        self._triplets[:, 0] = unique_rows
-        self._triplets[:, 1] = unique_cols
-        self._records = self._triplets.view(np.dtype((np.void, 24))).reshape(-1)
+        self._handover = None    # the triplets for Exudyn's solver: made when first asked for (see _triplets)
         self.kernel_time_s = 0.0
         self.user_time_s = 0.0
         self.force_calls = 0
@@ -186,6 +186,31 @@ class ContactCoupling:
     def forget_evaluation(self) -> None:
         """Reuse no former kernel pass: the kernel's law changed (its friction scale)."""
         self._last = None
+
+    def _handover_arrays(self):
+        """The triplets (row, column, value) handed to Exudyn, rows and columns filled once, each row
+        also one 24-byte record (so that dropping the zero values is one gather of records), and each
+        block entry's index among them: made on first use, since only a Jacobian handed to Exudyn (or
+        the SuperLU step's values) needs them, not our banded Newton step (10 km: 33 MB of triplets)."""
+        if self._handover is None:
+            unique_rows, unique_cols, inverse = _chain_pattern(self.kernel.n_elements)
+            triplets = np.zeros((unique_rows.size, 3))
+            triplets[:, 0] = unique_rows
+            triplets[:, 1] = unique_cols
+            self._handover = (triplets, triplets.view(np.dtype((np.void, 24))).reshape(-1), inverse)
+        return self._handover
+
+    @property
+    def _triplets(self):
+        return self._handover_arrays()[0]
+
+    @property
+    def _records(self):
+        return self._handover_arrays()[1]
+
+    @property
+    def _inverse(self):
+        return self._handover_arrays()[2]
 
     def chain_pattern_csr(self) -> tuple[np.ndarray, np.ndarray]:
         """The Jacobian's fixed sparsity as CSR ``(indptr, indices)`` over the cable's coordinates

@@ -80,7 +80,7 @@ def extended_point(centreline, s_m: np.ndarray) -> np.ndarray:
     s = np.atleast_1d(np.asarray(s_m, dtype=float))
     L = centreline.length_m
     inside = np.clip(s, 0.0, L)
-    p = np.atleast_2d(centreline.point(inside)).copy()
+    p = np.atleast_2d(centreline.point(inside))      # a new array, changed in place below
     lo, hi = s < 0.0, s > L
     if lo.any():
         p[lo] += (s[lo] - 0.0)[:, None] * np.atleast_2d(centreline.tangent(0.0))
@@ -142,23 +142,25 @@ def contact_offsets(
         Offset vectors [m].
     """
     s = np.asarray(s_m, dtype=float)
-    t = np.atleast_2d(centreline.tangent(s))
-    kn = np.atleast_2d(centreline.curvature_vector(s))
-    ez = np.array([0.0, 0.0, 1.0])
-    w_perp = weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
-    load = np.asarray(tension_N, dtype=float)[:, None] * kn - w_perp
-    p = np.linalg.norm(load, axis=1)
-    off = np.zeros_like(load)
     if path_offset_m is not None:
         p = np.asarray(path_pressure_N_per_m, dtype=float)
         load = np.asarray(path_offset_m, dtype=float)   # only its direction is used where loaded
         off = load.copy()
+    else:
+        t = np.atleast_2d(centreline.tangent(s))
+        kn = np.atleast_2d(centreline.curvature_vector(s))
+        ez = np.array([0.0, 0.0, 1.0])
+        w_perp = weight_per_length_N_per_m * (ez[None, :] - (t @ ez)[:, None] * t)
+        load = np.asarray(tension_N, dtype=float)[:, None] * kn - w_perp
+        p = np.linalg.norm(load, axis=1)
+        off = np.zeros_like(load)
     scale = max(p.max(), 1e-300)
     loaded = p > 1e-9 * scale
     if loaded.any():
         delta = (p[loaded] / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent)
-        size = np.maximum(np.linalg.norm(load[loaded], axis=1), 1e-300)
-        off[loaded] = load[loaded] / size[:, None] * (clearance_m + delta)[:, None]
+        bearing = load[loaded]
+        size = np.maximum(np.sqrt(_dot3(bearing.T, bearing.T)), 1e-300)   # the rows' lengths
+        off[loaded] = bearing / size[:, None] * (clearance_m + delta)[:, None]
     ds = s[1] - s[0] if len(s) > 1 else 1.0
     sigma = blend_length_m / ds
     if sigma > 0.5 and loaded.any():
@@ -169,7 +171,7 @@ def contact_offsets(
         pad = np.pad(off, ((half, half), (0, 0)), mode="edge")
         off = np.stack([np.convolve(pad[:, j], k, mode="valid") for j in range(3)], axis=1)
         # smoothing may only lift the cable off the wall, never push it further in than the load needs
-        mag = np.linalg.norm(off, axis=1)
+        mag = np.sqrt(_dot3(off.T, off.T))
         cap = np.where(loaded, clearance_m + (p / line_stiffness_N_per_m_e_per_m) ** (1.0 / exponent), clearance_m)
         too = mag > cap
         off[too] *= (cap[too] / mag[too])[:, None]
@@ -229,17 +231,25 @@ def lay_cable(
     ds = cable_length_m / (n_elements * points_per_element)
     s_full = np.arange(s0, s0 + 1.5 * cable_length_m + ds, ds)
     x_nodes = np.linspace(0.0, cable_length_m, n_elements + 1)
-    # First on the grid's leading part up to 1.15 cable lengths (enough below ~14 % strain): every
-    # value used below is then the full grid's, bit for bit (the same points; the integral is a
-    # running sum; only the last point's one-sided slope differs, and it is not used when the
-    # cable ends before it); else the whole grid.
-    for extent in (1.15, 1.5):
+    # First on the grid's leading part, as far as the largest strain stretches the cable (with a
+    # margin: the offset path is shorter than the axis on the inside of bends), then up to 1.15
+    # cable lengths (enough below ~14 % strain): every value used below is then the full grid's,
+    # bit for bit (the same points; the integral is a running sum; only the last point's one-sided
+    # slope differs, and it is not used when the cable ends before it); else the whole grid.
+    part = s_full[:int(np.searchsorted(s_full, s0 + 1.15 * cable_length_m)) + 1]
+    T_part = np.zeros_like(part) if tension_N is None else np.asarray(tension_N(np.clip(part, 0.0, L)), dtype=float)
+    first = 1.0 + 1.5 * max(float(np.max(T_part)), 0.0) / axial_stiffness_N + 0.01
+    for extent in ((first,) if first < 1.15 else ()) + (1.15, 1.5):
         s = s_full if extent == 1.5 else s_full[:int(np.searchsorted(s_full, s0 + extent * cable_length_m)) + 1]
-        T = np.zeros_like(s) if tension_N is None else np.asarray(tension_N(np.clip(s, 0.0, L)), dtype=float)
+        if len(s) <= len(part):
+            T = T_part[:len(s)]
+        else:
+            T = np.zeros_like(s) if tension_N is None else np.asarray(tension_N(np.clip(s, 0.0, L)), dtype=float)
         o = np.zeros((len(s), 3)) if offset_m is None else np.asarray(offset_m(np.clip(s, 0.0, L)), dtype=float)
-        P = extended_point(centreline, s) + o
+        P = extended_point(centreline, s)
+        P += o
         dP = np.gradient(P, s, axis=0, edge_order=2)
-        speed_geom = np.linalg.norm(dP, axis=1)              # dσ/ds of the offset path
+        speed_geom = np.sqrt(_dot3(dP.T, dP.T))             # dσ/ds of the offset path, |dP/ds|
         stretch = 1.0 + T / axial_stiffness_N                # dσ/dx
         if np.any(stretch <= 0.5) or np.any(stretch > 1.5):
             from ..errors import ModelError
@@ -260,40 +270,45 @@ def lay_cable(
     # the path make it bulge into the wall by up to ~L²κ/8 (0.6 mm against a 1 mm clearance on
     # Example 4's coarse mesh). Then correct: where a fitted point leaves the offset it should
     # have, move its target back by the excess and refit.
-    xi_s, _ = np.polynomial.legendre.leggauss(fit_points_per_element)
+    k = fit_points_per_element
+    xi_s, _ = np.polynomial.legendre.leggauss(k)
     xi_s = 0.5 * (xi_s + 1.0)
     xs = (x_nodes[:-1, None] + xi_s[None, :] * Le[:, None]).ravel()
     xs = np.concatenate([[0.0], xs, [cable_length_m]])
-    e_of = np.clip(np.searchsorted(x_nodes, xs, side="right") - 1, 0, n_elements - 1)
+    # the rows: the trailing node, k Gauss points in each element in turn, the leading node; each
+    # Gauss point lies inside its element (ξ in (0, 1)), so a row's element is known without a search
+    e_of = np.concatenate([[0], np.repeat(np.arange(n_elements), k), [n_elements - 1]])
     xi_of = (xs - x_nodes[e_of]) / Le[e_of]
-    cols, vals = _hermite_rows(e_of, xi_of, Le)
+    _, vals = _hermite_rows(e_of, xi_of, Le)
+    # From here on the rows are taken Gauss point by Gauss point (the first point of every element,
+    # then the second, ...; the end nodes first and last) and each coordinate direction is one
+    # contiguous row of a (3, m) array: the fit's sums over an element's points become additions of
+    # whole arrays (:func:`_fit_rhs`). Row-wise operations give the same numbers in any row order.
+    order = _point_major(n_elements, k)
+    xs, vals_t = xs[order], vals[order].T.copy()          # vals_t (4, m): each basis function's values
     ss = np.interp(xs, x, s)
-    target = np.stack([np.interp(ss, s, P[:, j]) for j in range(3)], axis=1)
-    ss_in = np.clip(ss, 0.0, L)
-    C = extended_point(centreline, ss)
-    t_c = extended_tangent(centreline, ss)
-    want = np.linalg.norm(target - C - np.sum((target - C) * t_c, axis=1)[:, None] * t_c, axis=1)
+    target = np.stack([np.interp(ss, s, P[:, j]) for j in range(3)])
+    C = np.ascontiguousarray(extended_point(centreline, ss).T)
+    t_c = np.ascontiguousarray(extended_tangent(centreline, ss).T)
+    rel = target - C
+    lat = rel - _dot3(rel, t_c) * t_c
+    want = np.sqrt(_dot3(lat, lat))
     inside = (ss > 0.0) & (ss < L)
     # scipy.linalg (loaded anyway: numba's BLAS) rather than scipy.sparse, whose import is part of
     # `exucable run`'s fixed cost (docs/performance.md)
     from scipy.linalg import cho_solve_banded, cholesky_banded
 
-    n_unknowns = 2 * (n_elements + 1)
-    factor = cholesky_banded(_normal_matrix_banded(cols, vals, n_unknowns))   # factored once
+    factor = cholesky_banded(_normal_matrix_banded(vals_t, n_elements, k), check_finite=False)   # factored once
     for _ in range(correction_iterations + 1):
-        # Bᵀ target, accumulated in row order as np.add.at would, at a tenth of its cost
-        rhs = np.stack([np.bincount(cols.ravel(), (vals * target[:, j, None]).ravel(), n_unknowns)
-                        for j in range(3)], axis=1)
-        coef = cho_solve_banded((factor, False), rhs)   # (2(n+1), 3): r_k, r'_k rows
-        fitted = np.einsum("mk,mkj->mj", vals, coef[cols])                               # B coef
-        rel = fitted - C
-        lat = rel - np.sum(rel * t_c, axis=1)[:, None] * t_c
-        d = np.linalg.norm(lat, axis=1)
+        rhs = _fit_rhs(vals_t, target, n_elements, k)                              # Bᵀ target
+        coef = cho_solve_banded((factor, False), rhs.T, check_finite=False)   # (2(n+1), 3): r_k, r'_k rows
+        rel = _fit_values(vals_t, coef, n_elements, k) - C                          # B coef − C
+        lat = rel - _dot3(rel, t_c) * t_c
+        d = np.sqrt(_dot3(lat, lat))
         excess = np.where(inside & (d > want), d - want, 0.0)
         if excess.max() < 1e-7 * max(1.0, want.max()) or clearance_m is None:
             break
-        target = target - (excess / np.maximum(d, 1e-300))[:, None] * lat
-    del ss_in
+        target = target - (excess / np.maximum(d, 1e-300)) * lat
     return sliding_layout(np.diff(x_nodes), x_nodes, s_nodes, coef[0::2], coef[1::2], speed_m_per_s)
 
 
@@ -331,13 +346,90 @@ def _hermite_rows(e, xi, Le):
     return cols, vals
 
 
-def _normal_matrix_banded(cols, vals, n_unknowns):
-    """BᵀB of the rows of :func:`_hermite_rows` in LAPACK's upper banded storage (row 3 + i − j holds
-    entry (i, j), i ≤ j), as ``scipy.linalg.cholesky_banded`` takes it."""
-    ab = np.zeros((4, n_unknowns))
-    a, b = np.triu_indices(4)          # column pairs of a row with cols[a] <= cols[b]
-    np.add.at(ab, ((3 + cols[:, a] - cols[:, b]).ravel(), cols[:, b].ravel()),
-              (vals[:, a] * vals[:, b]).ravel())
+def _dot3(a, b):
+    """Row-wise dot product of two (3, m) arrays, summed x + y then z, as ``np.sum(a * b, axis=1)``
+    sums the rows of (m, 3) arrays (so that the fit's numbers are those of the row-per-point form)."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _point_major(n_elements: int, k: int):
+    """The fit's rows (the trailing node, ``k`` points in each element in turn, the leading node)
+    reordered point by point: the trailing node, every element's first point, every element's
+    second, ..., the leading node."""
+    mid = 1 + np.arange(n_elements)[None, :] * k + np.arange(k)[:, None]
+    return np.concatenate([[0], mid.ravel(), [n_elements * k + 1]])
+
+
+def _element_sums(w, n_elements: int, k: int, carry_from: slice, carry_to: slice):
+    """Sums over each element of the fit's row terms ``w`` (..., slots, m) (rows in the order of
+    :func:`_point_major`), shape (..., slots, n): every sum taken in the original row order from
+    zero, as ``np.bincount`` adds the terms into their entries (the same sums, bit for bit), but in
+    whole arrays instead of one scattered addition per term.
+
+    A slot stands for one entry per element; the entry of slot ``carry_to`` of element e is the one
+    of slot ``carry_from`` of element e − 1 (a node's shared by the two elements), so its sum goes
+    on from there. The trailing node's row adds to element 0 before its points, the leading node's
+    to element n − 1 after them."""
+    mid = w[..., 1:-1].reshape(w.shape[:-1] + (k, n_elements))
+    out = np.zeros(w.shape[:-1] + (n_elements,))
+    out[..., 0] += w[..., 0]
+    own = slice(0, carry_to.start) if carry_to.start > 0 else slice(carry_to.stop, None)   # carry_to: first or last
+    for r in range(k):
+        out[..., own, :] += mid[..., own, r, :]
+    out[..., carry_to, 1:] = out[..., carry_from, :-1]
+    for r in range(k):
+        out[..., carry_to, :] += mid[..., carry_to, r, :]
+    out[..., -1] += w[..., -1]
+    return out
+
+
+def _fit_rhs(vals_t, target, n_elements: int, k: int):
+    """Bᵀ target, shape (3, 2(n + 1)), for the fit's rows in the order of :func:`_point_major`
+    (``vals_t`` (4, m): the Hermite values of :func:`_hermite_rows`, transposed; ``target`` (3, m)),
+    bit for bit ``np.bincount`` over the rows' columns (:func:`_element_sums`): element e's
+    columns 2, 3 are node e + 1's unknowns, its columns 0, 1 node e's."""
+    sums = _element_sums(vals_t[None, :, :] * target[:, None, :], n_elements, k, slice(2, 4), slice(0, 2))
+    # unknowns 2e + i at [:, i, e]; the leading node's, 2n + i, at [:, 2 + i, n − 1]
+    return np.concatenate([sums[:, :2].transpose(0, 2, 1).reshape(3, 2 * n_elements), sums[:, 2:, -1]], axis=1)
+
+
+def _fit_values(vals_t, coef, n_elements: int, k: int):
+    """B coef, shape (3, m), for the fit's rows in the order of :func:`_point_major` (``coef``
+    (2(n + 1), 3)): each row's four terms summed from zero in column order, as ``np.einsum("mk,mkj->mj",
+    vals, coef[cols])`` sums them, with element e's coefficients (rows 2e … 2e + 3 of ``coef``)
+    taken once per element instead of gathered per row."""
+    c = coef.T                                                 # (3, 2(n + 1))
+    out = np.zeros((3, vals_t.shape[1]))
+    for j in range(4):   # the end rows: the trailing node's element is the first, the leading node's the last
+        out[:, 0] += vals_t[j, 0] * c[:, j]
+        out[:, -1] += vals_t[j, -1] * c[:, 2 * n_elements - 2 + j]
+    mid = out[:, 1:-1].reshape(3, k, n_elements)
+    v = vals_t[:, 1:-1].reshape(4, k, n_elements)
+    for j in range(4):
+        mid += v[j][None] * np.ascontiguousarray(c[:, j:j + 2 * n_elements:2])[:, None, :]
+    return out
+
+
+#: Column pairs (a, b), a ≤ b, of a row's four Hermite values whose products enter BᵀB: those across
+#: an element's two nodes, those of its leading node (carried into the next element's trailing node,
+#: the same entries), those of its trailing node (see :func:`_element_sums`).
+_PAIRS = ((0, 2), (0, 3), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3), (0, 0), (0, 1), (1, 1))
+
+
+def _normal_matrix_banded(vals_t, n_elements: int, k: int):
+    """BᵀB of the rows of :func:`_hermite_rows` (``vals_t`` (4, m), rows in the order of
+    :func:`_point_major`) in LAPACK's upper banded storage (row 3 + i − j holds entry (i, j), i ≤ j),
+    as ``scipy.linalg.cholesky_banded`` takes it; each entry's products summed in the original row
+    order, as ``np.add.at`` sums them (bit for bit, :func:`_element_sums`)."""
+    a, b = np.array(_PAIRS).T
+    sums = _element_sums(vals_t[a] * vals_t[b], n_elements, k, slice(4, 7), slice(7, 10))
+    ab = np.zeros((4, 2 * (n_elements + 1)))
+    e2 = 2 * np.arange(n_elements)
+    for p, (i, j) in enumerate(_PAIRS):
+        if 4 <= p < 7:      # the leading node's entries: final in the last element only
+            ab[3 + i - j, 2 * (n_elements - 1) + j] = sums[p, -1]
+        else:
+            ab[3 + i - j, e2 + j] = sums[p]
     return ab
 
 
@@ -560,7 +652,6 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
     n_el = mesh.elements
     if sc.solver.pretension:
         s_grid = np.linspace(0.0, centre.length_m, max(2001, 20 * n_el + 1))
-        T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
         L_e = L_cable / n_el
         # blend over the length on which a tensioned beam leaves the wall, √(EJ/T), but at least
         # half an element so the nodes can follow it
@@ -573,7 +664,9 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         else:
             free = _clearance_rope_start(sc, centre, w, clearance, L_cable - lead_out)
         path = {}
-        if free is not None:
+        if free is None:
+            T_grid = np.interp(s_grid, rope.s_conduit_m, rope.tension_N)
+        else:
             # Start on the path of the rope with clearance: with gravity the cable leaves the wall in
             # free spans across the clearance, and a start pressed onto the wall the centreline rope's
             # load points to rang for a second as those spans formed.
@@ -588,8 +681,10 @@ def initial_layout(scenario, with_contact: bool = True, refine: float = 1.0,
         def tension_fn(s):
             return np.interp(s, s_grid, T_grid)
 
+        off_columns = [np.ascontiguousarray(off[:, j]) for j in range(3)]   # np.interp copies strided ones per call
+
         def offset_fn(s):
-            return np.stack([np.interp(s, s_grid, off[:, j]) for j in range(3)], axis=1)
+            return np.stack([np.interp(s, s_grid, column) for column in off_columns], axis=1)
 
         cable = lay_cable(centre, L_cable, n_el, c.axial_stiffness_N, sc.pull.speed_m_per_s, tension_fn,
                           offset_fn, clearance_m=clearance if with_contact else None, lead_out_m=lead_out)

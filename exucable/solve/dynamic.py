@@ -45,6 +45,7 @@ class SolveOutcome:
     started_from: str = "rope"   # a steady solve's start that converged: "rope" or "coarse mesh"
     static_solver: str | None = None   # a steady solve's static solver: "exucable" or "exudyn"
     backtracks: int = 0          # a steady solve's force evaluations of shortened steps (no Newton iteration)
+    onset_layer: dict | None = None    # several cables' steady solve: OnsetContinuation.summary()
 
 
 class Progress:

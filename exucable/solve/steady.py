@@ -99,6 +99,7 @@ from ..post.tension import TensionStations, profile_stations_m
 from .steady_advice import TIME_LIMIT_KEY, failure_advice
 from .newton_system import ExudynStatic, static_backend
 from .relax import check_settings
+from .onset_continuation import OnsetContinuation, OnsetSettings
 
 __all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
 
@@ -503,7 +504,7 @@ class SteadySolver:
     """
 
     def __init__(self, model, settings: SteadySettings = SteadySettings(), progress: Progress | None = None,
-                 warm_start: tuple | None = None):
+                 warm_start: tuple | None = None, onset: OnsetSettings | None = None):
         self.model = model
         self.warm_start = warm_start
         self.settings = settings
@@ -541,6 +542,8 @@ class SteadySolver:
         self.best = (np.inf, None)       # the smallest true residual [N] of an accepted step and its state
         self.friction_only = False       # the load ramp scales the friction only (a bundle's first ramp)
         self.relaxation = None           # a bundle's dynamic relaxation (exucable.solve.relax.RelaxOutcome), if run
+        #: several cables: solved through a smooth contact onset first (exucable.solve.onset_continuation)
+        self.onset = OnsetContinuation(onset) if onset is not None and self.bundle else None
 
     def out_of_time(self) -> bool:
         """Whether the solve has used up its CPU time (:attr:`SteadySettings.time_limit_s`)."""
@@ -807,6 +810,8 @@ class SteadySolver:
         model = self.model
         status, message = "ok", ""
         outside_at_start = _outside_points(model)
+        if self.onset is not None:
+            self.onset.begin(model)
         ok, warm_note, started_from = False, "", "rope"
         if self.warm_start is not None:
             ok, why = self.relax_warm()
@@ -841,6 +846,8 @@ class SteadySolver:
             if status != "ok" and self.bundle and not self.timed_out:
                 # the loads' ramp stalled: the friction's alone, from the best state reached
                 status, message = self.ramp_loads(first_message, friction_only=True)
+        if status == "ok" and self.onset is not None:
+            status, message = self.onset.descend(self, message)
         self.store.restore_as_initial()
         self.spring.rate = 0.0
         if status == "ok":
@@ -860,7 +867,8 @@ class SteadySolver:
         return SolveOutcome(history=self.history, status=status, message=message, end_time_s=0.0,
                             steps=self.steps, newton_iterations=self.newton_iterations,
                             jacobian_updates=self.jacobian_updates, wall_time_s=wall, started_from=started_from,
-                            static_solver=self.static.name, backtracks=self.backtracks)
+                            static_solver=self.static.name, backtracks=self.backtracks,
+                            onset_layer=self.onset.summary() if self.onset is not None else None)
 
     def restart_state(self):
         """The state the friction's ramp starts from: for a bundle the accepted state of smallest
@@ -896,11 +904,14 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float | Non
     one shows how converged the pulling force is, ``benchmarks/steady_scale.py --tolerance-check``);
     given, it replaces that of ``settings`` (default :class:`SteadySettings`). ``warm_start``: a
     state near the steady state to start from, the rope start the fallback (:class:`SteadySolver`).
+    Several cables are solved through a smooth contact onset continued to the law without it
+    (:mod:`exucable.solve.onset_continuation`, :class:`OnsetSettings`' defaults).
     """
     settings = SteadySettings() if settings is None else settings
     if tolerance is not None:
         settings = replace(settings, steady_residual=float(tolerance))
-    return SteadySolver(model, settings, progress, warm_start=warm_start).solve()
+    onset = OnsetSettings() if getattr(model, "n_cables", 1) > 1 else None
+    return SteadySolver(model, settings, progress, warm_start=warm_start, onset=onset).solve()
 
 
 #: What to change when a steady solve ends in a state that is not the steady pull.
