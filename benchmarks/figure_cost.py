@@ -10,14 +10,16 @@ the rest" is the figures' CPU time that did not add to the wall time (CPU cost l
 helper's import of matplotlib during the solve and its drawing in several processes at once.
 
 Part 2 (skipped by ``--quick``): the figures' critical path, from CPU times, which a saturated machine
-inflates less than wall times, per mode in a fresh child process: it runs the scenario with a helper
-started before (:class:`exucable.output.figure_process.Figures`) and without figures; its extra CPU,
-the helper's warm-up (beside the solve), the helper's own drawing after the results arrived and its
-forks' (their total and the longest). On two free cores the figures add to the wall time about the
-extra CPU plus the longer of the costliest drawing process and all the drawing CPU over two cores, once
-the warm-up (about 0.6-0.75 s CPU, the frames included) ends before the solve does (a fresh process's
-imports, build and solve after the fork: part 1's ``--no-plots`` CPU, less ~0.4 s of imports before
-it).
+inflates less than wall times, per mode, from fresh processes that run the command as ``exucable run``
+does (``--no-plots`` and with figures, interleaved; a process that has loaded the model's code would
+fork its helper with hundreds of MB to copy on write, which the command's helper, forked first thing,
+has not): the main process's own extra CPU with figures, its extra minor page faults and the bytes it
+sends to the helper; the helper's warm-up (beside the solve), the frames of the drawing processes it
+forks ahead, the helper's own drawing after the results arrived and its drawing processes' (their
+total and the longest); all figure processes' CPU. On two free cores the figures add to the wall time
+about the main process's extra CPU plus the longer of the costliest drawing process and all the
+drawing CPU over two cores, once the warm-up ends before the solve does; on a busy machine, about all
+the figure processes' CPU stretched by the load.
 
 Part 3, in this process (skipped by ``--quick``): the parts of the figures' cost, in CPU seconds: the
 import of matplotlib's Figure and Agg canvas, then each figure drawn and written (first call, then the
@@ -159,7 +161,7 @@ def breakdown(repeat: int) -> None:
         large(result, repeat, Path(tmp))
         print("\n| all figures drawn | wall, median [s] | CPU, median [s] |\n|---|---|---|")
         for what, draw in (("in one process", draw_figures),
-                           ("each in a process of its own, at once, on frames built ahead (as the helper)",
+                           ("each in a process of its own, at once, on frames built ahead (forked once the results are there)",
                             lambda out, res: draw_in_parallel(out, res, None, build_frames()))):
             wall, cpu = [], []
             for _ in range(repeat):
@@ -228,84 +230,87 @@ def large(result, repeat: int, tmp: Path) -> None:
         print(f"| {name} | {statistics.median(cpu):.3f} |")
 
 
-def critical_path(repeat: int, mode: str) -> dict:
-    """CPU seconds of the parts on the figures' critical path (medians of ``repeat``): this process's
-    extra CPU with figures (sending the results, writing beside the helper), the helper's warm-up
-    and its own drawing after the results arrived, the drawing of the processes it forked (their
-    total and the longest); and the estimate of the figures' wall cost on two free cores: the extra
-    CPU plus the longer of the costliest drawing process and all the drawing CPU over two cores."""
-    from exucable.output.figure_process import Figures
-    from exucable.run import run_scenario
-    keys = ("main", "warm_up_s", "draw_s", "forks_draw_s", "longest_fork_draw_s", "estimate")
-    rows = {k: [] for k in keys}
-    with tempfile.TemporaryDirectory() as tmp:
-        run_scenario(SCENARIO, Path(tmp) / "warm", plots=False, mode=mode)   # this process's first run loads the kernels
-        for k in range(repeat):
-            c0 = time.process_time()
-            run_scenario(SCENARIO, Path(tmp) / f"none{k}", plots=False, mode=mode)
-            none = time.process_time() - c0
-            with Figures(helper=True) as figures:
-                _wait_idle(figures._proc.pid)
-                c0 = time.process_time()
-                run_scenario(SCENARIO, Path(tmp) / f"fig{k}", plots=figures, mode=mode)
-                main = time.process_time() - c0 - none
-            cpu = dict(figures.helper_cpu_s)
-            if "second_process_draw_s" in cpu:          # a tree whose helper forked one process
-                cpu["forks_draw_s"] = cpu["longest_fork_draw_s"] = cpu.pop("second_process_draw_s")
-            rows["main"].append(main)
-            for key in keys[1:-1]:
-                rows[key].append(cpu.get(key, 0.0))
-            longest = max(cpu["draw_s"], cpu.get("longest_fork_draw_s", 0.0))
-            total = cpu["draw_s"] + cpu.get("forks_draw_s", 0.0)
-            rows["estimate"].append(max(main, 0.0) + max(longest, total / 2))
-    return {k: statistics.median(v) for k, v in rows.items()}
+def fresh_run(mode: str, out: str, plots: bool) -> dict:
+    """``exucable run -q`` of the fast Example 2 in this process, a fresh one (a child of
+    :func:`critical_paths`: nothing but the standard library loaded before it, as in the command,
+    so that the figures' helper is forked as there), then its parts: this process's own CPU time
+    [s] and minor page faults, its children's CPU time [s], the bytes sent to the helper and the
+    helper's CPU times (:attr:`exucable.output.figure_process.Figures.helper_cpu_s`)."""
+    import dataclasses
+    import pickle
+    import resource
+
+    from exucable import cli
+    from exucable.output import figure_process
+
+    got = {}
+    write = figure_process.Figures.write
+
+    def noting(self, out_dir, result, while_drawing=None):
+        paths = write(self, out_dir, result, while_drawing)
+        got["result"], got["cpu"] = result, dict(self.helper_cpu_s)
+        return paths
+
+    figure_process.Figures.write = noting
+    cli.main(["run", str(SCENARIO), "-q", "--mode", mode, "-o", out] + ([] if plots else ["--no-plots"]))
+    me, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    sent = (len(pickle.dumps((out, dataclasses.replace(got["result"], model=None)))) if "result" in got else 0)
+    return {"self_cpu_s": me.ru_utime + me.ru_stime, "minor_faults": me.ru_minflt,
+            "children_cpu_s": children.ru_utime + children.ru_stime, "sent_bytes": sent, "helper": got.get("cpu", {})}
 
 
-def _wait_idle(pid: int, settle_s: float = 0.3, timeout_s: float = 60.0) -> None:
-    """Wait until process ``pid`` has used no CPU for ``settle_s`` [s]: the helper's warm-up is over
-    and it waits for the results, as in a fresh run, whose imports, build and solve outlast it (here
-    the model's code is loaded already, and the results would come before the helper is ready).
-    Without ``/proc``, a fixed 3 s."""
-    stat = Path(f"/proc/{pid}/stat")
-    if not stat.exists():
-        time.sleep(3.0)
-        return
-    last, end = None, time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        fields = stat.read_text().rsplit(")", 1)[1].split()
-        cpu = int(fields[11]) + int(fields[12])           # utime + stime, in clock ticks
-        if cpu == last:
-            return
-        last = cpu
-        time.sleep(settle_s)
-
-
-CRITICAL_ROWS = (("main", "this process's extra CPU with figures (sending, writing beside the helper)"),
-                 ("warm_up_s", "helper: matplotlib's import, warm-up and the figures' frames, beside the solve"),
-                 ("draw_s", "helper: drawing its own figures after the results arrived"),
-                 ("forks_draw_s", "the helper's forks: drawing the other figures at the same time, total"),
-                 ("longest_fork_draw_s", "the helper's forks: the longest one"),
+CRITICAL_ROWS = (("main", "the main process's extra CPU with figures (its own CPU, fresh `exucable run` with figures less without)"),
+                 ("faults", "  of it, its extra minor page faults (copies on write after the fork) [count]"),
+                 ("sent_bytes", "  the results sent to the helper, pickled [bytes]"),
+                 ("warm_up_s", "helper: matplotlib's import, warm-up and frames, beside the solve"),
+                 ("forks_warm_up_s", "drawing processes forked ahead: their frames, beside the solve (total)"),
+                 ("draw_s", "helper: drawing its own figure after the results arrived"),
+                 ("forks_draw_s", "its drawing processes: drawing the other figures at the same time, total"),
+                 ("longest_fork_draw_s", "its drawing processes: the longest one"),
+                 ("children", "all figure processes' CPU (helper and drawing processes)"),
                  ("estimate", "figures' wall cost on two free cores, estimated: extra CPU + max(longest drawing, all drawing / 2)"))
 
 
 def critical_paths(repeat: int, modes: list[str], before: str | None) -> None:
-    """:func:`critical_path` of each mode in a fresh child process (its helper imports matplotlib
-    afresh), for the tree ``before`` too, interleaved."""
+    """The figures' critical path from CPU times, per mode (and tree, with ``before``), from fresh
+    processes that run the command as ``exucable run`` does (:func:`fresh_run`), ``--no-plots`` and
+    with figures, interleaved ``repeat`` times after one warm-up round; medians. The main process's
+    extra CPU is the difference of the two medians of its own CPU time (its children's excluded)."""
     trees = {"before": before, "after": None} if before else {"": None}
+    cases = [(mode, label, plots) for mode in modes for label in trees for plots in (False, True)]
+    runs = {c: [] for c in cases}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(repeat + 1):
+            for mode, label, plots in cases:
+                done = subprocess.run([sys.executable, __file__, "--fresh-run", mode, f"{tmp}/{mode}{label}{plots}"]
+                                      + ([] if plots else ["--no-plots"]), capture_output=True, text=True,
+                                      env=_env(trees[label]))
+                if done.returncode != 0:
+                    raise RuntimeError(f"fresh run ({mode} {label}) failed:\n{done.stderr[-2000:]}")
+                if k:           # the first round warms the disk, numba's and matplotlib's caches
+                    runs[(mode, label, plots)].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    med = statistics.median
     got = {}
     for mode in modes:
-        for label, tree in trees.items():
-            done = subprocess.run([sys.executable, __file__, "--critical-path", mode, "--repeat", str(repeat)],
-                                  capture_output=True, text=True, env=_env(tree))
-            if done.returncode != 0:
-                raise RuntimeError(f"critical path ({mode} {label}) failed:\n{done.stderr[-2000:]}")
-            got[(mode, label)] = json.loads(done.stdout.strip().splitlines()[-1])
-    cols = list(got)
-    print(f"\n| figures' critical path (in-process runs, CPU [s], median of {repeat}) | "
-          + " | ".join(f"{m}{' ' + lab if lab else ''}" for m, lab in cols) + " |")
-    print("|---|" + "---|" * len(cols))
+        for label in trees:
+            none, fig = runs[(mode, label, False)], runs[(mode, label, True)]
+            h = [r["helper"] for r in fig]
+            row = {"main": med(r["self_cpu_s"] for r in fig) - med(r["self_cpu_s"] for r in none),
+                   "faults": med(r["minor_faults"] for r in fig) - med(r["minor_faults"] for r in none),
+                   "sent_bytes": med(r["sent_bytes"] for r in fig),
+                   "children": med(r["children_cpu_s"] for r in fig)}
+            for key in ("warm_up_s", "forks_warm_up_s", "draw_s", "forks_draw_s", "longest_fork_draw_s"):
+                row[key] = med(x.get(key, 0.0) for x in h)
+            row["estimate"] = max(row["main"], 0.0) + med(
+                max(max(x["draw_s"], x.get("longest_fork_draw_s", 0.0)), (x["draw_s"] + x.get("forks_draw_s", 0.0)) / 2)
+                for x in h)
+            got[(mode, label)] = row
+    print(f"\n| figures' critical path (fresh processes, CPU [s], median of {repeat}; load average "
+          f"{os.getloadavg()[0]:.1f}) | " + " | ".join(f"{m}{' ' + lab if lab else ''}" for m, lab in got) + " |")
+    print("|---|" + "---|" * len(got))
     for key, what in CRITICAL_ROWS:
-        print(f"| {what} | " + " | ".join(f"{got[c][key]:.3f}" for c in cols) + " |")
+        fmt = "{:.0f}" if key in ("faults", "sent_bytes") else "{:.3f}"
+        print(f"| {what} | " + " | ".join(fmt.format(got[c][key]) for c in got) + " |")
 
 
 def main(argv=None) -> int:
@@ -313,13 +318,14 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=5, help="interleaved rounds (default 5)")
     ap.add_argument("--steady", action="store_true", help="also in steady mode")
     ap.add_argument("--before", metavar="TREE", help="also with the exucable package of source tree TREE, interleaved")
-    ap.add_argument("--critical-path", metavar="MODE", help=argparse.SUPPRESS)   # a child of critical_paths
+    ap.add_argument("--fresh-run", nargs=2, metavar=("MODE", "OUT"), help=argparse.SUPPRESS)   # a child of critical_paths
+    ap.add_argument("--no-plots", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--quick", action="store_true", help="smoke run: one round, no breakdown")
     ap.add_argument("--no-whole", action="store_true", help="skip part 1 (the whole processes)")
     args = ap.parse_args(argv)
-    if args.critical_path:
-        print(json.dumps(critical_path(args.repeat, args.critical_path)))
-        return 0
+    if args.fresh_run:
+        print(json.dumps(fresh_run(*args.fresh_run, plots=not args.no_plots)), flush=True)
+        os._exit(0)             # as the command ends (exucable.cli.end_process)
     if args.quick:
         args.repeat = 1
     modes = ["dynamic", "steady"] if args.steady else ["dynamic"]

@@ -17,8 +17,14 @@ time of the whole process and of each stage with its share (on a shared, loaded 
 times are the ones to compare), the build's parts (the rope references, the start layout's fine grid
 and fit, its contact offsets, Exudyn's cable items, the contact coupling), the solve's CPU time per
 Newton iteration, peak memory (ru_maxrss) and the pulling force against the rope with clearance;
-the share of everything outside the two steady solves (CPU time); then the exponent p of a
-least-squares fit CPU time ∝ L^p (whole process, the solves, the rest), measured in this one run.
+the share of everything outside the two steady solves (CPU time: the import, the interpreter's
+start and exit, the scenario's parsing, the build, post-processing and writing), and beside it the
+share the long-routes issue names, "the build, the references (rope, rope with clearance) and
+post-processing": (build + post + write) / whole process, CPU time, where the build includes the
+rope references solved in it (any reference solved after the solves is in post), so nothing is
+counted twice, and the import, the parsing and the interpreter's start and exit are left out; then
+the exponent p of a least-squares fit CPU time ∝ L^p (whole process, the solves, the rest, the
+issue's part), measured in this one run, and a table of the stages per length.
 
 ``--profile`` runs the longest route once more under cProfile (in this process, after a short
 warm-up) and prints Exudyn's own timers of its static solver per Newton iteration (system
@@ -272,6 +278,14 @@ BUILD_PARTS = ("layout_s", "offsets_s", "items_s", "coupling_s")
 BUILD_PART_NAMES = ("start layout (lay_cable)", "its contact offsets", "Exudyn's cable items", "contact coupling")
 
 
+def issue_part_s(r: dict) -> float:
+    """The long-routes issue's part of a run [s CPU]: the build (the rope references solved in it
+    included) + post-processing + writing; the two solves, the import, the parsing and the
+    interpreter's start and exit left out."""
+    cpu = r["cpu_s"]
+    return cpu["build_s"] + cpu["post_s"] + cpu["write_s"]
+
+
 def report(r: dict) -> str:
     cpu, whole = r["cpu_s"], r["process_cpu_s"]
     stages = "  ".join(f"{k[:-2].replace('_', ' ')} {cpu[k]:6.2f} ({100 * cpu[k] / whole:3.0f} %)" for k in STAGES)
@@ -281,6 +295,7 @@ def report(r: dict) -> str:
     rest = whole - cpu["solve_s"] - cpu["error_bar_s"]
     return (f"{r['length_m'] / 1000:5.1f} km {r['status']:6s} whole process CPU {whole:6.2f} s (wall {r['process_s']:6.2f} s)  "
             f"outside the two solves {rest:6.2f} s = {100 * rest / whole:3.0f} %  "
+            f"build (references) + post + write {issue_part_s(r):6.2f} s = {100 * issue_part_s(r) / whole:3.0f} %  "
             f"elements {r['elements']:5d}  check points {r['check_points']:7d}  Newton {r['newton_iterations']:4d} "
             f"({r['steps']} pseudo-time steps, from the {r['started_from']}; error bar's coarse solve "
             f"{r['error_bar_newton_iterations']})  "
@@ -292,6 +307,30 @@ def report(r: dict) -> str:
             f"of which contact kernel (wall) {1e3 * r['kernel_s'] / n:6.1f} ms;  "
             f"F {'-' if F is None else f'{F:.1f}'} N, vs rope with clearance {vs}"
             + (f"\n{'':9s}{r['message']}" if r["message"] else ""))
+
+
+def stage_table(runs, before=None) -> str:
+    """Markdown table of the runs (one per length; ``before``: the ``--before`` tree's runs of the same
+    lengths, shown as before / after), CPU times [s]."""
+    lines = ["| route | whole process | the two solves | outside them (share) | the issue's part: build (rope "
+             "references) + post + write (share of the whole process) | build (rope references) | post | write |",
+             "|---|---|---|---|---|---|---|---|"]
+    pairs = zip(before, runs) if before else ((None, r) for r in runs)
+    for b, r in pairs:
+        def cell(f, digits=2):
+            return (f"{f(b):.{digits}f} / " if b is not None else "") + f"{f(r):.{digits}f}"
+
+        def share(f):
+            return (f"{100 * f(b) / b['process_cpu_s']:.0f} → " if b is not None else "") + \
+                   f"{100 * f(r) / r['process_cpu_s']:.0f} %"
+
+        solves = lambda x: x["cpu_s"]["solve_s"] + x["cpu_s"]["error_bar_s"]
+        outside = lambda x: x["process_cpu_s"] - solves(x)
+        lines.append(f"| {r['length_m'] / 1000:g} km | {cell(lambda x: x['process_cpu_s'])} | {cell(solves)} | "
+                     f"{cell(outside)} ({share(outside)}) | {cell(issue_part_s)} ({share(issue_part_s)}) | "
+                     f"{cell(lambda x: x['cpu_s']['build_s'])} ({cell(lambda x: x['cpu_s']['references_s'])}) | "
+                     f"{cell(lambda x: x['cpu_s']['post_s'])} | {cell(lambda x: x['cpu_s']['write_s'])} |")
+    return "\n".join(lines)
 
 
 def cold_table(pairs) -> str:
@@ -317,10 +356,12 @@ def compare(b: dict, a: dict) -> str:
     def parts(r):
         cpu, whole = r["cpu_s"], r["process_cpu_s"]
         solves = cpu["solve_s"] + cpu["error_bar_s"]
-        return ((whole, solves, whole - solves, cpu["build_s"], cpu["references_s"])
-                + tuple(cpu.get(k, 0.0) for k in BUILD_PARTS) + (cpu["post_s"] + cpu["write_s"],))
+        return ((whole, solves, whole - solves, issue_part_s(r), cpu["build_s"], cpu["references_s"])
+                + tuple(cpu.get(k, 0.0) for k in BUILD_PARTS) + (cpu["post_s"] + cpu["write_s"], cpu["post_s"],
+                                                                 cpu["write_s"]))
 
-    names = ("whole", "solves", "outside the solves", "build", "rope references") + BUILD_PART_NAMES + ("post + write",)
+    names = (("whole", "solves", "outside the solves", "build + post + write", "build", "rope references")
+             + BUILD_PART_NAMES + ("post + write", "post", "write"))
     ratios = "  ".join(f"{n} {x:.2f} -> {y:.2f} s ({y / x if x else float('nan'):.2f})"
                        for n, x, y in zip(names, parts(b), parts(a)))
 
@@ -599,7 +640,7 @@ def main() -> None:
             return
         end_process(0)
     lengths = [200.0, 400.0] if args.quick else sorted(args.lengths)
-    rows, pairs = [], []
+    rows, pairs, runs, befores = [], [], [], []
     for L in lengths:
         if args.compare_static_solver:
             b = in_child(L, figures=not args.no_figures, static_solver="exudyn")
@@ -625,22 +666,28 @@ def main() -> None:
             print(("after:  " if args.before else "") + report(r), flush=True)
             if args.before:
                 print(compare(b, r), flush=True)
+                befores.append(b)
+        runs.append(r)
         if args.compare_cold:
             c = in_child(L, figures=not args.no_figures, cold=True)
             print(report(c), flush=True)
             pairs.append((r, c))
         if r["status"] != "failed":
             solves = r["cpu_s"]["solve_s"] + r["cpu_s"]["error_bar_s"]
-            rows.append((L, r["process_cpu_s"], solves, r["process_cpu_s"] - solves, r["process_s"]))
+            rows.append((L, r["process_cpu_s"], solves, r["process_cpu_s"] - solves, r["process_s"], issue_part_s(r)))
     if len(rows) >= 2:
         import numpy as np
 
-        L, cpu, solve, rest, w = np.array(rows).T
+        L, cpu, solve, rest, w, issue = np.array(rows).T
         fit = lambda y: np.polyfit(np.log(L), np.log(y), 1)[0]
         print(f"CPU time: whole process ∝ L^{fit(cpu):.2f}, the two steady solves ∝ L^{fit(solve):.2f}, everything "
-              f"but the solves ∝ L^{fit(rest):.2f}; whole process wall ∝ L^{fit(w):.2f}; over "
-              f"{', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
-        print(f"share of everything but the solve at {L[-1]:g} m (CPU time): {100 * rest[-1] / cpu[-1]:.0f} %")
+              f"but the solves ∝ L^{fit(rest):.2f}, build (references) + post + write ∝ L^{fit(issue):.2f}; whole "
+              f"process wall ∝ L^{fit(w):.2f}; over {', '.join(f'{x:g}' for x in L)} m (least squares on log-log)")
+        print(f"share of everything but the solve at {L[-1]:g} m (CPU time): {100 * rest[-1] / cpu[-1]:.0f} %; "
+              f"the issue's share, (build with its references + post + write) / whole process: "
+              f"{100 * issue[-1] / cpu[-1]:.0f} %")
+    if runs:
+        print(stage_table(runs, befores if len(befores) == len(runs) else None))
     if pairs:
         print(cold_table(pairs))
     if args.clearance_spacing:

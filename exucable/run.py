@@ -21,7 +21,7 @@ from .output.outdir import owned_out_dir
 from .output.results import RunResult, write_results
 from .output.summary import RunSummary
 from .scenario.specs import Scenario, load_scenario
-from .post.pressure import bend_table, default_window_m, pressure_profile
+from .post.pressure import bend_table, default_window_m, pressure_profile, sorted_point_loads
 from .post.tension import SteadyState, detect_steady_state, profile_stations_m
 from .post.trust import AxisGauge, DYNAMIC_LIMIT, FRICTION_DEFICIT_LIMIT, PENETRATION_LIMIT, assess, not_steady_fix, pull_force_uncertainty
 
@@ -41,11 +41,12 @@ def check_point_loads(model) -> dict | None:
     s = np.asarray(pts.s_conduit_m, dtype=float)
     keep = np.isfinite(s) & (s >= 0.0) & (s <= L)
     s = conduit_s(model, s)   # along the scenario's own conduit, not the pull-oriented one
-    order = np.argsort(s[keep])
-    return {"s_conduit_m": s[keep][order],
-            "normal_force_N": np.asarray(pts.normal_force_N, dtype=float)[keep][order],
-            "normal_force_per_length_N_per_m": np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[keep][order],
-            "penetration_m": np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[keep][order], nan=0.0), 0.0)}
+    kept = np.flatnonzero(keep)
+    rows = kept[np.argsort(s[kept])]   # the kept points in order of s: one gather per column
+    return {"s_conduit_m": s[rows],
+            "normal_force_N": np.asarray(pts.normal_force_N, dtype=float)[rows],
+            "normal_force_per_length_N_per_m": np.asarray(pts.normal_force_per_length_N_per_m, dtype=float)[rows],
+            "penetration_m": np.maximum(np.nan_to_num(np.asarray(pts.penetration_m, dtype=float)[rows], nan=0.0), 0.0)}
 
 
 def contact_profile(points: dict | None, max_rows: int = 5000) -> tuple[dict | None, float]:
@@ -80,32 +81,47 @@ def axis_gauge(model) -> AxisGauge:
     return AxisGauge(model.conduit.centreline, model.conduit.inner_radius_m)
 
 
-def cable_tension_along_conduit(model, gauge: AxisGauge | None = None) -> tuple[np.ndarray, np.ndarray]:
+def cable_tension_along_conduit(model, gauge: AxisGauge | None = None,
+                                profile_tension_N=None) -> tuple[np.ndarray, np.ndarray]:
     """The cable's tension at its nodes [N] (from its loads' equilibrium, :meth:`Model.tension_N`) and
-    their places along the scenario's conduit [m]; ``gauge``: :func:`axis_gauge` of the model, if made."""
+    their places along the scenario's conduit [m]; ``gauge``: :func:`axis_gauge` of the model, if made;
+    ``profile_tension_N``: the tension now at :func:`exucable.post.tension.profile_stations_m`'s
+    stations (k per element from each node, and the leading end), if known: every k-th value is a
+    node's (the same stations, the same numbers)."""
     q, _ = model.coordinates()
     Le = model.layout.element_length_m
-    x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
-    T = model.tension_N(x_nodes)
+    if profile_tension_N is not None:
+        T = np.asarray(profile_tension_N, dtype=float)
+        per_element, rest = divmod(len(T) - 1, len(Le))
+        if rest or not per_element:
+            raise ValueError(f"profile_tension_N: {len(T)} values are not k stations on each of {len(Le)} "
+                             "elements and the leading end (exucable.post.tension.profile_stations_m)")
+        T = T[::per_element]
+    else:
+        T = model.tension_N(np.concatenate([[0.0], np.cumsum(Le)]))
     _, s = (axis_gauge(model) if gauge is None else gauge)(q[:, :3])
     return conduit_s(model, s), T
 
 
-def _pressure(model, points, rope, gauge: AxisGauge | None = None) -> tuple[dict, list, dict | None]:
-    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.post.pressure)."""
+def _pressure(model, points, rope, gauge: AxisGauge | None = None,
+              profile_tension_N=None) -> tuple[dict, list, dict | None]:
+    """Windowed pressure summary, per-bend rows and the pressure profile (see exucable.post.pressure);
+    ``profile_tension_N``: as :func:`cable_tension_along_conduit` takes it."""
     if points is None or rope is None:
         return {}, [], None
     centre = model.scenario.build_conduit().centreline
     w = default_window_m(centre)
     rope_p = rope.sidewall_pressure_N_per_m
     rope_s = conduit_s(model, rope.s_conduit_m)     # the rope is solved on the pull-oriented conduit
-    prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m)
-    s_c, T_c = cable_tension_along_conduit(model, gauge)
+    summed = sorted_point_loads(points["s_conduit_m"], points["normal_force_N"])   # for both tables
+    prof = pressure_profile(points["s_conduit_m"], points["normal_force_N"], rope_s, rope_p, w, centre.length_m,
+                            sorted_loads=summed)
+    s_c, T_c = cable_tension_along_conduit(model, gauge, profile_tension_N)
     lam = model.mesh.bending_length_m if model.mesh is not None else 0.0
     bends = bend_table(centre.pieces, points["s_conduit_m"], points["normal_force_N"], s_c, T_c, rope_s,
                        rope.tension_N, rope_p, w, lam, model.scenario.pull.direction,
                        bending_stiffness_N_m2=model.scenario.cable.bending_stiffness_N_m2,
-                       element_length_m=float(np.max(model.layout.element_length_m)))
+                       element_length_m=float(np.max(model.layout.element_length_m)), sorted_loads=summed)
     i = int(np.argmax(prof["windowed_pressure_N_per_m"]))
     info = {"pressure_window_m": w,
             "pressure_window_rule": "half the tightest bend radius (a twentieth of the route without bends)",
@@ -350,7 +366,7 @@ def _solve(sc: Scenario, quiet: bool, steady_stop, refine: float, check_points_p
     # one gauge of the conduit's axis for the pressure table and the final contact check (built
     # from up to 200 000 centreline samples)
     gauge = axis_gauge(model) if model.kernel is not None else None
-    pressure_info, bends, pressure_prof = _pressure(model, points, rope, gauge)
+    pressure_info, bends, pressure_prof = _pressure(model, points, rope, gauge, profile_tension_N=N)
     has_history = bool(len(h["time_s"]))
     pull_force_N = float(np.mean(h["pull_force_N"][i0:])) if has_history else None
     warnings = list(model.mesh.warnings) if model.mesh is not None else []

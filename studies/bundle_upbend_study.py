@@ -1,4 +1,5 @@
-"""Three cables through an up-bend: where the bundle's steady solve stalls, and why.
+"""Three cables through an up-bend: where the bundle's steady solve stalled, and why (it now relaxes the
+bundle dynamically first where its one-iteration steps fail, exucable/solve/relax.py, and solves them).
 
 The smallest case of the 100 m bundle route's failure: a 30° up-bend of 5 m radius between two 3 m
 straights, three cables of 30 mm (1.41 kg/m, EJ 7.95 N m²) in a 100 mm duct (D/d 3.33), wall

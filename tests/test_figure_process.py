@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -58,6 +59,95 @@ def test_the_helpers_figures_are_those_drawn_here(tmp_path):
         assert (tmp_path / "helper" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
     assert not figures.helper_running and figures.helper_reason == ""
     assert {"warm_up_s", "draw_s"} <= set(figures.helper_cpu_s) and all(v > 0 for v in figures.helper_cpu_s.values())
+
+
+def _children(pid: int) -> list[int]:
+    """The ids of process ``pid``'s children (Linux's /proc; empty where there is none)."""
+    try:
+        return [int(c) for c in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
+    except OSError:
+        return []
+
+
+def _ended(pid: int) -> bool:
+    """Whether process ``pid`` has ended (gone, or a zombie not yet reaped)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except OSError:
+        return True
+
+
+def _wait_for(condition, timeout_s: float = 60.0) -> bool:
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if condition():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+needs_proc_children = pytest.mark.skipif(not Path(f"/proc/{os.getpid()}/task/{os.getpid()}/children").exists(),
+                                         reason="reads a process's children from Linux's /proc")
+
+
+def _drawing_processes_forked(figures) -> tuple[int, list[int]]:
+    """The helper's id and, once it has forked them after its warm-up, its two drawing processes'."""
+    if len(os.sched_getaffinity(0)) < 2:
+        pytest.skip("one core: the helper forks no drawing process")
+    helper = figures._proc.pid
+    assert _wait_for(lambda: len(_children(helper)) == 2), "no drawing processes forked"
+    return helper, _children(helper)
+
+
+@needs_fork
+@needs_proc_children
+def test_drawing_processes_forked_ahead_draw_the_same_files(tmp_path):
+    """A helper given the results after its warm-up has forked a drawing process for each figure but
+    its own, each with its frame built; they draw byte for byte what one process draws, report their
+    frames' CPU beside the solve, and every process of the figures has ended when the run goes on."""
+    from exucable.output import figure_process as fp
+
+    with Figures(helper=True) as figures:
+        helper, drawers = _drawing_processes_forked(figures)
+        helper_paths = write_results(tmp_path / "helper", _result(), plots=figures)
+    here = fp.draw_figures(tmp_path / "here", _result())
+    assert [p.name for p in helper_paths if p.suffix == ".png"] == [p.name for p in here]
+    for p in here:
+        assert (tmp_path / "helper" / p.name).read_bytes() == p.read_bytes(), p.name
+    assert figures.helper_cpu_s["forks_warm_up_s"] > 0 and figures.helper_cpu_s["longest_fork_draw_s"] > 0
+    assert all(_ended(pid) for pid in [helper] + drawers)
+
+
+@needs_fork
+@needs_proc_children
+def test_the_drawing_processes_of_a_helper_given_nothing_end_with_it():
+    """A failed run kills its helper without results: the drawing processes it forked ahead, waiting
+    for the results, end too."""
+    with Figures(helper=True) as figures:
+        _, drawers = _drawing_processes_forked(figures)
+    assert _wait_for(lambda: all(_ended(pid) for pid in drawers), 10.0)
+
+
+@needs_fork
+@needs_proc_children
+def test_the_helper_of_a_run_that_died_ends_by_itself(tmp_path):
+    """The run killed before it sent its results: the helper (which held the run's end of their
+    pipe too, and so waited for ever) ends."""
+    script = textwrap.dedent("""
+        import os, signal, time
+        from exucable.output.figure_process import Figures
+        figures = Figures(helper=True)
+        print(figures._proc.pid, flush=True)
+        time.sleep(0.2)
+        os.kill(os.getpid(), signal.SIGKILL)
+    """)
+    with open(tmp_path / "out", "w") as out:         # a file: a helper left behind holds no pipe open
+        subprocess.run([sys.executable, "-c", script], stdout=out, timeout=120, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    helper = int((tmp_path / "out").read_text().split()[0])
+    ended = _wait_for(lambda: _ended(helper))
+    if not ended:
+        os.kill(helper, 9)                          # not left behind by a failing test
+    assert ended, "the helper outlived its run"
 
 
 @needs_fork

@@ -84,7 +84,7 @@ def test_point_loads_look_only_near_their_bend_end(spread_points, weight_N, monk
     w = default_window_m(cl)
     args = (cl.pieces, s, F, s, T, s_rope, T_rope, p_rope, w, 0.012)
     near = bend_table(*args, element_length_m=0.003)
-    monkeypatch.setattr(pressure, "_near_end", lambda s, F, s_end_m, reach_m: (s, F))
+    monkeypatch.setattr(pressure, "_near_end", lambda s, F, s_end_m, reach_m, s_sorted=False: (s, F))
     whole = bend_table(*args, element_length_m=0.003)
     assert near == whole
     assert near[0]["entry_point_load_N"] != 0.0 and near[0]["exit_point_load_N"] != 0.0

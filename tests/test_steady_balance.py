@@ -10,6 +10,8 @@ whose loads do not balance.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -66,7 +68,7 @@ def test_unbalanced_loads_are_named():
 
 def test_a_frictionless_pull_needs_only_its_back_tension():
     loads, nodes = _straight()
-    loads = CableLoads(**{**loads.__dict__, "point_force_N": np.tile([0.0, 0.0, W_PER_M * L / 100], (100, 1)),
-                          "leading_force_N": np.array([T_B, 0.0, 0.0])})
+    loads = dataclasses.replace(loads, point_force_N=np.tile([0.0, 0.0, W_PER_M * L / 100], (100, 1)),
+                                leading_force_N=np.array([T_B, 0.0, 0.0]))
     check = steady_balance(loads, nodes, L, 0.0)
     assert check.ok, check.message

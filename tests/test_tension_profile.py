@@ -6,6 +6,7 @@ both bend ends) and the paper's Example 2 (fast variant). EA·ε of the same sta
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -134,8 +135,8 @@ def test_equilibrium_of_a_hanging_chain_closed_form():
     np.testing.assert_allclose(equilibrium_tension(q, Le, loads, x), mu * g * x, atol=1e-12)
     acc = np.zeros((n_el + 1, 6))
     acc[:, 2] = a
-    moving = CableLoads(**{**loads.__dict__, "acceleration": acc, "leading_force_N": mu * (g + a) * L * np.array([0, 0, 1.0]),
-                           "trailing_force_N": None})
+    moving = dataclasses.replace(loads, acceleration=acc, leading_force_N=mu * (g + a) * L * np.array([0, 0, 1.0]),
+                                 trailing_force_N=None)
     np.testing.assert_allclose(equilibrium_tension(q, Le, moving, x), mu * (g + a) * x, atol=1e-12)
     # the integrated shape functions: ∫₀^L r dx of a straight element is L·(r_i + r_j)/2
     w = hermite_integral_weights(np.ones(1), np.array([2.0]))[0]

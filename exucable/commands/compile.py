@@ -34,8 +34,8 @@ def announce_compiling(stream=None) -> None:
 
 
 def _warm_up() -> None:
-    """Run the coarse Example 2 over a few steps in dynamic mode and once in steady mode: every kernel
-    a run calls is compiled and cached."""
+    """Run the coarse Example 2 over a few steps in dynamic mode and once in steady mode, and format a
+    row of numbers: every kernel a run calls is compiled and cached."""
     from ..data import data_path
     from ..run import run_scenario
     from ..scenario.specs import load_scenario
@@ -46,6 +46,11 @@ def _warm_up() -> None:
     # the cable-cable kernel runs only with several cables: without this a first bundle run compiles
     # it inside its own time budget
     run_scenario(_tiny_bundle(), plots=False)
+    # the result files' number formatter (runs without out_dir write nothing)
+    import numpy as np
+
+    from ..output.numbers_text import rows_text
+    rows_text([np.zeros(1), np.arange(1)])
 
 
 def _tiny_bundle():

@@ -2,7 +2,9 @@
 
 The kernels (:mod:`.fast`, the broad phase :mod:`.broadphase`, the steady-mode kernel :mod:`.steady`,
 the parts those two share, :mod:`.kernel_parts`, the trust gauge's nearest-sample search
-:mod:`.nearest`, the compiled ANCF cable element :mod:`.ancf_cable`) are decorated with :func:`njit` from here, not numba's: it records the function
+:mod:`.nearest`, the compiled ANCF cable element :mod:`.ancf_cable`; outside this package the result
+files' number formatter :mod:`exucable.output.numbers_text`, which :func:`load_cached_kernels` leaves
+to its first call) are decorated with :func:`njit` from here, not numba's: it records the function
 and its numba options and imports nothing until the first call (``import exucable`` stays light).
 A call goes to numba's JIT dispatcher, created on first use with ``cache=True``: the first call in a
 fresh environment compiles (tens of seconds for :mod:`.fast`; ``exucable compile`` does it up front,

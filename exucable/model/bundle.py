@@ -435,6 +435,7 @@ class BundleModel:
     trail_drive: Drive | None = None
     applied_pull_force_N: float | None = None
     _ode2_index: np.ndarray | None = field(default=None)
+    _loads: list | None = field(default=None)
 
     def __repr__(self) -> str:
         return (f"BundleModel({self.scenario.name!r}: {len(self.cables)} cables {self.arrangement}, "
@@ -529,6 +530,78 @@ class BundleModel:
         x = np.concatenate([[0.0], np.cumsum(Le)])
         tmax = max(float(np.max(tension_at(q, Le, self.axial_stiffness_N, x))) for q in self.cable_coordinates())
         return float(np.sum(self.pull_shares_N())), self.back_tension_N * self.load_scale.end_force, tmax
+
+    # ---- the steady equilibrium's residual and stiffness on the cables' coordinates, outside Exudyn
+    # (the dynamic relaxation's, exucable.solve.relax): the same forces the static solve balances
+
+    def held_coordinates(self) -> np.ndarray:
+        """Indices, among the cables' coordinates (:attr:`ode2_index`'s order), of the coordinates the
+        eye holds: each leading node's position."""
+        n1 = 6 * (self.cables[0].n_elements + 1)
+        return (n1 * np.arange(self.n_cables)[:, None] + (n1 - 6) + np.arange(3)[None, :]).reshape(-1)
+
+    def steady_force(self, q) -> np.ndarray:
+        """The resultant generalized force [N, N·m] on the cables' displacement coordinates ``q``
+        (:attr:`ode2_index`'s order) of the steady model at its current load scale: wall contact with
+        the steady sliding friction, the cables' elastic forces and weight, the contact between the
+        cables and the end loads; the eye's reactions left out (its rows are not balanced). Equal to
+        the static solver's residual on the free coordinates, bit for bit (``tests/test_relax.py``).
+        Needs the compiled cable element (``solver.cable_element = "compiled"``)."""
+        q = np.asarray(q, dtype=float)
+        self._need_compiled()
+        n1 = self.walls[0].n_coordinates
+        f = np.empty(q.size)
+        for i, coupling in enumerate(self.wall_couplings):
+            f[i * n1:(i + 1) * n1] = coupling.force(q[i * n1:(i + 1) * n1], 1.0, jacobian=False)
+        f += self.between.evaluate(self.between_coupling.q_ref + q, jacobian=False).generalized_force
+        for i, rows in self._load_rows():
+            f[rows] += np.asarray(self.mbs.GetLoadParameter(i, "loadVector"), dtype=float)
+        return f
+
+    def stiffness_blocks3(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The stiffness K = −∂f/∂q of :meth:`steady_force` at ``q`` as 3 × 3 blocks (a node's
+        positions, a node's slopes): row and column block indices (coordinate // 3) and the blocks,
+        shape (m, 3, 3); a pair may repeat (the walls' element blocks, the pairs' node blocks), K is their sum."""
+        q = np.asarray(q, dtype=float)
+        self._need_compiled()
+        n1 = self.walls[0].n_coordinates
+        n_el = self.cables[0].n_elements
+        a = np.arange(4)
+        rows, cols, blocks = [], [], []
+        for i, coupling in enumerate(self.wall_couplings):
+            B = coupling.stiffness_blocks(q[i * n1:(i + 1) * n1], 1.0)          # (n_el, 12, 12)
+            first = i * n1 // 3 + 2 * np.arange(n_el)
+            rows.append(np.repeat(first[:, None] + a[None, :], 4, axis=1).reshape(-1))
+            cols.append(np.tile(first[:, None] + a[None, :], (1, 4)).reshape(-1))
+            blocks.append(B.reshape(n_el, 4, 3, 4, 3).transpose(0, 1, 3, 2, 4).reshape(-1, 3, 3))
+        J = self.between.evaluate(self.between_coupling.q_ref + q, jacobian=True).jacobian.tobsr(blocksize=(3, 3))
+        rows.append(np.repeat(np.arange(J.shape[0] // 3), np.diff(J.indptr)))
+        cols.append(J.indices)
+        blocks.append(-J.data)
+        return np.concatenate(rows), np.concatenate(cols), np.concatenate(blocks)
+
+    @property
+    def steady_force_supported(self) -> bool:
+        """Whether :meth:`steady_force` can assemble the residual: the cables' elastic forces are the
+        compiled element's (``solver.cable_element = "compiled"``), not Exudyn's objects."""
+        return self.wall_couplings[0].cable_forces is not None
+
+    def _need_compiled(self) -> None:
+        if not self.steady_force_supported:
+            raise ModelError("solver.cable_element", 'the bundle\'s residual outside Exudyn needs the compiled '
+                             'cable element; set solver.cable_element = "compiled"')
+
+    def _load_rows(self) -> list:
+        """(Exudyn load index, its node's three rows among the cables' coordinates) of every load: the
+        end loads, point forces on node positions (their vectors are read at each call: the load scale)."""
+        if self._loads is None:
+            where = np.full(len(self.mbs.systemData.GetODE2Coordinates()), -1, dtype=np.int64)
+            where[self.ode2_index] = np.arange(self.ode2_index.size)
+            self._loads = []
+            for i in range(self.mbs.systemData.NumberOfLoads()):
+                node = self.mbs.GetMarker(self.mbs.GetLoad(i)["markerNumber"])["nodeNumber"]
+                self._loads.append((i, where[self.mbs.GetNodeODE2Index(node) + np.arange(3)]))
+        return self._loads
 
 
 def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearance") -> BundleModel:

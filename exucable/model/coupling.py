@@ -217,12 +217,15 @@ class ContactCoupling:
         (node-major; each row's columns sorted): the order of :meth:`stiffness_values`."""
         return self._csr
 
-    def force(self, q, t: float = 0.0) -> np.ndarray:
+    def force(self, q, t: float = 0.0, jacobian: bool | None = None) -> np.ndarray:
         """The generalized force [N, N·m] on the cable's displacement coordinates ``q`` at rest
         (q̇ = 0): contact, and the cable's elastic forces and weight when assembled here; the same
-        vector the force user function hands Exudyn (a static solve's right-hand side)."""
+        vector the force user function hands Exudyn (a static solve's right-hand side).
+        ``jacobian``: compute the Jacobian blocks in the same pass (None: as
+        :attr:`jacobian_with_force`; False for a caller that needs the force alone, such as the
+        dynamic relaxation, :mod:`exucable.solve.relax`)."""
         q = np.asarray(q, dtype=float)
-        return self._force(None, t, 0, q, np.zeros_like(q))
+        return self._total(t, q, np.zeros_like(q), self.jacobian_with_force if jacobian is None else jacobian)
 
     def stiffness_values(self, q, t: float = 0.0) -> np.ndarray:
         """The left-hand-side derivative ``-∂Q/∂q`` at ``q`` (at rest), as the values of
@@ -247,9 +250,13 @@ class ContactCoupling:
         return -res.jac_q_blocks if elastic is None else elastic[1] - res.jac_q_blocks
 
     def _force(self, mbs, t, item, q, q_t):
+        return self._total(t, q, q_t, self.jacobian_with_force)
+
+    def _total(self, t, q, q_t, jacobian: bool) -> np.ndarray:
+        """The force user function's vector at displacement coordinates q and rates q_t."""
         t0 = time.perf_counter()
         qa, va = self.absolute(q, q_t)
-        res = self._evaluate(t, qa, va, jacobian=self.jacobian_with_force)
+        res = self._evaluate(t, qa, va, jacobian=jacobian)
         self.force_calls += 1
         elastic = self._elastic()
         out = res.generalized_force

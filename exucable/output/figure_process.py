@@ -4,13 +4,17 @@ Importing matplotlib costs about as much CPU as drawing a run's three figures (`
 figure_cost.py``); in a fresh process both came after the solve and nearly doubled a short run. The
 helper is forked when the run starts (``exucable run`` forks it first thing, before anything loads
 Exudyn or numba), imports matplotlib and loads its fonts while this process imports, builds and solves
-the model, then builds each figure's frame (its figure, axes and ticks: what does not depend on the
-results, about a fifth of a figure's drawing, :func:`build_frames`) and waits. Once the results are
-post-processed they are sent to it through a pipe; it draws and writes the figures (atomically,
-:func:`exucable.io.save_figure`), each in a process of its own at once (:func:`draw_in_parallel`),
-while this process writes the data files and ``summary.json``; :meth:`Figures.write` returns once every
-figure is on disk. A helper given nothing to draw (bad input, an error) is killed at once;
-:class:`Figures` is a context manager, so an error or Ctrl-C stops it.
+the model, then forks a drawing process for each figure but its own (:data:`HELPER_DRAWS`); each of
+them builds its figure's frame (its figure, axes and ticks: what does not depend on the results,
+about a fifth of a figure's drawing, :func:`build_frames`) and waits. Once the results are
+post-processed they are sent to the helper through a pipe, and by it to the drawing processes; each
+draws and writes its figure (atomically, :func:`exucable.io.save_figure`) at once
+(:func:`draw_in_parallel`), while this process writes the data files and ``summary.json``;
+:meth:`Figures.write` returns once every figure is on disk. Forked before the results arrive, the
+drawing processes' fork and their first writes to the pages they share with the helper (copied on
+write) are paid beside the solve, not after it. A helper given nothing to draw (bad input, an
+error) is killed at once, and its drawing processes end with it; :class:`Figures` is a context
+manager, so an error or Ctrl-C stops it, and a helper whose run died (killed) ends on its own.
 
 Deterministic: the helper is a fork of this process (the same matplotlib settings) and draws with the
 same functions, so its files are byte for byte those drawn here (a figure drawn on a frame built ahead
@@ -31,6 +35,7 @@ import gc
 import multiprocessing
 import os
 import pickle
+import select
 import sys
 import threading
 import time
@@ -81,42 +86,67 @@ def _warm_up() -> None:
     fig.savefig(io.BytesIO(), format="png", dpi=40)
 
 
-def build_frames(ticks: int = FRAME_TICKS, until=None) -> dict:
+def build_frames(ticks: int = FRAME_TICKS, until=None, names=None) -> dict:
     """Each figure's frame (:data:`exucable.plots.results.FRAMES`: figure, axes, ``ticks`` major
     ticks on each axis), built before the results exist; each is drawn on once. ``until``: a
     callable checked before each frame; once it is true no more are built (the results arrived: a
-    figure without a frame is drawn on a new one, the same file, rather than wait)."""
+    figure without a frame is drawn on a new one, the same file, rather than wait). ``names``: only
+    these figures' frames (default: all)."""
     frames = {}
     for name, frame in FRAMES.items():
+        if names is not None and name not in names:
+            continue
         if until is not None and until():
             break
         frames[name] = frame(ticks)
     return frames
 
 
-def _serve(conn) -> None:
-    """The helper: warm up, wait for ``(out_dir, result)`` (or None: nothing to draw), draw, reply
-    ``("ok", paths, cpu)`` (``cpu``: :attr:`Figures.helper_cpu_s`), ``("oserror", errno, strerror,
-    filename)`` or ``("failed", reason)``."""
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def _serve(conn, main_end=None) -> None:
+    """The helper: warm up, fork the drawing processes (:class:`_Drawer`), build its own figure's
+    frame, wait for ``(out_dir, result)`` (or None: nothing to draw), draw, reply ``("ok", paths,
+    cpu)`` (``cpu``: :attr:`Figures.helper_cpu_s`), ``("oserror", errno, strerror, filename)`` or
+    ``("failed", reason)``. ``main_end``: the run's end of the pipe, closed here at once (a fork
+    holds it too): otherwise the helper of a run that died would wait for it for ever."""
+    if main_end is not None:
+        main_end.close()
+    drawers = {}
     try:
-        _warm_up()
-        frames = build_frames(until=conn.poll)
+        # matplotlib's import makes some 10^5 objects, freeing next to none: the collector's passes
+        # over them and over the run's objects (whose pages each pass copies here) are a tenth of
+        # the warm-up's CPU (benchmarks/figure_cost.py)
+        gc.disable()
+        try:
+            _warm_up()
+        finally:
+            gc.enable()
         # matplotlib's objects, loaded now, stay: the collector need not walk them again while the
-        # figures are drawn, nor write to their pages in the drawing forks (each write copies a page)
+        # figures are drawn, nor write to their pages in the drawing processes (each write copies a page)
         gc.freeze()
+        if _cores() > 1 and not conn.poll():
+            drawers = _start_drawers([name for name in FRAMES if name != HELPER_DRAWS], [conn.fileno()])
+        frames = build_frames(until=conn.poll, names=[HELPER_DRAWS] if drawers else None)
         cpu = {"warm_up_s": time.process_time()}        # a fork's CPU time starts at zero
-        msg = conn.recv()
+        message = conn.recv_bytes()
+        msg = pickle.loads(message)
         if msg is None:
             return
         out, result = msg
         c0 = time.process_time()
-        paths = draw_in_parallel(Path(out), result, cpu, frames)
+        paths = draw_in_parallel(Path(out), result, cpu, frames, drawers, message)
         cpu["draw_s"] = time.process_time() - c0
         reply = ("ok", [str(p) for p in paths], cpu)
     except EOFError:
         return                                  # the run is gone or ended without figures
     except BaseException as exc:  # reported, and the run draws the figures itself
         reply = _outcome(exc)
+    finally:
+        for drawer in drawers.values():         # those not given the results: told to end, reaped
+            drawer.stop()
     try:
         conn.send(reply)
     except OSError:
@@ -176,13 +206,45 @@ def _raise(reply: tuple) -> None:
     raise RuntimeError(reply[1])
 
 
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:                                     # a pipe, not a file: written in pieces
+        view = view[os.write(fd, view):]
+
+
+def _read_all(fd: int) -> bytes:
+    """Everything written into the pipe ``fd`` until its writers closed it (b"" if none was)."""
+    with os.fdopen(fd, "rb") as f:
+        return f.read()
+
+
+def _draw_and_report(write_end: int, out: Path, result, name: str, frames: dict | None) -> None:
+    """In a drawing process: draw figure ``name``, write ``("ok", the drawing's CPU time [s], the
+    CPU time before it [s])`` or the exception's :func:`_outcome` into the pipe ``write_end`` and
+    close it."""
+    c0 = time.process_time()
+    try:
+        draw_figures(out, result, [name], frames)
+        reply = ("ok", time.process_time() - c0, c0)
+    except BaseException as exc:  # reported; the forking process draws what is missing
+        reply = _outcome(exc)
+    _write_all(write_end, pickle.dumps(reply))
+    os.close(write_end)
+
+
+def _fork() -> int | None:
+    try:
+        return os.fork()
+    except OSError:                                 # no process to spare: not a file's error, draw here
+        return None
+
+
 def _drawn_in_a_fork(out: Path, result, name: str, frames: dict | None) -> tuple[int, int] | None:
     """Fork a process that draws figure ``name`` and reports through a pipe; returns (pid, the
     pipe's read end), or None if no process could be forked."""
     read_end, write_end = os.pipe()
-    try:
-        pid = os.fork()
-    except OSError:                                 # no process to spare: not a file's error, draw here
+    pid = _fork()
+    if pid is None:
         os.close(read_end)
         os.close(write_end)
         return None
@@ -190,15 +252,7 @@ def _drawn_in_a_fork(out: Path, result, name: str, frames: dict | None) -> tuple
         code = 1
         try:
             os.close(read_end)
-            try:
-                draw_figures(out, result, [name], frames)
-                reply = ("ok", time.process_time())
-            except BaseException as exc:  # reported; the forking process draws what is missing
-                reply = _outcome(exc)
-            data = memoryview(pickle.dumps(reply))
-            while data:                             # a pipe, not a file: a short reply, written whole
-                data = data[os.write(write_end, data):]
-            os.close(write_end)
+            _draw_and_report(write_end, out, result, name, frames)
             code = 0
         finally:
             os._exit(code)                          # no cleanup of the parent's state in the fork
@@ -206,45 +260,138 @@ def _drawn_in_a_fork(out: Path, result, name: str, frames: dict | None) -> tuple
     return pid, read_end
 
 
-def draw_in_parallel(out: Path, result, cpu: dict | None = None, frames: dict | None = None) -> list[Path]:
+class _Drawer:
+    """A process forked by the helper before the results exist, to draw one figure: it builds that
+    figure's frame, then waits for the pickled ``(out_dir, result)`` on a pipe (:meth:`start`) and
+    draws and reports as :func:`_drawn_in_a_fork`'s processes do; the pipe closed with nothing
+    written (:meth:`stop`), it ends. ``inherited``: the forking process's descriptors it must not
+    hold (the helper's pipe to the run, the other drawers' pipes: a pipe held open by a process
+    that does not use it never reports its end)."""
+
+    def __init__(self, name: str, inherited: list[int]):
+        self.name = name
+        self.pid = None
+        results_r, self._results_w = os.pipe()
+        self._reply_r, reply_w = os.pipe()
+        pid = _fork()
+        if pid == 0:
+            code = 1
+            try:
+                for fd in (*inherited, self._results_w, self._reply_r):
+                    os.close(fd)
+                arrived = lambda: bool(select.select([results_r], [], [], 0)[0])  # noqa: E731
+                frames = build_frames(until=arrived, names=[name])
+                message = _read_all(results_r)
+                if message:
+                    out, result = pickle.loads(message)
+                    _draw_and_report(reply_w, Path(out), result, name, frames)
+                else:
+                    os.close(reply_w)
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(results_r)
+        os.close(reply_w)
+        if pid is None:
+            os.close(self._results_w)
+            os.close(self._reply_r)
+        self.pid = pid
+
+    def fds(self) -> list[int]:
+        """The helper's ends of this drawer's pipes."""
+        return [self._results_w, self._reply_r] if self.pid else []
+
+    def start(self, message: bytes) -> tuple[int, int] | None:
+        """Send the pickled ``(out_dir, result)``; returns (pid, the reply pipe's read end), as
+        :func:`_drawn_in_a_fork`, or None if the drawer is gone (its figure is drawn elsewhere)."""
+        try:
+            _write_all(self._results_w, message)
+        except OSError:                             # it died (a broken pipe): reaped, and drawn elsewhere
+            self.stop()
+            return None
+        os.close(self._results_w)
+        (pid, self.pid), reply_r = (self.pid, None), self._reply_r
+        self._results_w = self._reply_r = -1        # the caller's now
+        return pid, reply_r
+
+    def release(self) -> None:
+        """Tell a drawer not given the results to end (its pipes closed); :meth:`stop` reaps it."""
+        for fd in (self._results_w, self._reply_r):
+            try:
+                os.close(fd)
+            except OSError:                         # closed already
+                pass
+        self._results_w = self._reply_r = -1
+
+    def stop(self) -> None:
+        """End a drawer that was not given the results and reap it."""
+        if not self.pid:
+            return
+        self.release()
+        os.waitpid(self.pid, 0)
+        self.pid = None
+
+
+def _start_drawers(names, inherited: list[int]) -> dict:
+    """A :class:`_Drawer` for each of ``names`` that could be forked, by name."""
+    drawers = {}
+    for name in names:
+        drawer = _Drawer(name, inherited + [fd for d in drawers.values() for fd in d.fds()])
+        if drawer.pid:
+            drawers[name] = drawer
+    return drawers
+
+
+def draw_in_parallel(out: Path, result, cpu: dict | None = None, frames: dict | None = None,
+                     drawers: dict | None = None, message: bytes | None = None) -> list[Path]:
     """Draw the figures in processes of their own at once: each in a fork of this process but
     :data:`HELPER_DRAWS` (or, without it, the last), which is drawn here meanwhile; returns their
     paths in :func:`figure_names`' order. Drawing is CPU-bound and single-threaded, so on n free
     cores the figures take about the longer of the costliest figure and the total over n (on two
     cores, one fork drawing two figures took the time of both). The forks report through pipes;
     whatever a fork did not draw (it failed or died) is drawn here, and an :class:`OSError` of its
-    write is raised here. ``cpu``: a dict given the forks' CPU times [s], ``forks_draw_s`` (total)
-    and ``longest_fork_draw_s``. ``frames``: as :func:`draw_figures`'; a fork draws on its copy of
-    its figure's frame, and a figure drawn again here (its fork failed) on a new figure."""
+    write is raised here. ``cpu``: a dict given the forks' CPU times [s], ``forks_draw_s`` (total),
+    ``longest_fork_draw_s`` and, of drawers forked ahead, ``forks_warm_up_s`` (their frames, before
+    the results). ``frames``: as :func:`draw_figures`'; a fork draws on its copy of its figure's
+    frame, and a figure drawn again here (its fork failed) on a new figure. ``drawers``: processes
+    forked ahead (:class:`_Drawer`) by figure name, each given ``message`` (the pickled ``(str(out),
+    result)``; pickled here if None) instead of a new fork; those used are taken out of the dict."""
     names = figure_names(result)
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    if len(names) < 2 or cores < 2:
+    if len(names) < 2 or _cores() < 2:
         return draw_figures(out, result, frames=frames)
     mine = HELPER_DRAWS if HELPER_DRAWS in names else names[-1]
     forks = {}
     for name in names:
-        if name != mine:
+        if name == mine:
+            continue
+        if drawers and name in drawers:
+            if message is None:
+                message = pickle.dumps((str(out), result))
+            forked = drawers.pop(name).start(message)
+        else:
             forked = _drawn_in_a_fork(out, result, name, frames)
-            if forked is not None:
-                forks[name] = forked
-                if frames:
-                    frames.pop(name, None)          # drawn on in the fork; if that fails, here on a new figure
+        if forked is not None:
+            forks[name] = forked
+            if frames:
+                frames.pop(name, None)          # drawn on in the fork; if that fails, here on a new figure
+    for drawer in (drawers or {}).values():     # a figure this result does not have: ends now, reaped later
+        drawer.release()
     replies = {}
     try:
         draw_figures(out, result, [n for n in names if n not in forks], frames)
     finally:
         for name, (pid, read_end) in forks.items():
-            with os.fdopen(read_end, "rb") as f:
-                data = f.read()
+            data = _read_all(read_end)
             os.waitpid(pid, 0)
             replies[name] = pickle.loads(data) if data else ("failed", "the drawing process died")
     for reply in replies.values():
         if reply[0] == "oserror":
             _raise(reply)
     draw_figures(out, result, [n for n, reply in replies.items() if reply[0] != "ok"])
-    drawn = [reply[1] for reply in replies.values() if reply[0] == "ok"]
+    drawn = [reply for reply in replies.values() if reply[0] == "ok"]
     if cpu is not None and drawn:
-        cpu["forks_draw_s"], cpu["longest_fork_draw_s"] = sum(drawn), max(drawn)
+        cpu["forks_draw_s"], cpu["longest_fork_draw_s"] = sum(r[1] for r in drawn), max(r[1] for r in drawn)
+        cpu["forks_warm_up_s"] = sum(r[2] for r in drawn)
     return [out / n for n in names]
 
 
@@ -263,10 +410,11 @@ class Figures:
         self._proc = self._conn = None
         self._sent = False               # whether the helper was given results to draw
         self.helper_reason = ""          # why the figures were drawn here, if they were
-        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import, warm-up and frames,
-        #: beside the solve), ``draw_s`` (its drawing after the results arrived) and, where forks
-        #: drew the other figures at the same time, ``forks_draw_s`` (their total) and
-        #: ``longest_fork_draw_s``; empty otherwise
+        #: the helper's CPU times [s] once it drew: ``warm_up_s`` (matplotlib's import, warm-up and its
+        #: frame, beside the solve), ``draw_s`` (its drawing after the results arrived) and, where forks
+        #: drew the other figures at the same time, ``forks_draw_s`` (their total),
+        #: ``longest_fork_draw_s`` and ``forks_warm_up_s`` (the frames of those forked before the
+        #: results, beside the solve); empty otherwise
         self.helper_cpu_s: dict[str, float] = {}
         if helper is None:
             helper, self.helper_reason = helper_allowed()
@@ -275,7 +423,7 @@ class Figures:
         if helper:
             ctx = multiprocessing.get_context("fork")
             self._conn, child = ctx.Pipe(duplex=True)
-            self._proc = ctx.Process(target=_serve, args=(child,), daemon=True, name="exucable-figures")
+            self._proc = ctx.Process(target=_serve, args=(child, self._conn), daemon=True, name="exucable-figures")
             self._proc.start()
             child.close()
 

@@ -33,6 +33,7 @@ from pathlib import Path
 from ..errors import OutputError
 from ..io import AtomicBatch, atomic_write_bytes, atomic_write_text, csv_text, read_csv, write_csv, write_json
 from .figure_process import Figures, draw_figures
+from .numbers_text import csv_rows
 from ..post.pressure import BEND_COLUMNS, PRESSURE_COLUMNS
 from .summary import RunSummary
 
@@ -146,9 +147,10 @@ def _write_data(out: Path, result: RunResult) -> list[Path]:
     # last; an error on the way still puts the files before it in place (io.AtomicBatch)
     with AtomicBatch() as batch:
         def add_csv(name, columns, data):
-            text = csv_text(columns, data)
-            contents[name] = len(text.encode("utf-8"))
-            written.append(batch.add_text(out / name, text))
+            # the numbers through the compiled formatter on large tables: repr's characters, ~5x faster
+            encoded = csv_text(columns, data, rows=csv_rows).encode("utf-8")
+            contents[name] = len(encoded)
+            written.append(batch.add(out / name, encoded))
 
         add_csv("history.csv", [c for c in HISTORY_COLUMNS if c in result.history], result.history)
         if result.tension_profile is not None:

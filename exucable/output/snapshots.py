@@ -74,6 +74,7 @@ class SnapshotRecorder:
     def __init__(self, model, times_s):
         self.model = model
         self.pending = [float(t) for t in sorted(times_s)]
+        # per file and column, one array per snapshot, joined by tables()
         self.rows = {name: {c: [] for c in cols} for name, cols in SNAPSHOT_FILES.items()}
         q, v = model.coordinates()
         a = self._accelerations()
@@ -90,7 +91,7 @@ class SnapshotRecorder:
 
     @property
     def recorded_s(self) -> list[float]:
-        return list(self.rows["snapshot_times.csv"]["time_s"])
+        return [float(t) for part in self.rows["snapshot_times.csv"]["time_s"] for t in part]
 
     def step(self, t: float, pull_force_N: float) -> None:
         """Called at the end of every solver step (time t [s]) with the pulling force there [N]."""
@@ -120,7 +121,7 @@ class SnapshotRecorder:
     def _append(self, name, **columns):
         n = max(np.size(v) for v in columns.values())
         for c, v in columns.items():
-            self.rows[name][c].extend(np.broadcast_to(np.asarray(v), (n,)).tolist())
+            self.rows[name][c].append(np.array(np.broadcast_to(np.asarray(v), (n,))))   # a copy: v may be a view of the state
 
     def _record(self, t, q, v, step, pull_force_N, a=None, reactions=None):
         """One snapshot of state (t, q, v); ``a`` the nodal accelerations (None: a static state) and
@@ -153,8 +154,12 @@ class SnapshotRecorder:
         pts = m.kernel.points(q.reshape(-1), np.nan_to_num(v).reshape(-1))
         e = pts.element
         pen = np.nan_to_num(np.asarray(pts.penetration_m, dtype=float), nan=-np.inf)
-        max_pen = np.full(n_el, -np.inf)
-        np.maximum.at(max_pen, e, pen)
+        k = len(e) // n_el if n_el else 0
+        if k and len(e) == k * n_el:
+            max_pen = pen.reshape(n_el, k).max(axis=1)    # the kernel's points: element-major, k each
+        else:
+            max_pen = np.full(n_el, -np.inf)
+            np.maximum.at(max_pen, e, pen)
         normal = np.bincount(e, pts.normal_force_N, n_el)
         friction = np.bincount(e, pts.friction_force_N, n_el)
         self._append("snapshot_contact.csv", time_s=t, element=np.arange(n_el),
@@ -165,7 +170,5 @@ class SnapshotRecorder:
 
     def tables(self) -> dict[str, dict]:
         """file name -> {column: array}; integer columns stay integer."""
-        out = {}
-        for name, cols in self.rows.items():
-            out[name] = {c: np.asarray(v) for c, v in cols.items()}
-        return out
+        return {name: {c: np.concatenate(parts) if parts else np.asarray([]) for c, parts in cols.items()}
+                for name, cols in self.rows.items()}

@@ -10,6 +10,7 @@ results report, from the balance of the cable's loads (EA·ε spikes next to the
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -228,6 +229,21 @@ class CableLoads:
     trailing_force_N: np.ndarray | None
     leading_force_N: np.ndarray | None
 
+    @cached_property
+    def point_forces_summed(self) -> tuple[np.ndarray, np.ndarray]:
+        """The concentrated loads' places in increasing order [m], shape (p,), and the running sums
+        of their forces in that order [N], shape (p + 1, 3), a zero row first: the check points' part
+        of G(x) (:func:`equilibrium_tension`), sorted and summed once for every station asked (the
+        tension profile, the nodes' tension and the snapshot read one steady state's loads)."""
+        x, f = self.point_x_m, self.point_force_N
+        if not np.all(x[1:] >= x[:-1]):          # the check points come element by element, in order
+            order = np.argsort(x, kind="stable")
+            x, f = x[order], f[order]
+        summed = np.empty((len(x) + 1, 3))
+        summed[0] = 0.0
+        np.cumsum(f, axis=0, out=summed[1:])
+        return x, summed
+
 
 def _loads_up_to(loads: CableLoads, element_length_m, x_m) -> np.ndarray:
     """G(x): the resultant [N] of every load on the material [0, x] but the ends' forces, shape (m, 3)."""
@@ -235,9 +251,8 @@ def _loads_up_to(loads: CableLoads, element_length_m, x_m) -> np.ndarray:
     x_nodes = np.concatenate([[0.0], np.cumsum(Le)])
     x = np.asarray(x_m, dtype=float)
     # concentrated loads at x_p <= x, summed in order of x_p
-    order = np.argsort(loads.point_x_m, kind="stable")
-    cum = np.vstack([np.zeros((1, 3)), np.cumsum(loads.point_force_N[order], axis=0)])
-    G = cum[np.searchsorted(loads.point_x_m[order], x, side="right")]
+    point_x, cum = loads.point_forces_summed
+    G = cum[np.searchsorted(point_x, x, side="right")]
     node_cum = np.vstack([np.zeros((1, 3)), np.cumsum(loads.node_force_N, axis=0)])
     G = G + node_cum[np.searchsorted(x_nodes, x, side="right")]
     G = G + np.clip(x, 0.0, x_nodes[-1])[:, None] * np.asarray(loads.line_load_N_per_m, dtype=float)[None, :]

@@ -66,6 +66,13 @@ with gravity and the end forces ramped to zero the cables float in the duct, the
 singular, and the ramp stalled at load scale 0 (one 90° bend at 4000 N back tension: with friction
 alone from the best state it converged at λ = 0.5). The loads' ramp from the start stays first:
 a keystone laid in a straight drops into a cradle that way, and not from the best state.
+And where the one-iteration steps from the start fail, a bundle is first relaxed by a fictitious
+explicit dynamics on the same residual (:mod:`exucable.solve.relax`, :meth:`SteadySolver.relax_dynamic`)
+to ``bundle_relax_within`` stop tolerances, and every phase after runs from the relaxed state: the
+implicit steps stalled at newtons where the cables must rearrange across the duct (three cables in an
+up-bend: the triangle turns over onto the upper wall), and the relaxation, like a physical settle, moves
+off the unstable balances on the way (reference/README.md, the up-bend study: 12 of 12 cases solve, 5
+failed at the 60 s limit before).
 
 A solve may instead start warm, from a state near its steady state (``warm_start``: the coarse mesh's
 solved state subdivided, :func:`exucable.solve.start.nested_start`). The phases above assume the rope
@@ -81,7 +88,7 @@ depend on the start (``tests/test_nested_start.py``).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import exudyn as exu
@@ -91,6 +98,7 @@ from .dynamic import History, Progress, SolveOutcome, quiet_sparse
 from ..post.tension import TensionStations, profile_stations_m
 from .steady_advice import TIME_LIMIT_KEY, failure_advice
 from .newton_system import ExudynStatic, static_backend
+from .relax import check_settings
 from .onset_continuation import OnsetContinuation, OnsetSettings
 
 __all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
@@ -183,6 +191,12 @@ class SteadySettings:
         Pseudo-time steps (accepted and rejected) a warm start may take, the stall rule
         (``max_one_iteration_stall``) included, before the solve starts again from the rope start [-]
         (a warm start that converges took at most 10 on the long routes).
+    bundle_relax_steps : int
+        Several cables: steps of the dynamic relaxation (:mod:`exucable.solve.relax`) at most, run
+        where the one-iteration continuation from the start fails [-]; 0 skips it (the module's notes).
+    bundle_relax_within : float
+        Residual, in stop tolerances, at which the dynamic relaxation hands its state to the
+        one-iteration continuation [-].
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -211,17 +225,12 @@ class SteadySettings:
     time_limit_s: float = 60.0
     warm_start_skipped_steps: int = 3
     max_warm_start_steps: int = 20
+    bundle_relax_steps: int = 100000
+    bundle_relax_within: float = 30.0
     max_backtracks: int = 6
 
     def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.type == "int":
-                if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-                    raise SolverError(f"SteadySettings.{f.name} = {value!r}: must be a whole number >= 0")
-            elif isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
-                    or not np.isfinite(value) or value <= 0:
-                raise SolverError(f"SteadySettings.{f.name} = {value!r}: must be a finite number > 0")
+        check_settings(self)
 
     @classmethod
     def from_solver(cls, solver) -> "SteadySettings":
@@ -532,6 +541,7 @@ class SteadySolver:
         self.bundle = getattr(model, "n_cables", 1) > 1
         self.best = (np.inf, None)       # the smallest true residual [N] of an accepted step and its state
         self.friction_only = False       # the load ramp scales the friction only (a bundle's first ramp)
+        self.relaxation = None           # a bundle's dynamic relaxation (exucable.solve.relax.RelaxOutcome), if run
         #: several cables: solved through a smooth contact onset first (exucable.solve.onset_continuation)
         self.onset = OnsetContinuation(onset) if onset is not None and self.bundle else None
 
@@ -669,12 +679,36 @@ class SteadySolver:
         times stiffer (across it, 7 nm), and every retried step was rejected: in a bend of radius R
         an axial step u moves the nodes off their curve by up to u²/2R (78 µm at 28 mm and 5 m),
         several times the contacts' loaded penetration (reference/README.md, "The 100 m route: the
-        spring released along the cables"; ``tests/test_bundle_continuation.py``). One cable's steps keep 4c alone (its rejected
-        steps are shortened first, :meth:`shorten_step`)."""
+        spring released along the cables"; ``tests/test_bundle_continuation.py``). One cable's steps
+        keep 4c alone (its rejected steps are shortened first, :meth:`shorten_step`)."""
         if self.bundle:
             s = self.settings
             self.spring.axial_share = min(s.axial_share, self.spring.axial_share / s.axial_release)
         return 4.0 * c
+
+    def relax_dynamic(self, why: str) -> tuple[bool, str]:
+        """Several cables, where the one-iteration continuation from the start failed (``why``):
+        dynamic relaxation (:func:`exucable.solve.relax.relax_bundle`) from the start at full load to
+        ``bundle_relax_within`` stop tolerances, then the one-iteration continuation from the relaxed
+        state, which is the start of every phase after: converged?, and why not."""
+        from .relax import RelaxSettings, relax_bundle
+
+        s = self.settings
+        self.at_scale(1.0)
+        self.store.saved = self.start
+        self.store.restore_as_initial()
+        left = s.time_limit_s - (time.process_time() - self._cpu_start)
+        out = relax_bundle(self.model, RelaxSettings(residual_N=s.bundle_relax_within * self.tolerance_N,
+                                                     max_steps=s.bundle_relax_steps, time_limit_s=max(left, 1e-3)))
+        self.relaxation = out
+        self.store.save()
+        self.start = self.store.saved
+        note = (f"{why}; then dynamic relaxation: {out.steps} steps, {out.restarts} restarts, residual "
+                f"{out.residual_N:.3g} N ({out.message})")
+        if self.out_of_time():
+            return False, note
+        ok, message = self.relax_one_iteration(1.0)
+        return ok, note if ok else f"{note}; from there: {message}"
 
     def shorten_step(self, residual_N: float, limit_N: float) -> float:
         """Go back along the one-iteration step just made (its true residual ``residual_N`` above
@@ -807,13 +841,24 @@ class SteadySolver:
         if not ok:
             self.store.saved = self.start
             ok, first_message = self.relax_one_iteration(1.0)
+            if (not ok and self.bundle and self.settings.bundle_relax_steps and not self.timed_out
+                    and model.steady_force_supported):
+                ok, first_message = self.relax_dynamic(first_message)
             if not ok and not self.timed_out:
                 self.store.saved = self.start
                 ok, first_message = self.relax(1.0)
+                if not ok and self.relaxation is not None:
+                    r = self.relaxation
+                    first_message += (f" (from the state of a dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s "
+                                      f"CPU, residual {r.residual_N:.3g} N: {r.message})")
             first_message += warm_note
         if ok:
             message = (f"{self.accepted} pseudo-time steps from the coarse mesh's state" if started_from != "rope"
                        else f"{self.accepted} pseudo-time steps{warm_note}")
+            if self.relaxation is not None:
+                r = self.relaxation
+                message += (f" (after the one-iteration steps from the rope start failed, from the state of a "
+                            f"dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s CPU, residual {r.residual_N:.3g} N)")
         else:
             status, message = self.ramp_loads(first_message)
             if status != "ok" and self.bundle and not self.timed_out:

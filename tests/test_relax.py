@@ -1,0 +1,179 @@
+"""Dynamic relaxation (exucable/solve/relax.py) against closed forms, and the bundle's residual
+outside Exudyn against Exudyn's static residual."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from exucable.errors import SolverError
+from exucable.solve.relax import RelaxSettings, block_gershgorin_masses, diagonal_gershgorin_masses, relax
+
+
+def chain_problem(n=12, k=2.0e4, m=1.3, g=9.81):
+    """n nodes hanging in a vertical chain of linear springs k [N/m] from a held top node (node 0),
+    each node's weight m g: the spring above node i carries the weight of the n - i nodes from i down,
+    so node i sinks u_i = Σ_{j=1..i} (n - j) m g / k below its unloaded place (a closed form)."""
+    nb = n
+
+    def force(q):
+        z = q.reshape(n, 3)
+        f = np.zeros((n, 3))
+        stretch = z[1:] - z[:-1]                      # spring j joins nodes j-1, j
+        f[1:] -= k * stretch
+        f[:-1] += k * stretch
+        f[:, 2] -= m * g
+        return f.reshape(-1)
+
+    rows, cols, blocks = [], [], []
+    for j in range(1, n):
+        for a, b, sign in ((j - 1, j - 1, 1), (j, j, 1), (j - 1, j, -1), (j, j - 1, -1)):
+            rows.append(a), cols.append(b), blocks.append(sign * k * np.eye(3))
+    free = np.ones(3 * n, dtype=bool)
+    free[:3] = False
+    exact = np.zeros((n, 3))
+    exact[:, 2] = -np.concatenate([[0.0], np.cumsum([(n - j) * m * g / k for j in range(1, n)])])
+    return force, (nb, rows, cols, blocks), free, exact.reshape(-1)
+
+
+@pytest.mark.parametrize("kind", ["block", "diagonal"])
+@pytest.mark.parametrize("damping", ["kinetic", "viscous"])
+def test_a_hanging_spring_chain_relaxes_to_its_closed_form(kind, damping):
+    force, K, free, exact = chain_problem()
+    bound = block_gershgorin_masses if kind == "block" else diagonal_gershgorin_masses
+    M = bound(*K, safety=1.2)
+    out = relax(force, lambda q: M, np.zeros_like(exact), free,
+                RelaxSettings(residual_N=1e-9, damping=damping, viscous_rate=0.2, time_limit_s=30.0))
+    assert out.converged, out.message
+    # the error is at most |f| / λ_min(K), λ_min ≈ k (π / 2n)² = 343 N/m here: 3e-12 m
+    assert np.max(np.abs(out.q - exact)) < 1e-10
+    assert np.allclose(out.q[:3], 0.0)          # the held node did not move
+    assert out.steps > 0 and out.mass_updates >= 1
+
+
+@pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning")
+def test_masses_too_light_are_made_heavier():
+    """Masses a fifth of the bound: the central difference is unstable, the relaxation goes back to its
+    best state with the masses doubled until it is not, and still reaches the closed form."""
+    force, K, free, exact = chain_problem()
+    M = block_gershgorin_masses(*K, safety=1.2)
+    out = relax(force, lambda q: 0.2 * M, np.zeros_like(exact), free, RelaxSettings(residual_N=1e-9, time_limit_s=30.0))
+    assert out.converged, out.message
+    assert out.mass_scale >= 4.0
+    assert np.max(np.abs(out.q - exact)) < 1e-10
+
+
+def test_the_masses_bound_the_stiffness():
+    """Eq. (DR 3): every eigenvalue of M⁻¹K below 4/α, for blocks that are not symmetric on their own
+    (a symmetric K with random off-diagonal blocks)."""
+    rng = np.random.default_rng(3)
+    nb = 7
+    A = rng.normal(size=(3 * nb, 3 * nb))
+    K = A @ A.T
+    rows, cols = np.divmod(np.arange(nb * nb), nb)
+    blocks = K.reshape(nb, 3, nb, 3).transpose(0, 2, 1, 3).reshape(-1, 3, 3)
+    for bound in (block_gershgorin_masses, diagonal_gershgorin_masses):
+        M = bound(nb, rows, cols, blocks, safety=1.0)
+        Mfull = np.zeros_like(K)
+        for b in range(nb):
+            Mfull[3 * b:3 * b + 3, 3 * b:3 * b + 3] = M[b]
+        lam = np.linalg.eigvals(np.linalg.solve(Mfull, K)).real
+        assert lam.max() <= 4.0 * (1 + 1e-12)
+
+
+def test_a_chain_on_a_hertz_floor_relaxes_to_its_penetrations():
+    """A straight horizontal chain of axial springs resting on a Hertz floor under its weight: each node
+    sinks δ_i = (W_i / K_h)^(1/e), W_i its weight (half at the ends), from a start 1 mm above the floor,
+    where the open contact has no stiffness: the masses carry the floor's stiffness at a reference
+    penetration (as :func:`exucable.solve.relax.bundle_masses` does for the cables' contacts)."""
+    n, k, K_h, e, w = 9, 5.0e4, 1.0e8, 1.5, 14.0
+    W = np.full(n, w)
+    W[[0, -1]] = w / 2
+
+    def force(q):
+        x = q.reshape(n, 3)
+        f = np.zeros((n, 3))
+        d = x[1:, 0] - x[:-1, 0]
+        f[1:, 0] -= k * d
+        f[:-1, 0] += k * d
+        f[:, 2] -= W
+        pen = np.maximum(-x[:, 2], 0.0)
+        f[:, 2] += K_h * pen ** e
+        return f.reshape(-1)
+
+    def masses(q):
+        pen = np.maximum(-q.reshape(n, 3)[:, 2], 2e-5)
+        M = np.zeros((n, 3, 3))
+        M[:, 0, 0] = 2 * 2 * k
+        M[:, 1, 1] = 1.0
+        M[:, 2, 2] = e * K_h * pen ** (e - 1)
+        return 0.25 * 1.5 * M
+
+    q0 = np.zeros(3 * n)
+    q0[2::3] = 1e-3
+    free = np.ones(3 * n, dtype=bool)
+    out = relax(force, masses, q0, free, RelaxSettings(residual_N=1e-8, time_limit_s=30.0))
+    assert out.converged, out.message
+    assert np.allclose(-out.q[2::3], (W / K_h) ** (1 / e), rtol=1e-7, atol=0)
+
+
+def test_it_leaves_an_unstable_balance():
+    """f(x) = x - x³ (the potential -x²/2 + x⁴/4): x = 0 is a balance, unstable; started 1e-4 off it
+    the relaxation falls into the well at x = 1, where Newton from the start would go back to 0."""
+    def force(q):
+        return q - q ** 3
+
+    def masses(q):
+        # |∂f/∂x| at the state, at least 20: steps short against the well's width (a unit step from
+        # masses of the well's own stiffness 2 crosses it in a few steps and overshoots into the other)
+        return (0.25 * 1.5 * np.diag(np.maximum(np.abs(1 - 3 * q ** 2), 20.0)))[None]
+
+    out = relax(force, masses, np.array([1e-4, 1e-4, -1e-4]), np.ones(3, dtype=bool),
+                RelaxSettings(residual_N=1e-10, time_limit_s=30.0))
+    assert out.converged, out.message
+    assert np.allclose(out.q, [1.0, 1.0, -1.0], atol=1e-9)
+
+
+def test_bad_settings_are_refused_by_name():
+    with pytest.raises(SolverError, match="RelaxSettings.damping"):
+        RelaxSettings(damping="none")
+    with pytest.raises(SolverError, match="RelaxSettings.mass_safety"):
+        RelaxSettings(mass_safety=0.5)
+
+
+def test_the_bundle_residual_is_the_static_solvers():
+    """BundleModel.steady_force equals Exudyn's static residual on the free coordinates bit for bit,
+    and the blocks of stiffness_blocks3 sum to minus Exudyn's Newton Jacobian there."""
+    import exudyn as exu
+    import exucable as xc
+    from exucable.model.bundle import build_bundle_model
+    from exucable.solve import steady as st
+
+    route = xc.Route(inner_radius=0.05).straight(2.0).bend(30, radius=5.0, turn="up").straight(1.0)
+    sc = xc.Scenario(route=route, cable=xc.Cable(radius=0.015, density=2000.0, youngs_modulus=2e8, count=3,
+                                                 arrangement="triangular"),
+                     contact=xc.Contact(friction=0.3, check_points_per_element=8),
+                     pull=xc.Pull(speed=0.1, back_tension=300.0), gravity=xc.Gravity(g=9.81),
+                     solver=xc.Solver(mode="steady", steady_lead_out=0.0))
+    model = build_bundle_model(sc)
+    solver = st.SteadySolver(model)           # its spring (rate 0) is part of Exudyn's system
+    mbs = model.mbs
+    idx = model.ode2_index
+    q_all = np.array(mbs.systemData.GetODE2Coordinates())
+    settings = st.static_settings(tolerance=1.0, max_iterations=1)
+    s = exu.MainSolverStatic()
+    s.InitializeSolver(mbs, settings)
+    s.ComputeNewtonResidual(mbs, settings)
+    r = np.array(s.GetSystemResidual())[:q_all.size][idx]
+    s.ComputeNewtonJacobian(mbs, settings)
+    J = np.asarray(s.GetSystemJacobian())[np.ix_(idx, idx)]
+    free = np.setdiff1d(np.arange(idx.size), model.held_coordinates())
+    f = model.steady_force(q_all[idx])
+    assert np.array_equal(f[free], r[free])
+    rows, cols, blocks = model.stiffness_blocks3(q_all[idx])
+    K = np.zeros((idx.size, idx.size))
+    for a, b, B in zip(rows, cols, blocks):
+        K[3 * a:3 * a + 3, 3 * b:3 * b + 3] += B
+    # Exudyn's static system Jacobian is ∂(residual)/∂q = ∂f/∂q = -K
+    assert np.allclose(K[np.ix_(free, free)], -J[np.ix_(free, free)], rtol=0, atol=1e-9 * np.abs(J).max())
+    assert solver.spring.rate == 0.0
