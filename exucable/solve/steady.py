@@ -558,7 +558,8 @@ class SteadySolver:
         falling = len(r) < 6 or r[-1] <= 0.5 * r[-6]
         return failure_advice(self.model, load_scale=lam, residual_N=min(r) if r else float("nan"),
                               tolerance_N=self.tolerance_N, timed_out=self.timed_out, still_converging=falling,
-                              time_limit_s=self.settings.time_limit_s)
+                              time_limit_s=self.settings.time_limit_s,
+                              residual_load_scale=self._trace_lam if r else None)
 
     def one_solve(self, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
         """One static solve with the exact, inexact or given settings: converged?, message, and
