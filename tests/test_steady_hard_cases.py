@@ -190,3 +190,22 @@ def test_several_cables_that_stall_are_sent_to_the_dynamic_run_not_to_a_coarser_
     single = failure_advice(_model(2.0e8, 0.015, 1_753.0), load_scale=0.0, residual_N=465.0, tolerance_N=0.00175,
                             timed_out=False, still_converging=False, time_limit_s=60.0)
     assert "cable.element_length" in single
+
+
+def test_steps_rejected_to_the_stiffest_spring_say_so_and_how_many(monkeypatch):
+    """One-iteration steps that every time fail are retried at 4× the spring rate until 1e6 c0; the
+    message then says that, after how many steps and the last failure, not "no equilibrium after
+    <budget> steps" (the budget of 80 was never spent)."""
+    from exucable.data import data_path
+    from exucable.model.build import build_model
+    from exucable.solve.steady import SteadySolver
+
+    model = build_model(load_scenario(data_path("scenarios/fast/paper_ex2_bend90.toml"))
+                        .replace(**{"solver.mode": "steady"}))
+    solver = SteadySolver(model)
+    monkeypatch.setattr(solver, "pseudo_step", lambda c, settings: (False, "Newton diverged", float("nan")))
+    ok, why = solver.relax_one_iteration(1.0)
+    # from c0 to beyond 1e6 c0 by 4×: 4^k > 1e6 first at k = 10
+    assert not ok
+    assert why == ("one-iteration pseudo-time steps: a step rejected up to a spring rate of 1e6 c0 after 10 "
+                   "steps (none accepted); last: Newton diverged")

@@ -631,7 +631,7 @@ class SteadySolver:
         previous, after_reject, message = np.inf, False, ""
         best, stalled = np.inf, 0
         budget = s.max_one_iteration_steps if max_steps is None else max_steps
-        for _ in range(budget):
+        for tried in range(1, budget + 1):
             if self.out_of_time():
                 return False, f"stopped at `{TIME_LIMIT_KEY}`"
             if stalled >= s.max_one_iteration_stall:
@@ -652,7 +652,10 @@ class SteadySolver:
                 c = self.stiffen(c)
                 after_reject = True
                 if c > 1e6 * self.c0:
-                    break
+                    return False, (f"one-iteration pseudo-time steps: a step rejected up to a spring rate of "
+                                   f"1e6 c0 after {tried} steps ("
+                                   f"{f'smallest {best:.3g} N' if np.isfinite(best) else 'none accepted'})"
+                                   f"{f'; last: {message}' if message else ''}")
                 continue
             self.store.save()
             self.record(lam, residual)
