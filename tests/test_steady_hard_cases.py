@@ -46,6 +46,18 @@ def test_a_large_strain_at_the_head_is_reported_with_the_modulus_to_check():
     assert "youngs_modulus" not in small
 
 
+def test_a_residual_reached_at_another_load_scale_names_it():
+    """A solve that failed at the full loads before any ramp reached λ = 0; its residual was at λ = 1,
+    and the message says so instead of leaving it to read as the start's."""
+    model = _model(3.0e8, 0.015, 2_000.0)
+    text = failure_advice(model, load_scale=0.0, residual_N=34.2, tolerance_N=0.00175, timed_out=False,
+                          still_converging=False, time_limit_s=60.0, residual_load_scale=1.0)
+    assert "load scale reached 0 of 1, residual 34.2 N at load scale 1 (stop at 0.00175 N)" in text
+    same = failure_advice(model, load_scale=0.5, residual_N=3.0, tolerance_N=0.002, timed_out=False,
+                          still_converging=False, time_limit_s=60.0, residual_load_scale=0.5)
+    assert "residual 3 N (stop at" in same
+
+
 def test_a_solve_out_of_time_while_converging_is_told_to_allow_more():
     stiff = _model(3.0e8, 0.015, 2_000.0)            # 0.94 % at the head: not the cause
     assert head_strain(stiff)[2] < LARGE_STRAIN
@@ -178,3 +190,22 @@ def test_several_cables_that_stall_are_sent_to_the_dynamic_run_not_to_a_coarser_
     single = failure_advice(_model(2.0e8, 0.015, 1_753.0), load_scale=0.0, residual_N=465.0, tolerance_N=0.00175,
                             timed_out=False, still_converging=False, time_limit_s=60.0)
     assert "cable.element_length" in single
+
+
+def test_steps_rejected_to_the_stiffest_spring_say_so_and_how_many(monkeypatch):
+    """One-iteration steps that every time fail are retried at 4× the spring rate until 1e6 c0; the
+    message then says that, after how many steps and the last failure, not "no equilibrium after
+    <budget> steps" (the budget of 80 was never spent)."""
+    from exucable.data import data_path
+    from exucable.model.build import build_model
+    from exucable.solve.steady import SteadySolver
+
+    model = build_model(load_scenario(data_path("scenarios/fast/paper_ex2_bend90.toml"))
+                        .replace(**{"solver.mode": "steady"}))
+    solver = SteadySolver(model)
+    monkeypatch.setattr(solver, "pseudo_step", lambda c, settings: (False, "Newton diverged", float("nan")))
+    ok, why = solver.relax_one_iteration(1.0)
+    # from c0 to beyond 1e6 c0 by 4×: 4^k > 1e6 first at k = 10
+    assert not ok
+    assert why == ("one-iteration pseudo-time steps: a step rejected up to a spring rate of 1e6 c0 after 10 "
+                   "steps (none accepted); last: Newton diverged")

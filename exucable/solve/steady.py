@@ -558,7 +558,8 @@ class SteadySolver:
         falling = len(r) < 6 or r[-1] <= 0.5 * r[-6]
         return failure_advice(self.model, load_scale=lam, residual_N=min(r) if r else float("nan"),
                               tolerance_N=self.tolerance_N, timed_out=self.timed_out, still_converging=falling,
-                              time_limit_s=self.settings.time_limit_s)
+                              time_limit_s=self.settings.time_limit_s,
+                              residual_load_scale=self._trace_lam if r else None)
 
     def one_solve(self, exact: bool | exu.SimulationSettings) -> tuple[bool, str, float]:
         """One static solve with the exact, inexact or given settings: converged?, message, and
@@ -630,7 +631,7 @@ class SteadySolver:
         previous, after_reject, message = np.inf, False, ""
         best, stalled = np.inf, 0
         budget = s.max_one_iteration_steps if max_steps is None else max_steps
-        for _ in range(budget):
+        for tried in range(1, budget + 1):
             if self.out_of_time():
                 return False, f"stopped at `{TIME_LIMIT_KEY}`"
             if stalled >= s.max_one_iteration_stall:
@@ -651,7 +652,10 @@ class SteadySolver:
                 c = self.stiffen(c)
                 after_reject = True
                 if c > 1e6 * self.c0:
-                    break
+                    return False, (f"one-iteration pseudo-time steps: a step rejected up to a spring rate of "
+                                   f"1e6 c0 after {tried} steps ("
+                                   f"{f'smallest {best:.3g} N' if np.isfinite(best) else 'none accepted'})"
+                                   f"{f'; last: {message}' if message else ''}")
                 continue
             self.store.save()
             self.record(lam, residual)

@@ -44,7 +44,8 @@ def head_strain(model) -> tuple[float, float, float]:
 
 
 def failure_advice(model, *, load_scale: float, residual_N: float, tolerance_N: float, timed_out: bool,
-                   still_converging: bool, time_limit_s: float | None) -> str:
+                   still_converging: bool, time_limit_s: float | None,
+                   residual_load_scale: float | None = None) -> str:
     """The cause of a failed steady solve and what to change, in one sentence for its message.
 
     Parameters
@@ -59,9 +60,15 @@ def failure_advice(model, *, load_scale: float, residual_N: float, tolerance_N: 
         Whether the solve stopped at its time limit (``time_limit_s`` CPU seconds).
     still_converging : bool
         Whether the residual was still falling when it stopped.
+    residual_load_scale : float, optional
+        The load scale λ [-] at which ``residual_N`` was reached, named where it is not the next one
+        after ``load_scale`` would suggest (a solve that failed at the full loads before any ramp
+        reached λ = 0 and its residual at λ = 1).
     """
     T, EA, strain = head_strain(model)
     reached = (f"residual {residual_N:.3g} N" if np.isfinite(residual_N) else "no pseudo-time step accepted")
+    if np.isfinite(residual_N) and residual_load_scale is not None and residual_load_scale != load_scale:
+        reached += f" at load scale {residual_load_scale:.3g}"
     where = (f"load scale reached {load_scale:.3g} of 1, {reached} (stop at {tolerance_N:.3g} N), "
              f"strain at the head {100 * strain:.3g} % (the rope's {T:.4g} N over EA {EA:.4g} N)")
     if np.isfinite(strain) and strain > LARGE_STRAIN:
