@@ -8,7 +8,9 @@ width ``first`` [m] (:class:`~exucable.solve.onset_continuation.OnsetSettings`),
 CPU of each phase (the one-iteration steps from the rope start, the relaxation with the steps from its
 state, the load or friction ramps, the onset layers' descent) with the smallest true residual [N]
 reached by that phase's end, the relaxation's steps and residual, the pull force [N] and the process's
-whole CPU (build included, from getrusage). The machine is shared: compare CPU, not wall.
+whole CPU (build included, from getrusage). A variant ``N:first:friction`` goes from the relaxation
+straight to the friction's ramp (a what-if: the continuation at full load and the loads' ramp
+skipped). The machine is shared: compare CPU, not wall.
 
     nice .venv/bin/python benchmarks/bundle_budget.py [--limit 90] [--variants 300:5e-4,1000:5e-4]
 """
@@ -35,8 +37,10 @@ def _route_scenario():
     return mod.route_scenario()
 
 
-def run_variant(relax_steps: int, first_m: float, limit_s: float) -> None:
-    """One variant in this process: the table row's fields printed, one per line."""
+def run_variant(relax_steps: int, first_m: float, limit_s: float, friction_first: bool = False) -> None:
+    """One variant in this process: the table row's fields printed, one per line. ``friction_first``:
+    after the relaxation, straight to the friction's ramp (the continuation at full load and the
+    loads' ramp skipped; a what-if, not a library path)."""
     from exucable.model.bundle import build_bundle_model
     from exucable.solve import steady as st
     from exucable.solve.onset_continuation import OnsetSettings
@@ -58,6 +62,19 @@ def run_variant(relax_steps: int, first_m: float, limit_s: float) -> None:
                     log.append((name, time.process_time() - c0, solver.best[0]))
         return wrapper
 
+    if friction_first:
+        relax, ramp_loads, skipped = solver.relax, solver.ramp_loads, []
+
+        def relax_skipping_full_load(lam, *a, **k):
+            if not skipped and lam == 1.0:
+                skipped.append(lam)
+                return False, "the continuation at full load skipped"
+            return relax(lam, *a, **k)
+
+        def friction_ramp_only(first_message, friction_only=False):
+            return ramp_loads(first_message, friction_only=True) if friction_only else ("failed", "skipped")
+
+        solver.relax, solver.ramp_loads = relax_skipping_full_load, friction_ramp_only
     for name in PHASES:
         setattr(solver, name, timed(name, getattr(solver, name)))
     solver.onset.descend = timed("onset descent", solver.onset.descend)
@@ -80,16 +97,17 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--limit", type=float, default=90.0, help="the solve's CPU limit [s]")
     p.add_argument("--variants", default="300:5e-4,1000:5e-4,2000:5e-4,300:1e-3,300:2e-3",
-                   help="comma-separated relax_steps:first_m pairs")
+                   help="comma-separated relax_steps:first_m pairs, each optionally :friction (friction_first)")
     p.add_argument("--variant", default=None, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     if args.variant:
-        steps, first = args.variant.split(":")
-        run_variant(int(steps), float(first), args.limit)
+        steps, first, *rest = args.variant.split(":")
+        run_variant(int(steps), float(first), args.limit, friction_first=rest == ["friction"])
         return 0
     for v in args.variants.split(","):
-        steps, first = v.split(":")
-        print(f"relaxation cap {steps} steps, first onset layer {1e3 * float(first):g} mm, limit {args.limit:g} s:", flush=True)
+        steps, first, *rest = v.split(":")
+        print(f"relaxation cap {steps} steps, first onset layer {1e3 * float(first):g} mm, limit {args.limit:g} s"
+              + (", then the friction's ramp alone" if rest else "") + ":", flush=True)
         c0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         subprocess.run([sys.executable, __file__, "--limit", str(args.limit), "--variant", v], check=False)
         c1 = resource.getrusage(resource.RUSAGE_CHILDREN)
