@@ -13,6 +13,7 @@ straight to the friction's ramp (a what-if: the continuation at full load and th
 skipped). The machine is shared: compare CPU, not wall.
 
     nice .venv/bin/python benchmarks/bundle_budget.py [--limit 90] [--variants 300:5e-4,1000:5e-4]
+    nice .venv/bin/python benchmarks/bundle_budget.py --quick      # smoke run: one variant, 3 s limit
 """
 
 from __future__ import annotations
@@ -99,7 +100,10 @@ def main(argv=None) -> int:
     p.add_argument("--variants", default="300:5e-4,1000:5e-4,2000:5e-4,300:1e-3,300:2e-3",
                    help="comma-separated relax_steps:first_m pairs, each optionally :friction (friction_first)")
     p.add_argument("--variant", default=None, help=argparse.SUPPRESS)
+    p.add_argument("--quick", action="store_true", help="smoke run: one variant (300:5e-4) under a 3 s limit")
     args = p.parse_args(argv)
+    if args.quick:
+        args.limit, args.variants = 3.0, "300:5e-4"
     if args.variant:
         steps, first, *rest = args.variant.split(":")
         run_variant(int(steps), float(first), args.limit, friction_first=rest == ["friction"])

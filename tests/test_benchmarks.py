@@ -21,6 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # script -> a line fragment of the table header it prints (how a reader finds the table)
 SCRIPTS = {
     "benchmarks/bundle_route.py": "ratio bundle / one cable",
+    "benchmarks/bundle_budget.py": "relaxation cap 300 steps",
     "benchmarks/bundle_iteration.py": "| tree | cable element |",
     "benchmarks/bundle_start.py": "CPU clearance / axis",
     "benchmarks/cable_element.py": "| part (CPU per call, median) | exudyn [ms] | compiled [ms]",
