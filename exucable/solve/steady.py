@@ -195,8 +195,14 @@ class SteadySettings:
         Several cables: steps of the dynamic relaxation (:mod:`exucable.solve.relax`) at most, run
         where the one-iteration continuation from the start fails [-]; 0 skips it (the module's notes).
     bundle_relax_within : float
-        Residual, in stop tolerances, at which the dynamic relaxation hands its state to the
-        one-iteration continuation [-].
+        Residual, in stop tolerances, below which the dynamic relaxation does not go [-]: its last
+        hand-over to the one-iteration continuation (:meth:`SteadySolver.relax_dynamic`).
+    bundle_relax_handover : float
+        Residual, in stop tolerances, of the dynamic relaxation's first hand-over to the
+        one-iteration continuation [-]. Measured (the 100 m three-cable route, cradled, stop
+        tolerance 2.2e-3 N): that continuation converged from relaxed states at 3 and 7.9 N.
+    bundle_relax_handover_fall : float
+        Factor by which the hand-over residual falls after a hand-over whose continuation failed [-].
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -227,10 +233,15 @@ class SteadySettings:
     max_warm_start_steps: int = 20
     bundle_relax_steps: int = 100000
     bundle_relax_within: float = 30.0
+    bundle_relax_handover: float = 3000.0
+    bundle_relax_handover_fall: float = 10.0
     max_backtracks: int = 6
 
     def __post_init__(self):
         check_settings(self)
+        if self.bundle_relax_handover_fall <= 1.0:
+            raise SolverError(f"SteadySettings.bundle_relax_handover_fall = {self.bundle_relax_handover_fall!r}: "
+                              f"must be > 1 (the hand-over residual must fall)")
 
     @classmethod
     def from_solver(cls, solver) -> "SteadySettings":
@@ -692,27 +703,49 @@ class SteadySolver:
 
     def relax_dynamic(self, why: str) -> tuple[bool, str]:
         """Several cables, where the one-iteration continuation from the start failed (``why``):
-        dynamic relaxation (:func:`exucable.solve.relax.relax_bundle`) from the start at full load to
-        ``bundle_relax_within`` stop tolerances, then the one-iteration continuation from the relaxed
-        state, which is the start of every phase after: converged?, and why not."""
+        dynamic relaxation (:func:`exucable.solve.relax.relax_bundle`) from the start at full load,
+        handed to the one-iteration continuation at ``bundle_relax_handover`` stop tolerances; where
+        that continuation fails, the relaxation goes on from its state to a residual
+        ``bundle_relax_handover_fall`` times smaller, and so on down to ``bundle_relax_within`` stop
+        tolerances. The last relaxed state is the start of every phase after: converged?, and why not.
+
+        Why a ladder: Newton's basin is wider than the relaxation's last digits cost. On the 100 m
+        three-cable route (cradled) the one-iteration continuation converges from relaxed states at
+        3 and 7.9 N (20 and 79 Newton iterations, 1.2 and 4.6 s CPU), where the relaxation had taken
+        3000 steps (30 s) to reach 3 N and would need thousands more to reach 30 stop tolerances
+        (0.05 N); a failed attempt costs at most ``max_one_iteration_steps`` Newton iterations
+        (reference/README.md, "The relaxation handed over early")."""
         from .relax import RelaxSettings, relax_bundle
 
         s = self.settings
         self.at_scale(1.0)
         self.store.saved = self.start
-        self.store.restore_as_initial()
-        left = s.time_limit_s - (time.process_time() - self._cpu_start)
-        out = relax_bundle(self.model, RelaxSettings(residual_N=s.bundle_relax_within * self.tolerance_N,
-                                                     max_steps=s.bundle_relax_steps, time_limit_s=max(left, 1e-3)))
-        self.relaxation = out
-        self.store.save()
-        self.start = self.store.saved
-        note = (f"{why}; then dynamic relaxation: {out.steps} steps, {out.restarts} restarts, residual "
-                f"{out.residual_N:.3g} N ({out.message})")
-        if self.out_of_time():
-            return False, note
-        ok, message = self.relax_one_iteration(1.0)
-        return ok, note if ok else f"{note}; from there: {message}"
+        floor = s.bundle_relax_within * self.tolerance_N
+        target = max(s.bundle_relax_handover * self.tolerance_N, floor)
+        steps = restarts = 0
+        cpu = 0.0
+        notes = []
+        while True:
+            self.store.saved = self.start
+            self.store.restore_as_initial()
+            left = s.time_limit_s - (time.process_time() - self._cpu_start)
+            out = relax_bundle(self.model, RelaxSettings(residual_N=target, max_steps=max(s.bundle_relax_steps - steps, 1),
+                                                         time_limit_s=max(left, 1e-3)))
+            steps, restarts, cpu = steps + out.steps, restarts + out.restarts, cpu + out.cpu_s
+            self.relaxation = replace(out, steps=steps, restarts=restarts, cpu_s=cpu)
+            self.store.save()
+            self.start = self.store.saved
+            note = (f"{why}; then dynamic relaxation: {steps} steps, {restarts} restarts, residual "
+                    f"{out.residual_N:.3g} N ({out.message})")
+            if self.out_of_time():
+                return False, note
+            ok, message = self.relax_one_iteration(1.0)
+            if ok:
+                return True, note
+            notes.append(f"from {out.residual_N:.3g} N: {message}")
+            if not out.converged or target <= floor or steps >= s.bundle_relax_steps or self.timed_out:
+                return False, f"{note}; the continuation " + "; ".join(notes)
+            target = max(target / s.bundle_relax_handover_fall, floor)
 
     def shorten_step(self, residual_N: float, limit_N: float) -> float:
         """Go back along the one-iteration step just made (its true residual ``residual_N`` above
