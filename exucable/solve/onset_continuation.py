@@ -184,7 +184,9 @@ class OnsetContinuation:
 
     def descend(self, solver, message: str) -> tuple[str, str]:
         """From the state ``solver`` converged to at the first layer, smaller layers in turn, each
-        by its one-iteration, then exact-step continuation at full load: status and message.
+        by its one-iteration continuation at full load from c0 (``skipped_steps``), held to that
+        layer's own best residual (then the exact-step continuation where ``exact_steps``): status
+        and message.
 
         The layer falls by ``factor`` while its solves converge; a layer that stalls is tried again
         closer to the last one solved (the factor's square root: a loaded contact sits at

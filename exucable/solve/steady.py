@@ -68,7 +68,9 @@ alone from the best state it converged at λ = 0.5). The loads' ramp from the st
 a keystone laid in a straight drops into a cradle that way, and not from the best state.
 And where the one-iteration steps from the start fail, a bundle is first relaxed by a fictitious
 explicit dynamics on the same residual (:mod:`exucable.solve.relax`, :meth:`SteadySolver.relax_dynamic`)
-to ``bundle_relax_within`` stop tolerances, and every phase after runs from the relaxed state: the
+until the one-iteration continuation from its state converges (handed over at ``bundle_relax_handover``
+stop tolerances, then at residuals 10× smaller down to ``bundle_relax_within``: Newton's basin is wider
+than the relaxation's last digits cost), and every phase after runs from the relaxed state: the
 implicit steps stalled at newtons where the cables must rearrange across the duct (three cables in an
 up-bend: the triangle turns over onto the upper wall), and the relaxation, like a physical settle, moves
 off the unstable balances on the way (reference/README.md, the up-bend study: 12 of 12 cases solve, 5
