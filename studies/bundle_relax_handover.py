@@ -8,7 +8,8 @@ where its best state's residual sits (along, across the cables, on the slopes; p
 relaxation's first states below ``--marks`` [N] are kept, and from each the solve's one-iteration
 continuation (``SteadySolver.relax_one_iteration``) runs as in the solve: converged?, Newton
 iterations, CPU. That measures Newton's basin against the relaxation's residual (the hand-over of
-``SteadySettings.bundle_relax_handover``). ``--quick``: two cables through the 34 m route, 3 s.
+``SteadySettings.bundle_relax_handover``). ``--sections``: the cables across the duct every 5 m at
+the start and at the relaxation's best state. ``--quick``: two cables through the 34 m route, 3 s.
 
     nice .venv/bin/python studies/bundle_relax_handover.py [--arrangement cradled] [--limit 40] [--masses diagonal]
 """
@@ -23,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from exucable.model.bundle import build_bundle_model
+from exucable.model.bundle import build_bundle_model, bundle_cross_sections
 from exucable.scenario.specs import load_scenario
 from exucable.solve import relax as rx
 from exucable.solve import steady as st
@@ -55,12 +56,32 @@ def solver_at_first_layer(scenario):
     return model, solver
 
 
+def sections(model, q_start, q) -> None:
+    """Each cable's axis across the duct [mm] (horizontal, up, looking along the pull) every 5 m
+    along the conduit: at the cables' displacement coordinates ``q_start`` (the start) and ``q``."""
+    sd = model.mbs.systemData
+    s = np.arange(5.0, model.conduit.centreline.length_m, 5.0)
+    ode2 = np.array(sd.GetODE2Coordinates())
+    found = []
+    for x in (q_start, q):
+        ode2[model.ode2_index] = x
+        sd.SetODE2Coordinates(ode2)
+        found.append(bundle_cross_sections(model, s))
+    start, relaxed = found
+    print("\ncables across the duct [mm], (horizontal, up) looking along the pull, cable 1, 2, ...:")
+    for x, a, b in zip(s, start, relaxed):
+        print(f"  s = {x:5.1f} m: start " + " ".join(f"({1e3 * h:+4.0f}, {1e3 * v:+4.0f})" for h, v in a)
+              + "   relaxed " + " ".join(f"({1e3 * h:+4.0f}, {1e3 * v:+4.0f})" for h, v in b))
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--arrangement", default="cradled")
     p.add_argument("--limit", type=float, default=40.0, help="the relaxation's CPU limit [s]")
     p.add_argument("--masses", default="diagonal", choices=("diagonal", "frame", "block"))
     p.add_argument("--marks", default="30,10,3,1", help="residuals [N] whose first relaxed states are kept")
+    p.add_argument("--sections", action="store_true",
+                   help="the cables across the duct every 5 m, at the start and at the relaxation's best state")
     p.add_argument("--quick", action="store_true", help="two cables (triangular) through the 34 m route, 3 s (a smoke run)")
     args = p.parse_args(argv)
     sc = route_scenario("triangular", 2, 12.0) if args.quick else route_scenario(args.arrangement)
@@ -100,6 +121,8 @@ def main(argv=None) -> int:
     print(f"its residual: along the cables {np.linalg.norm(along):.3g} N, across {np.linalg.norm(nodes[:, :3] - along[:, None] * t):.3g} N, "
           f"slopes {np.linalg.norm(nodes[:, 3:]):.3g} N; per cable: "
           + ", ".join(f"{np.linalg.norm(part):.3g}" for part in np.split(f, model.n_cables)) + " N")
+    if args.sections:
+        sections(model, q0, out.q)
     print("\n| relaxed state below [N] | its residual [N] | one-iteration continuation | Newton its | CPU [s] | last (converged) or smallest residual [N] |")
     print("| --- | --- | --- | --- | --- | --- |")
     for m in marks:
