@@ -58,14 +58,14 @@ class OnsetSettings:
         halved moves every loaded contact, and on the 100 m three-cable route (cradled) the state
         solved at 500 µm has a residual of 1511 N at 250 µm; from there the steps begun as after 3
         accepted ones (c0/512) ran to 2e4-4e4 N, those begun at c0 converged in 15 Newton
-        iterations (reference/README.md, "The relaxation handed over early").
+        iterations (reference/README.md, "The relaxation handed over early, and the layers' descent
+        from c0").
     exact_steps : bool
         Where a thinner layer's one-iteration continuation fails, try the exact-step continuation
         (:meth:`~exucable.solve.steady.SteadySolver.relax`) there before going back to a thicker
         layer. Why not: on the 100 m three-cable route (cradled) the one-iteration steps at 15.6 µm
         alternate at 7.83 mN (stop 2.2 mN), two cables' contact at one node flipping, and the exact
-        steps then spent 39 s CPU to stop at 7.8 mN; the layer between (22.1 µm) solved in 28
-        iterations.
+        steps then spent 39 s CPU to stop at 7.8 mN; the layer between (22.1 µm), tried next, solved.
     """
 
     first_m: float = 5.0e-4

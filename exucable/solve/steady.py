@@ -202,7 +202,8 @@ class SteadySettings:
     bundle_relax_handover : float
         Residual, in stop tolerances, of the dynamic relaxation's first hand-over to the
         one-iteration continuation [-]. Measured (the 100 m three-cable route, cradled, stop
-        tolerance 2.2e-3 N): that continuation converged from relaxed states at 3 and 7.9 N.
+        tolerance 2.2e-3 N): that continuation converged from relaxed states at 2.96 and 7.9 N,
+        not from 23.6 N (``studies/bundle_relax_handover.py``).
     bundle_relax_handover_fall : float
         Factor by which the hand-over residual falls after a hand-over whose continuation failed [-].
     max_backtracks : int
@@ -713,10 +714,11 @@ class SteadySolver:
 
         Why a ladder: Newton's basin is wider than the relaxation's last digits cost. On the 100 m
         three-cable route (cradled) the one-iteration continuation converges from relaxed states at
-        3 and 7.9 N (20 and 79 Newton iterations, 1.2 and 4.6 s CPU), where the relaxation had taken
-        3000 steps (30 s) to reach 3 N and would need thousands more to reach 30 stop tolerances
-        (0.05 N); a failed attempt costs at most ``max_one_iteration_steps`` Newton iterations
-        (reference/README.md, "The relaxation handed over early")."""
+        2.96 and 7.9 N (20 and 79 Newton iterations, 1.1 and 4.2 s CPU), where the relaxation had
+        taken ~3000 steps (30 s) to reach 3 N and was at 1.15 N after 40 s, far from 30 stop
+        tolerances (0.066 N); a failed attempt costs at most ``max_one_iteration_steps`` Newton
+        iterations (``studies/bundle_relax_handover.py``; reference/README.md, "The relaxation
+        handed over early, and the layers' descent from c0")."""
         from .relax import RelaxSettings, relax_bundle
 
         s = self.settings
