@@ -112,6 +112,7 @@ def main(argv=None) -> int:
     p.add_argument("--order", default="bottom_first")
     p.add_argument("--block-iterations", type=int, default=20)
     p.add_argument("--block-reduction", type=float, default=BlockSweepSettings().block_reduction)
+    p.add_argument("--coarse-steps", type=int, default=0, help="coarse-correction steps after each sweep (Eq. GS 3)")
     p.add_argument("--handoff", action="store_true")
     p.add_argument("--from-coupled", action="store_true",
                    help="sweep from the best state of the coupled one-iteration steps, not the rope start")
@@ -154,7 +155,8 @@ def main(argv=None) -> int:
     settings = BlockSweepSettings(residual_N=st.SteadySettings().bundle_relax_within * solver.tolerance_N,
                                   max_sweeps=args.sweeps, relaxation=args.relaxation, order=args.order,
                                   block_iterations=args.block_iterations, time_limit_s=args.limit,
-                                  block_reduction=args.block_reduction, stall_sweeps=args.sweeps)
+                                  block_reduction=args.block_reduction, stall_sweeps=args.sweeps,
+                                  coarse_steps=args.coarse_steps)
     out = block_sweeps(model, q0, solver.c0, settings)
     print(f"{sc.name}, {model.n_cables} cables {model.arrangement}, layer {1e6 * args.layer:g} µm, ω {args.relaxation:g}, "
           f"order {args.order}, {args.block_iterations} block steps at most: {out.message}; {out.sweeps} sweeps, "
@@ -162,7 +164,7 @@ def main(argv=None) -> int:
     print("| sweep | coupled residual [N] | per cable [N] | per cable: residual before → after its solve [N] (steps) |")
     print("| --- | --- | --- | --- |")
     for row in out.trace:
-        blocks = ", ".join(f"{i + 1}: {a:.3g} → {b:.3g} ({k})" for i, a, b, k in row["blocks"])
+        blocks = ", ".join(f"{i + 1 if i >= 0 else 'coarse'}: {a:.3g} → {b:.3g} ({k})" for i, a, b, k in row["blocks"])
         print(f"| {row['sweep']} | {row['residual_N']:.4g} | " + ", ".join(f"{x:.3g}" for x in row["cable_residual_N"])
               + f" | {blocks} |")
     where(model, out.q)

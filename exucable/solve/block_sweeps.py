@@ -24,12 +24,22 @@ share × 4, at most 1); an accepted one divides c by 8 and a by 4, as the one-it
 coupled solve do. After each sweep the coupled residual |f| is taken on every free coordinate; the
 sweeps stop when it is below ``residual_N`` or stops halving.
 
+A coarse correction (two-level, as in additive Schwarz methods) may follow each sweep: Galerkin
+pseudo-time Newton steps on the subspace P of the bundle's cross-section moving rigidly, node index by
+node index (every cable's node k translated across the mean tangent and turned about it, positions
+and slopes alike; :func:`_coarse_basis`),
+
+    (Pᵀ (K + c M P_a) P) δ = Pᵀ f,   q ← q + P δ,                                         (GS 3)
+
+K the whole bundle's stiffness, kept only where it lowers the coupled residual.
+
 What this can and cannot do: the block solve removes each cable's own misfit (its axial strain, its
 wall contact, its weight) at the cost of one cable's Newton system; the coupling between the cables
 is only relaxed sweep by sweep. A collective mode (two cables side by side on the wall pushing each
 other along it) has a Gauss–Seidel rate near 1 − K_soft/K_contact, i.e. no progress, and a cable on
-frozen obstacles may sit on an unstable balance (K_ii indefinite): measured on the 100 m route in
-reference/README.md, "Block Gauss–Seidel by cable".
+frozen obstacles may sit on an unstable balance (K_ii indefinite). The coarse correction removes
+the first in a straight duct (``tests/test_block_sweeps.py``), not on the 100 m route: measured in
+reference/README.md, "Block Gauss–Seidel by cable: where it stalls".
 """
 
 from __future__ import annotations
@@ -79,6 +89,9 @@ class BlockSweepSettings:
     order : str
         ``"bottom_first"``: the cables in the order of their start height in the arrangement
         (lowest first: those on the wall, then those resting on them); ``"index"``: as numbered.
+    coarse_steps : int
+        After each sweep, pseudo-time Newton steps of the coarse correction (Eq. GS 3: the bundle's
+        cross-section moved rigidly, node index by node index) at most [-]; 0: none.
     """
 
     residual_N: float = 1e-2
@@ -92,6 +105,7 @@ class BlockSweepSettings:
     stall_sweeps: int = 3
     time_limit_s: float = 60.0
     order: str = "bottom_first"
+    coarse_steps: int = 0
 
     def __post_init__(self):
         if self.order not in ("bottom_first", "index"):
@@ -123,12 +137,13 @@ class BlockSweepOutcome:
         Sweeps made [-].
     block_steps : int
         Pseudo-time Newton steps over all cables, rejected ones included (each one force and
-        Jacobian evaluation of the bundle's residual) [-].
+        Jacobian evaluation of the bundle's residual), the coarse correction's included [-].
     cpu_s : float
         CPU time [s].
     trace : list of dict
         Per sweep: ``sweep``, ``residual_N`` (coupled, after it), ``cable_residual_N`` (list), and per
-        cable ``blocks`` as (cable, residual before [N], after [N], steps).
+        cable ``blocks`` as (cable, residual before [N], after [N], steps); cable −1: the coarse
+        correction, with the coupled residual before and after.
     """
 
     q: np.ndarray
@@ -245,6 +260,79 @@ def _solve_cable(blocks: _CableBlocks, q, f, between, i: int, c: float, share: f
     return q, f, between, steps
 
 
+def _coarse_basis(blocks: _CableBlocks, q) -> sparse.csr_matrix:
+    """P of Eq. (GS 3): per node index k, six coarse unknowns moving every cable's node k alike, the
+    positions by (a₁ e₁ + a₂ e₂ + θ t × r_c) and the slopes by (b₁ e₁ + b₂ e₂ + φ t × r_c), t the
+    cables' mean tangent there, e₁, e₂ across it, r_c the cable's position from the cables' centroid
+    [m]; the eye's held rows left out."""
+    m = blocks.model
+    nc = m.n_cables
+    qa = (blocks.q_ref + q).reshape(nc, -1, 6)
+    nodes = qa.shape[1]
+    t = qa[:, :, 3:].mean(axis=0)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    helper = np.where(np.abs(t[:, 2:3]) < 0.9, np.array([[0.0, 0.0, 1.0]]), np.array([[1.0, 0.0, 0.0]]))
+    e1 = np.cross(t, helper)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(t, e1)
+    r = qa[:, :, :3] - qa[:, :, :3].mean(axis=0)[None]
+    spin = np.cross(t[None], r)                                        # (nc, nodes, 3)
+    cols3 = np.stack([e1, e2], axis=2)                                  # (nodes, 3, 2)
+    rows, cols, vals = [], [], []
+    for c in range(nc):
+        for part in (0, 1):                                             # positions, slopes
+            row = c * blocks.n1 + 6 * np.arange(nodes)[:, None] + 3 * part + np.arange(3)[None, :]   # (nodes, 3)
+            B = np.concatenate([cols3, spin[c][:, :, None]], axis=2)    # (nodes, 3, 3)
+            col = 6 * np.arange(nodes)[:, None] + 3 * part + np.arange(3)[None, :]
+            rows.append(np.broadcast_to(row[:, :, None], B.shape).reshape(-1))
+            cols.append(np.broadcast_to(col[:, None, :], B.shape).reshape(-1))
+            vals.append(B.reshape(-1))
+    rows, cols, vals = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    keep = blocks.free[rows]
+    return sparse.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(blocks.n, 6 * nodes))
+
+
+def _coupled_stiffness(blocks: _CableBlocks, q) -> sparse.csr_matrix:
+    """The bundle's whole stiffness K = −∂f/∂q at ``q`` (:meth:`~exucable.model.bundle.BundleModel.stiffness_blocks3`)."""
+    rows, cols, B = blocks.model.stiffness_blocks3(q)
+    i3 = np.arange(3)
+    r = np.broadcast_to((3 * rows)[:, None, None] + i3[None, :, None], B.shape).reshape(-1)
+    c = np.broadcast_to((3 * cols)[:, None, None] + i3[None, None, :], B.shape).reshape(-1)
+    return sparse.coo_matrix((B.reshape(-1), (r, c)), shape=(blocks.n, blocks.n)).tocsr()
+
+
+def _coarse_correction(blocks: _CableBlocks, q, f, c: float, share: float, settings: BlockSweepSettings, deadline: float):
+    """Pseudo-time Newton steps on the coarse space (Eq. GS 3),
+    (Pᵀ (K + c M P_a) P) δ = Pᵀ f, q ← q + P δ, accepted where it lowers the coupled residual: the state, its residual and pair result, the rate reached and the steps made."""
+    r = float(np.linalg.norm(f[blocks.free]))
+    between = None
+    steps = 0
+    while steps < settings.coarse_steps and time.process_time() < deadline:
+        steps += 1
+        P = _coarse_basis(blocks, q)
+        spring = sparse.block_diag([blocks.spring(q, i, share) for i in range(blocks.model.n_cables)], format="csr")
+        A = (P.T @ ((_coupled_stiffness(blocks, q) + c * spring) @ P)).toarray()
+        g = P.T @ f
+        try:
+            d = np.linalg.solve(A + 1e-12 * np.abs(np.diag(A)).max() * np.eye(len(A)), g)
+        except np.linalg.LinAlgError:
+            c, share = 4.0 * c, min(1.0, 4.0 * share)
+            continue
+        q_new = q + P @ d
+        f_new, between_new = blocks.force(q_new, jacobian=True)
+        r_new = float(np.linalg.norm(f_new[blocks.free]))
+        # only a step that lowers the coupled residual: the sweep before was a descent already,
+        # and on the 100 m route steps within twice the best undid it (73.7 → 131 N)
+        if not np.isfinite(r_new) or r_new >= r:
+            c, share = 4.0 * c, min(1.0, 4.0 * share)
+            continue
+        q, f, between, r = q_new, f_new, between_new, r_new
+        c, share = c / 8.0, share / 4.0
+    if between is None:
+        f, between = blocks.force(q, jacobian=True)
+    return q, f, between, c, share, steps
+
+
 def block_sweeps(model, q0, c0: float, settings: BlockSweepSettings = BlockSweepSettings()) -> BlockSweepOutcome:
     """Nonlinear block Gauss–Seidel by cable (the module's Eqs. GS 1-2) on a steady bundle model
     (:class:`exucable.model.bundle.BundleModel`, compiled cable element) at its current load scale
@@ -281,6 +369,7 @@ def block_sweeps(model, q0, c0: float, settings: BlockSweepSettings = BlockSweep
     steps = sweeps = since_halved = 0
     n = model.n_cables
     message = ""
+    coarse_c, coarse_share = s.later_rate * c0, s.later_axial_share
     while True:
         if r <= s.residual_N:
             message = f"coupled residual {r:.3g} N after {sweeps} sweeps"
@@ -302,6 +391,11 @@ def block_sweeps(model, q0, c0: float, settings: BlockSweepSettings = BlockSweep
             q, f, between, k = _solve_cable(blocks, q, f, between, i, rate * c0, share, target, s, deadline)
             steps += k
             done.append((i, before, float(blocks.residuals(f)[i]), k))
+        if s.coarse_steps:
+            before = float(np.linalg.norm(f[blocks.free]))
+            q, f, between, coarse_c, coarse_share, k = _coarse_correction(blocks, q, f, coarse_c, coarse_share, s, deadline)
+            steps += k
+            done.append((-1, before, float(np.linalg.norm(f[blocks.free])), k))
         sweeps += 1
         per = blocks.residuals(f)
         r = float(np.linalg.norm(f[blocks.free]))
