@@ -175,12 +175,13 @@ def main(argv=None) -> int:
         cpu1 = time.process_time()
         model = build_bundle_model(sc)
         solver = st.SteadySolver(model, st.SteadySettings(time_limit_s=args.limit, bundle_relax_steps=args.relax_steps,
-                                                          bundle_block_sweeps=args.sweeps),
+                                                          bundle_block_sweeps=args.sweeps,
+                                                          bundle_block_coarse_steps=args.coarse_steps),
                                  onset=OnsetSettings(first_m=args.layer))
         result = solver.solve()
         b = solver.sweeps
-        print(f"\nthe steady solve with {args.sweeps} block sweeps first (SteadySettings.bundle_block_sweeps; the "
-              f"sweeps' own settings the defaults): {result.status}, {time.process_time() - cpu1:.2f} s CPU (build and "
+        print(f"\nthe steady solve with {args.sweeps} block sweeps first (SteadySettings.bundle_block_sweeps, "
+              f"{args.coarse_steps} coarse steps after each; the sweeps' other settings the defaults): {result.status}, {time.process_time() - cpu1:.2f} s CPU (build and "
               f"solve), sweeps {b.sweeps if b else 0} ({b.cpu_s if b else 0:.2f} s, {b.residual_N if b else float('nan'):.4g} N), "
               f"{result.newton_iterations} Newton iterations: {result.message}")
         if result.status == "ok":

@@ -205,6 +205,9 @@ class SteadySettings:
         route the sweeps stall at a coupled residual of ~170 N (the coupled steps' best is 62 N) and
         the solve from their state fails as from the rope start (reference/README.md, "Block
         Gauss–Seidel by cable").
+    bundle_block_coarse_steps : int
+        The block sweeps' coarse correction: steps after each sweep at most
+        (:attr:`exucable.solve.block_sweeps.BlockSweepSettings.coarse_steps`) [-]; 0 (the default): none.
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -237,6 +240,7 @@ class SteadySettings:
     bundle_relax_within: float = 30.0
     max_backtracks: int = 6
     bundle_block_sweeps: int = 0
+    bundle_block_coarse_steps: int = 0
 
     def __post_init__(self):
         check_settings(self)
@@ -730,7 +734,8 @@ class SteadySolver:
         model = self.model
         out = block_sweeps(model, self.start[0][model.ode2_index], self.c0,
                            BlockSweepSettings(residual_N=s.bundle_relax_within * self.tolerance_N,
-                                              max_sweeps=s.bundle_block_sweeps, time_limit_s=max(left, 1e-3)))
+                                              max_sweeps=s.bundle_block_sweeps, time_limit_s=max(left, 1e-3),
+                                              coarse_steps=s.bundle_block_coarse_steps))
         self.sweeps = out
         sd = self.mbs.systemData
         ode2 = np.array(self.start[0])
