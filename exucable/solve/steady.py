@@ -101,6 +101,7 @@ from ..post.tension import TensionStations, profile_stations_m
 from .steady_advice import TIME_LIMIT_KEY, failure_advice
 from .newton_system import ExudynStatic, static_backend
 from .relax import check_settings
+from .block_sweeps import node_block_masses
 from .onset_continuation import OnsetContinuation, OnsetSettings
 
 __all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
@@ -206,6 +207,16 @@ class SteadySettings:
         not from 23.6 N (``studies/bundle_relax_handover.py``).
     bundle_relax_handover_fall : float
         Factor by which the hand-over residual falls after a hand-over whose continuation failed [-].
+    bundle_block_sweeps : int
+        Several cables: sweeps of block Gauss–Seidel by cable (:mod:`exucable.solve.block_sweeps`) at
+        most, run from the rope start at full load in the onset layer's first width before any other
+        phase, whose start the swept state then is [-]; 0 (the default) skips it. Why off: on the 100 m
+        route the sweeps stall at a coupled residual of ~170 N (the coupled steps' best is 62 N) and
+        the solve from their state fails as from the rope start (reference/README.md, "Block
+        Gauss–Seidel by cable").
+    bundle_block_coarse_steps : int
+        The block sweeps' coarse correction: steps after each sweep at most
+        (:attr:`exucable.solve.block_sweeps.BlockSweepSettings.coarse_steps`) [-]; 0 (the default): none.
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -239,6 +250,8 @@ class SteadySettings:
     bundle_relax_handover: float = 3000.0
     bundle_relax_handover_fall: float = 10.0
     max_backtracks: int = 6
+    bundle_block_sweeps: int = 0
+    bundle_block_coarse_steps: int = 0
 
     def __post_init__(self):
         check_settings(self)
@@ -296,20 +309,11 @@ class PseudoTimeSpring:
     def __init__(self, model, axial_share: float = SteadySettings.axial_share):
         from exudyn.itemInterface import ObjectGenericODE2
 
-        Le = np.asarray(model.layout.element_length_m, dtype=float)
-        rho_a = model.properties.mass_per_length_kg_per_m
-        m_node = rho_a * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
-        L_node = np.maximum(np.concatenate([Le, [0.0]]), np.concatenate([[0.0], Le]))
-        # several cables meshed alike (exucable.model.bundle): their nodes one cable after another
-        cables = getattr(model.layout, "n_cables", 1)
-        m_node, L_node = np.tile(m_node, cables), np.tile(L_node, cables)
         self._q_ref = np.asarray(model.layout.coordinates, dtype=float).reshape(-1)
-        self.n_nodes = len(m_node)
-        self.n = 6 * self.n_nodes
         # per 3-block (positions, slopes of each node): its mass
-        self.block_mass = np.empty((self.n_nodes, 2))
-        self.block_mass[:, 0] = m_node
-        self.block_mass[:, 1] = m_node * L_node**2
+        self.block_mass = node_block_masses(model)
+        self.n_nodes = len(self.block_mass)
+        self.n = 6 * self.n_nodes
         self.rate = 0.0                       # c [1/s²]
         self.axial_share = axial_share        # weight along the tangent [-]
         self.anchor = np.zeros(self.n)        # q̄ (displacement coordinates)
@@ -556,6 +560,7 @@ class SteadySolver:
         self.best = (np.inf, None)       # the smallest true residual [N] of an accepted step and its state
         self.friction_only = False       # the load ramp scales the friction only (a bundle's first ramp)
         self.relaxation = None           # a bundle's dynamic relaxation (exucable.solve.relax.RelaxOutcome), if run
+        self.sweeps = None               # a bundle's block sweeps (exucable.solve.block_sweeps.BlockSweepOutcome), if run
         #: several cables: solved through a smooth contact onset first (exucable.solve.onset_continuation)
         self.onset = OnsetContinuation(onset) if onset is not None and self.bundle else None
 
@@ -751,6 +756,32 @@ class SteadySolver:
                 return False, f"{note}; the continuation " + "; ".join(notes)
             target = max(target / s.bundle_relax_handover_fall, floor)
 
+    def sweep_cables(self) -> None:
+        """Several cables: block Gauss–Seidel by cable (:func:`exucable.solve.block_sweeps.block_sweeps`)
+        from the start at full load, at most ``bundle_block_sweeps`` sweeps, to ``bundle_relax_within``
+        stop tolerances; its best state becomes the start of every phase after (:attr:`sweeps` holds
+        the outcome)."""
+        from .block_sweeps import BlockSweepSettings, block_sweeps
+
+        s = self.settings
+        self.at_scale(1.0)
+        self.store.saved = self.start
+        self.store.restore_as_initial()
+        left = s.time_limit_s - (time.process_time() - self._cpu_start)
+        model = self.model
+        out = block_sweeps(model, self.start[0][model.ode2_index], self.c0,
+                           BlockSweepSettings(residual_N=s.bundle_relax_within * self.tolerance_N,
+                                              max_sweeps=s.bundle_block_sweeps, time_limit_s=max(left, 1e-3),
+                                              coarse_steps=s.bundle_block_coarse_steps))
+        self.sweeps = out
+        sd = self.mbs.systemData
+        ode2 = np.array(self.start[0])
+        ode2[model.ode2_index] = out.q
+        for cfg in (exu.ConfigurationType.Initial, exu.ConfigurationType.Current):
+            sd.SetODE2Coordinates(ode2, configuration=cfg)
+        self.store.save()
+        self.start = self.store.saved
+
     def shorten_step(self, residual_N: float, limit_N: float) -> float:
         """Go back along the one-iteration step just made (its true residual ``residual_N`` above
         ``limit_N`` [N]), halving its length up to ``max_backtracks`` times, until the true residual
@@ -880,6 +911,9 @@ class SteadySolver:
                 warm_note = f" (from the coarse mesh's state: {why}; again from the rope start)"
                 self.forget_history()
         if not ok:
+            if (self.bundle and self.settings.bundle_block_sweeps and not self.timed_out
+                    and model.steady_force_supported):
+                self.sweep_cables()
             self.store.saved = self.start
             ok, first_message = self.relax_one_iteration(1.0)
             if (not ok and self.bundle and self.settings.bundle_relax_steps and not self.timed_out
@@ -893,9 +927,15 @@ class SteadySolver:
                     first_message += (f" (from the state of a dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s "
                                       f"CPU, residual {r.residual_N:.3g} N: {r.message})")
             first_message += warm_note
+            if self.sweeps is not None:
+                b = self.sweeps
+                first_message = (f"from the state of {b.sweeps} block sweeps by cable ({b.cpu_s:.3g} s CPU, "
+                                 f"residual {b.residual_N:.3g} N: {b.message}): {first_message}")
         if ok:
             message = (f"{self.accepted} pseudo-time steps from the coarse mesh's state" if started_from != "rope"
                        else f"{self.accepted} pseudo-time steps{warm_note}")
+            if self.sweeps is not None:
+                message += f" ({first_message.split('): ')[0]})"
             if self.relaxation is not None:
                 r = self.relaxation
                 message += (f" (after the one-iteration steps from the rope start failed, from the state of a "
