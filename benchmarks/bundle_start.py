@@ -2,7 +2,8 @@
 arrangement about the duct's axis and the cross-section's statics (``build_bundle_model(...,
 start_path=...)``), CPU time and Newton iterations of each solve measured in one run.
 
-    nice .venv/bin/python benchmarks/bundle_start.py [--quick] [--route [--limit 55]]
+    nice .venv/bin/python benchmarks/bundle_start.py [--quick]
+        [--route [--limit 55] [--arrangements triangular,cradled] [--starts clearance,statics,statics_own]]
 
 ``--route``: ``benchmarks/bundle_route.py``'s 100 m route (triangular and cradled) from the clearance
 path and from the statics (``"statics"`` and ``"statics_own"``), each solve under a CPU limit (``--limit``, default 55 s, the route's
@@ -115,14 +116,16 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="the bend at 300 N only (a smoke run)")
     p.add_argument("--route", action="store_true", help="the 100 m route from the clearance path and the statics (equal and own loads)")
     p.add_argument("--limit", type=float, default=55.0, help="the route's solve CPU limit [s]")
+    p.add_argument("--arrangements", default="triangular,cradled", help="the route's arrangements, comma-separated")
+    p.add_argument("--starts", default="clearance,statics,statics_own", help="the route's starts, comma-separated")
     args = p.parse_args(argv)
     if args.route:
         build_bundle_model(bend(300.0))      # the kernels' first call (numba's cache) outside the timings
         print("| arrangement | start | status | build CPU [s] | solve CPU [s] | start residual, 0.5 mm layer [N] "
               "| pull [N] | residual left: per cable, and the 10 m holding most |")
         print("| --- | --- | --- | --- | --- | --- | --- | --- |")
-        for arrangement in ("triangular", "cradled"):
-            for start in ("clearance", "statics", "statics_own"):
+        for arrangement in args.arrangements.split(","):
+            for start in args.starts.split(","):
                 route_row(arrangement, start, args.limit)
         return 0
     cases = [(f"90° bend, triangular, T_b {b:g} N", bend(b)) for b in ((300.0,) if args.quick else
