@@ -701,8 +701,11 @@ class CableContactKernel:
         if jacobian and self.backend == "numba":
             # Sᵀ J S summed into node blocks in one compiled pass (the same sums as the sparse
             # products below, in another order: round-off only)
+            # without friction and damping between the cables ∂Q/∂u is zero entry by entry (its
+            # terms are multiples of μ_c and C), so its sweep would add zeros only (half the cost)
+            moving = self.law.friction != 0.0 or self.law.damping != 0.0
             J = self._assemble([(c["jac_x"], self._coef, 1.0)] + (
-                [(c["jac_u"], self._coef_d, self.speed_m_per_s)] if q_t is None else []), c["index"])
+                [(c["jac_u"], self._coef_d, self.speed_m_per_s)] if q_t is None and moving else []), c["index"])
             if q_t is not None:
                 J_t = self._assemble([(c["jac_u"], self._coef, 1.0)], c["index"])
         elif jacobian:
