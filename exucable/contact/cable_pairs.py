@@ -249,6 +249,50 @@ def _segment_distance2(X, j, px, py, pz):
 
 
 @njit(**_JIT)
+def _hermite_points(q, n_cables, n_el, n_k, coef, out):
+    """S q without the sparse matrix: out[c·n_points + p, i] = Σ_a coef[p, a] q[slot a of point p's
+    element, i] of cable c, summed in S's stored order (a = 0..3 after 0.0, as scipy's CSR product
+    does: the same bits)."""
+    n_points = n_el * n_k
+    n1 = 6 * (n_el + 1)
+    for c in range(n_cables):
+        for e in range(n_el):
+            b = c * n1 + 6 * e
+            for k in range(n_k):
+                p = e * n_k + k
+                row = c * n_points + p
+                for i in range(3):
+                    s = 0.0
+                    s += coef[p, 0] * q[b + i]
+                    s += coef[p, 1] * q[b + 3 + i]
+                    s += coef[p, 2] * q[b + 6 + i]
+                    s += coef[p, 3] * q[b + 9 + i]
+                    out[row, i] = s
+
+
+@njit(**_JIT)
+def _hermite_transpose(f, n_cables, n_el, n_k, coef, out):
+    """Sᵀ f without the sparse matrix (f: 3 per point, all cables): each coordinate of node n sums its
+    points in increasing order (element n - 1's, then element n's), as Sᵀ's stored rows do."""
+    n_points = n_el * n_k
+    n1 = 6 * (n_el + 1)
+    for c in range(n_cables):
+        for node in range(n_el + 1):
+            for slot in range(2):
+                for i in range(3):
+                    s = 0.0
+                    if node >= 1:
+                        for k in range(n_k):
+                            p = (node - 1) * n_k + k
+                            s += coef[p, 2 + slot] * f[3 * (c * n_points + p) + i]
+                    if node < n_el:
+                        for k in range(n_k):
+                            p = node * n_k + k
+                            s += coef[p, slot] * f[3 * (c * n_points + p) + i]
+                    out[c * n1 + 6 * node + 3 * slot + i] = s
+
+
+@njit(**_JIT)
 def _balls(X, ob, n_seg, size, n_blocks, cen, rad):
     """Bounding balls (centre ``cen`` (n_blocks, 3), radius ``rad``) of the polyline X[ob..]'s blocks
     of ``size`` consecutive segments (each ball holds its segments' end points, so the segments)."""
@@ -615,6 +659,9 @@ class CableContactKernel:
         self._acc = None
         one = sparse.csr_matrix((vals, (rows, cols)), shape=(3 * self.n_points, self.n_coordinates_per_cable))
         done = sparse.csr_matrix((dvals, (rows, cols)), shape=one.shape)
+        # S's and S''s values per point and slot, in their stored order (for _hermite_points)
+        self._s_coef = np.ascontiguousarray(one.data.reshape(self.n_points, 3, 4)[:, 0, :])
+        self._ds_coef = np.ascontiguousarray(done.data.reshape(self.n_points, 3, 4)[:, 0, :])
         self.S = sparse.block_diag([one] * self.n_cables, format="csr")
         self.dS = sparse.block_diag([done] * self.n_cables, format="csr")
         self.St = self.S.T.tocsr()
@@ -642,8 +689,14 @@ class CableContactKernel:
         steady-sliding V ∂r/∂x, or with the nodal rates ``q_t`` (a dynamic state) S q̇."""
         q = np.asarray(q, dtype=float).reshape(-1)
         if q_t is not None:
-            return (self.S @ q).reshape(-1, 3), (self.S @ np.asarray(q_t, dtype=float).reshape(-1)).reshape(-1, 3)
-        return (self.S @ q).reshape(-1, 3), (self.speed_m_per_s * (self.dS @ q)).reshape(-1, 3)
+            return self._map(self._s_coef, q), self._map(self._s_coef, np.asarray(q_t, dtype=float).reshape(-1))
+        return self._map(self._s_coef, q), self.speed_m_per_s * self._map(self._ds_coef, q)
+
+    def _map(self, coef, q) -> np.ndarray:
+        """S q (or S' q) as (n_cables·n_points, 3), compiled (the sparse product's bits, 8x faster)."""
+        out = np.empty((self.n_cables * self.n_points, 3))
+        _hermite_points(np.ascontiguousarray(q, dtype=float), self.n_cables, self.n_el, self.n_k, coef, out)
+        return out
 
     def contacts(self, q, jacobian: bool = False, q_t=None, copy: bool = True) -> dict:
         """Every contact at absolute coordinates ``q`` (see :func:`pair_contacts_reference`), the
@@ -722,7 +775,8 @@ class CableContactKernel:
         n3 = 3 * self.n_points * self.n_cables
         dof = (3 * c["index"][:, :, None] + np.arange(3)[None, None, :]).reshape(-1, 9)   # (m, 9)
         f_pts = np.bincount(dof.reshape(-1), weights=c["force"].reshape(-1), minlength=n3)
-        Q = self.St @ f_pts
+        Q = np.empty(self.n_coordinates)
+        _hermite_transpose(f_pts, self.n_cables, self.n_el, self.n_k, self._s_coef, Q)       # Sᵀ f
         J = J_t = None
         if jacobian and self.backend == "numba":
             # Sᵀ J S summed into node blocks in one compiled pass (the same sums as the sparse
