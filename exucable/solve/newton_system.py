@@ -594,6 +594,9 @@ class OwnBundleNewton(OwnStaticNewton):
         wc = (first + loc[None, :, None, :] + 0 * loc[None, :, :, None]).reshape(-1)
         self._fixed_rows = np.concatenate([wr, spring._rows.astype(np.int64)])
         self._fixed_cols = np.concatenate([wc, spring._cols.astype(np.int64)])
+        self._fixed_prow, self._fixed_pcol = self.order[self._fixed_rows], self.order[self._fixed_cols]
+        off = self._fixed_prow - self._fixed_pcol
+        self._fixed_kl, self._fixed_ku = int(off.max()), int(-off.min())
         # the eye's held coordinates (cable order) and their constraints' multipliers (AE order)
         sd = self.mbs.systemData
         where = np.empty(n, dtype=np.int64)
@@ -648,30 +651,36 @@ class OwnBundleNewton(OwnStaticNewton):
         """As :meth:`OwnStaticNewton._newton_step`, in the interleaved order (the class notes)."""
         t0 = time.process_time()
         rows, cols, vals = self.stiffness_triplets(q)
+        n_fixed = self._fixed_prow.size
+        pr = np.concatenate([self._fixed_prow, self.order[rows[n_fixed:]]])
+        pc = np.concatenate([self._fixed_pcol, self.order[cols[n_fixed:]]])
         t1 = time.process_time()
-        held_r, held_c = self._is_held[rows], self._is_held[cols]
         rhs = -r
         rhs[self.held] = 0.0
+        b = np.empty(self.n)
+        b[self.order] = rhs
+        ph = self.order[self.held]
+        if self.linear_solver == "banded":
+            off = pr[n_fixed:] - pc[n_fixed:]
+            kl = max(self._fixed_kl, int(off.max()) if off.size else 0)
+            ku = max(self._fixed_ku, int(-off.min()) if off.size else 0)
+            if kl * (kl + ku + 1) <= self.BAND_WORK_LIMIT:
+                return self._band_step(pr, pc, vals, b, r, ph, dq_held, kl, ku, (t0, t1))
+            # cables slid far apart along the route (a diverging iterate): SuperLU's own order is cheaper
+        # SuperLU on the triplets, the held rows and columns dropped and the identity put there
+        held_r, held_c = self._is_held[rows], self._is_held[cols]
         if np.any(dq_held):
             full = np.zeros(self.n)
             full[self.held] = dq_held
-            rhs -= np.bincount(rows, weights=np.where(held_r, 0.0, vals * full[cols]), minlength=self.n)
-        rhs[self.held] = dq_held
-        # the held rows' products for the multipliers' update: Δλ = r_h + K_h· Δq
-        in_held_row = np.flatnonzero(held_r)
+            b[self.order] -= np.bincount(rows, weights=np.where(held_r, 0.0, vals * full[cols]), minlength=self.n)
+        b[ph] = dq_held
         keep = ~(held_r | held_c)
-        pr = np.concatenate([self.order[rows[keep]], self.order[self.held]])
-        pc = np.concatenate([self.order[cols[keep]], self.order[self.held]])
-        pv = np.concatenate([vals[keep], np.ones(self.held.size)])
-        b = np.empty(self.n)
-        b[self.order] = rhs
         t2 = time.process_time()
-        if self.linear_solver == "banded":
-            x = self._banded_solve(pr, pc, pv, b)
-        else:
-            x = self._splu_solve(pr, pc, pv, b)
+        x = self._splu_solve(np.concatenate([pr[keep], ph]), np.concatenate([pc[keep], ph]),
+                             np.concatenate([vals[keep], np.ones(ph.size)]), b)
         t3 = time.process_time()
         dq = x[self.order]
+        in_held_row = np.flatnonzero(held_r)
         h_of = np.full(self.n, -1, dtype=np.int64)
         h_of[self.held] = np.arange(self.held.size)
         dlam = r[self.held] + np.bincount(h_of[rows[in_held_row]], weights=vals[in_held_row] * dq[cols[in_held_row]],
@@ -679,21 +688,37 @@ class OwnBundleNewton(OwnStaticNewton):
         self._count_time(t0, t1, t2, t3)
         return dq, dlam
 
-    def _banded_solve(self, rows, cols, vals, b) -> np.ndarray:
-        """Solve the matrix of triplets (duplicates summed) by LAPACK's banded LU (``dgbsv``)."""
+    def _band_step(self, pr, pc, vals, b, r, ph, dq_held, kl, ku, times):
+        """:meth:`_newton_step` by LAPACK's banded LU (``dgbsv``): the triplets (interleaved order,
+        duplicates summed) into the band, the held rows and columns read and replaced by the identity."""
         n = self.n
-        off = rows - cols
-        kl, ku = max(int(off.max()), 0), max(int(-off.min()), 0)
         ld = 2 * kl + ku + 1
-        if kl * (kl + ku + 1) > self.BAND_WORK_LIMIT:
-            # cables slid far apart along the route (a diverging iterate): SuperLU's own order is cheaper
-            return self._splu_solve(rows, cols, vals, b)
+        top = kl + ku
         # LAPACK's band storage, Fortran order: entry (i, j) at row kl + ku + i - j of column j
-        band = np.bincount(cols * ld + (kl + ku) + off, weights=vals, minlength=ld * n).reshape(n, ld).T
+        memory = np.bincount(pc * ld + top + pr - pc, weights=vals, minlength=ld * n)
+        band = memory.reshape(n, ld).T
+        rows_k = []
+        for h, dqh in zip(ph, dq_held):
+            j = np.arange(max(0, h - kl), min(n, h + ku + 1))          # row h's columns in the band
+            row_pos = j * ld + top + h - j
+            i = np.arange(max(0, h - ku), min(n, h + kl + 1))          # column h's rows in the band
+            col_pos = h * ld + top + i - h
+            rows_k.append((j, memory[row_pos].copy(), row_pos, col_pos))
+            if dqh != 0.0:
+                b[i] -= memory[col_pos] * dqh
+        for _, _, row_pos, col_pos in rows_k:
+            memory[row_pos] = 0.0
+            memory[col_pos] = 0.0
+        memory[ph * ld + top] = 1.0
+        b[ph] = dq_held
+        t2 = time.process_time()
         _, _, x, info = lapack.dgbsv(kl, ku, band, b, overwrite_ab=True, overwrite_b=True)
         if info != 0:
             raise np.linalg.LinAlgError(f"the system matrix is singular (LAPACK dgbsv info {info})")
-        return x
+        t3 = time.process_time()
+        dlam = r[self.held] + np.array([k @ x[j] for j, k, _, _ in rows_k])
+        self._count_time(times[0], times[1], t2, t3)
+        return x[self.order], dlam
 
     def _splu_solve(self, rows, cols, vals, b) -> np.ndarray:
         """Solve the matrix of triplets (duplicates summed) by SuperLU."""
