@@ -293,6 +293,16 @@ def _hermite_transpose(f, n_cables, n_el, n_k, coef, out):
 
 
 @njit(**_JIT)
+def _beyond(centre, radius, px, py, pz, reach):
+    """Whether the ball (``centre``, ``radius``) lies farther than ``reach`` from P (squared distances)."""
+    dx = px - centre[0]
+    dy = py - centre[1]
+    dz = pz - centre[2]
+    lim = reach + radius
+    return dx * dx + dy * dy + dz * dz > lim * lim
+
+
+@njit(**_JIT)
 def _balls(X, ob, n_seg, size, n_blocks, cen, rad):
     """Bounding balls (centre ``cen`` (n_blocks, 3), radius ``rad``) of the polyline X[ob..]'s blocks
     of ``size`` consecutive segments (each ball holds its segments' end points, so the segments)."""
@@ -361,22 +371,12 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 reach = np.sqrt(ub) + 1e-9
                 best_j, best_t, best_d2 = -1, 0.0, np.inf
                 for k in range(first // G, (last - 1) // G + 1):
-                    dx = px - cen[b, k, 0]
-                    dy = py - cen[b, k, 1]
-                    dz = pz - cen[b, k, 2]
-                    lim = reach + rad[b, k]
-                    if dx * dx + dy * dy + dz * dz > lim * lim:
+                    if _beyond(cen[b, k], rad[b, k], px, py, pz, reach):
                         continue
                     for sk in range(k * g, min(k * g + g, ns)):
                         j0 = max(first, sk * g)
                         j1 = min(last, sk * g + g)
-                        if j0 >= j1:
-                            continue
-                        dx = px - scen[b, sk, 0]
-                        dy = py - scen[b, sk, 1]
-                        dz = pz - scen[b, sk, 2]
-                        lim = reach + srad[b, sk]
-                        if dx * dx + dy * dy + dz * dz > lim * lim:
+                        if j0 >= j1 or _beyond(scen[b, sk], srad[b, sk], px, py, pz, reach):
                             continue
                         for j in range(j0, j1):
                             t, d2 = _segment_distance2(X, ob + j, px, py, pz)

@@ -211,16 +211,8 @@ class OwnStaticNewton(StaticBackend):
         sd = self.mbs.systemData
         where = np.empty(n, dtype=np.int64)
         where[self.index] = np.arange(n)
-        held, ae = [], []
-        for drive in (model.lead_drive, model.trail_drive):
-            if drive is None:
-                continue
-            for c in drive.constraints:
-                marker = self.mbs.GetMarker(self.mbs.GetObject(c)["markerNumbers"][1])
-                held.append(where[self.mbs.GetNodeODE2Index(marker["nodeNumber"]) + int(marker["coordinate"])])
-                ae.append(int(np.asarray(sd.GetObjectLTGAE(c))[0]))
-        self.held = np.asarray(held, dtype=np.int64)
-        self.ae = np.asarray(ae, dtype=np.int64)
+        self.held, self.ae = _held_rows(self.mbs, [d for d in (model.lead_drive, model.trail_drive) if d is not None],
+                                        where)
         self.n_ae = len(sd.GetAECoordinates())
         is_held = np.zeros(n, dtype=bool)
         is_held[self.held] = True
@@ -496,6 +488,20 @@ class OwnStaticNewton(StaticBackend):
         return float(np.sqrt(_squared_norm(r)))
 
 
+def _held_rows(mbs, drives, where) -> tuple[np.ndarray, np.ndarray]:
+    """The coordinates the rig's ``drives`` hold (their constraints' coordinates, as indices into the
+    cables' coordinates through ``where``: system ODE2 index → cable order) and their constraints'
+    multipliers (indices into the AE coordinates)."""
+    sd = mbs.systemData
+    held, ae = [], []
+    for drive in drives:
+        for c in drive.constraints:
+            marker = mbs.GetMarker(mbs.GetObject(c)["markerNumbers"][1])
+            held.append(where[mbs.GetNodeODE2Index(marker["nodeNumber"]) + int(marker["coordinate"])])
+            ae.append(int(np.asarray(sd.GetObjectLTGAE(c))[0]))
+    return np.asarray(held, dtype=np.int64), np.asarray(ae, dtype=np.int64)
+
+
 def _squared_norm(r: np.ndarray) -> float:
     """r·r without BLAS: OpenBLAS splits a dot product of over 10 000 entries across its threads,
     whose start-up cost 7.7 ms of CPU per 77 000-entry residual on this loaded 2-core machine
@@ -601,14 +607,7 @@ class OwnBundleNewton(OwnStaticNewton):
         sd = self.mbs.systemData
         where = np.empty(n, dtype=np.int64)
         where[self.index] = np.arange(n)
-        held, ae = [], []
-        for drive in model.lead_drives:
-            for con in drive.constraints:
-                marker = self.mbs.GetMarker(self.mbs.GetObject(con)["markerNumbers"][1])
-                held.append(where[self.mbs.GetNodeODE2Index(marker["nodeNumber"]) + int(marker["coordinate"])])
-                ae.append(int(np.asarray(sd.GetObjectLTGAE(con))[0]))
-        self.held = np.asarray(held, dtype=np.int64)
-        self.ae = np.asarray(ae, dtype=np.int64)
+        self.held, self.ae = _held_rows(self.mbs, model.lead_drives, where)
         self.n_ae = len(sd.GetAECoordinates())
         self._is_held = np.zeros(n, dtype=bool)
         self._is_held[self.held] = True
