@@ -303,6 +303,18 @@ def _beyond(centre, radius, px, py, pz, reach):
 
 
 @njit(**_JIT)
+def _point_forces(index, force, m, out):
+    """Each check point's force (3 per point, all cables) summed from the contacts' ``force`` (m, 9)
+    on their points ``index`` (m, 3), in the contacts' order: numpy's ``bincount`` of the same
+    entries, bit for bit, without its index and weight arrays."""
+    for c in range(m):
+        for al in range(3):
+            base = 3 * index[c, al]
+            for k in range(3):
+                out[base + k] += force[c, 3 * al + k]
+
+
+@njit(**_JIT)
 def _balls(X, ob, n_seg, size, n_blocks, cen, rad):
     """Bounding balls (centre ``cen`` (n_blocks, 3), radius ``rad``) of the polyline X[ob..]'s blocks
     of ``size`` consecutive segments (each ball holds its segments' end points, so the segments)."""
@@ -773,8 +785,8 @@ class CableContactKernel:
 
         c = self.contacts(q, jacobian, q_t, copy=False)
         n3 = 3 * self.n_points * self.n_cables
-        dof = (3 * c["index"][:, :, None] + np.arange(3)[None, None, :]).reshape(-1, 9)   # (m, 9)
-        f_pts = np.bincount(dof.reshape(-1), weights=c["force"].reshape(-1), minlength=n3)
+        f_pts = np.zeros(n3)
+        _point_forces(c["index"], c["force"], len(c["index"]), f_pts)
         Q = np.empty(self.n_coordinates)
         _hermite_transpose(f_pts, self.n_cables, self.n_el, self.n_k, self._s_coef, Q)       # Sᵀ f
         J = J_t = None
@@ -789,6 +801,7 @@ class CableContactKernel:
             if q_t is not None:
                 J_t = self._assemble([(c["jac_u"], self._coef, 1.0)], c["index"])
         elif jacobian:
+            dof = (3 * c["index"][:, :, None] + np.arange(3)[None, None, :]).reshape(-1, 9)   # (m, 9)
             r = np.broadcast_to(dof[:, :, None], (len(dof), 9, 9)).reshape(-1)
             k = np.broadcast_to(dof[:, None, :], (len(dof), 9, 9)).reshape(-1)
             Jx = sparse.csr_matrix((c["jac_x"].reshape(-1), (r, k)), shape=(n3, n3))
