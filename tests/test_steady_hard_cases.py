@@ -192,6 +192,28 @@ def test_several_cables_that_stall_are_sent_to_the_dynamic_run_not_to_a_coarser_
     assert "cable.element_length" in single
 
 
+@pytest.mark.parametrize("duct_radius_m, arrangement, named", [
+    (0.05, "triangular", True),       # D/d 3.33: the calculators take three cables cradled
+    (0.035, "triangular", False),     # D/d 2.33 < 2.5: triangular is the calculators' own choice
+    (0.05, "cradled", False),         # already the cradle
+])
+def test_a_stalled_triangle_where_the_calculators_take_a_cradle_is_told_the_cradled_arrangement(
+        duct_radius_m, arrangement, named):
+    """A triangle of three cables at D/d ≥ 2.5 loses its top cable into the cradle's place in the
+    bends, which the steady solve has not followed (reference/README.md): its failure names the
+    arrangement that solves, with the D/d; a triangle below 2.5, or a cradle, is not told so."""
+    bundle = _model(2.0e8, 0.015, 1_753.0)
+    bundle.n_cables, bundle.arrangement = 3, arrangement
+    bundle.scenario.cable.radius_m = 0.015
+    bundle.scenario.conduit = SimpleNamespace(inner_radius_m=duct_radius_m)
+    text = failure_advice(bundle, load_scale=0.0, residual_N=29.4, tolerance_N=0.00175, timed_out=False,
+                          still_converging=False, time_limit_s=60.0)
+    assert 'solver.mode = "dynamic"' in text
+    assert ('cable.arrangement = "cradled"' in text) == named
+    if named:
+        assert "D/d 3.33" in text
+
+
 def test_steps_rejected_to_the_stiffest_spring_say_so_and_how_many(monkeypatch):
     """One-iteration steps that every time fail are retried at 4× the spring rate until 1e6 c0; the
     message then says that, after how many steps and the last failure, not "no equilibrium after

@@ -33,6 +33,30 @@ _BUNDLE_FIX = ('the dynamic run (`solver.mode = "dynamic"` with a `solver.end_ti
                'has not helped)')
 
 
+def _triangle_note(model) -> str:
+    """For three cables laid triangular in a duct where the calculators take them cradled (D/d ≥
+    2.5, :func:`exucable.quasistatic.engineering.auto_arrangement`), the arrangement that does solve
+    and why the triangle may not; else "".
+
+    Why: pressed onto a bend's wall by tensions far above their weight, the triangle's top cable
+    sits on a crest of the other two (its stiffness with them held has negative eigenvalues) and
+    falls into the cradle's place, climbing back on the straights; the steady solve has not
+    followed that rearrangement on the 100 m route or the industry plan, where the cradled
+    arrangement solves (reference/README.md, "Block Gauss–Seidel by cable" and "The industry
+    three-cable plan: the top cable falls off in the bends")."""
+    from ..quasistatic.engineering import auto_arrangement
+
+    sc = getattr(model, "scenario", None)
+    if sc is None or getattr(model, "n_cables", 1) != 3 or getattr(model, "arrangement", "") != "triangular":
+        return ""
+    D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
+    if auto_arrangement(3, D, d) != "cradled":
+        return ""
+    return (f"; or `cable.arrangement = \"cradled\"` (the calculators' arrangement at D/d {D / d:.3g} ≥ 2.5): "
+            "at this D/d a triangle's top cable falls off the other two in the bends, a rearrangement the "
+            "steady solve does not follow yet")
+
+
 def head_strain(model) -> tuple[float, float, float]:
     """The rope reference's largest tension [N], the cable's axial stiffness EA [N] and their ratio,
     the axial strain at the head [-] (NaN without a rope reference)."""
@@ -78,6 +102,7 @@ def failure_advice(model, *, load_scale: float, residual_N: float, tolerance_N: 
         where += (f"; a strain above {100 * LARGE_STRAIN:g} % is beyond cables' pulling limits: check "
                   "`cable.youngs_modulus`")
     fix = _BUNDLE_FIX if getattr(model, "n_cables", 1) > 1 else _MESH_FIX
+    fix += _triangle_note(model)
     if timed_out and (still_converging or not np.isfinite(residual_N)):
         why = "the residual was still falling" if still_converging else "nothing had converged yet"
         return (f"{where}: {why} when the time limit of {time_limit_s:g} s CPU ran out; "
