@@ -44,6 +44,7 @@ SCRIPTS = {
     "studies/beam_conduit_study.py": "| case | EJ [N m²] | model: stiff vs its EJ → 0 limit",
     "studies/bundle_upbend_study.py": "| bend | arrangement | cable friction | status",
     "studies/bundle_route_onset.py": "| check | result |",
+    "studies/bundle_curvature_study.py": "| eigenvalue [1/s²] | mode largest on cable |",
     "studies/bending_stiffness_study.py": "| case | gravity | c [mm] | EJ [N m²] | √(EJ/T_in)/R",
     "studies/contact_flips.py": "| t [s] | touching | contact in/out",
     "studies/ex4_study.py": "| clearance R − r [mm] | E [Pa] | pulling force [N]",
