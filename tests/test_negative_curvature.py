@@ -67,3 +67,5 @@ def test_bad_settings_are_refused_by_name():
 
     with pytest.raises(SolverError, match="max_move_m"):
         CurvatureSettings(max_move_m=-1.0)
+    with pytest.raises(SolverError, match="CurvatureSettings.modes"):
+        CurvatureSettings(modes=0)

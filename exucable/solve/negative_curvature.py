@@ -43,6 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh
 
+from ..errors import SolverError
 from .relax import check_settings
 
 __all__ = ["CurvatureSettings", "CurvatureStep", "lowest_modes", "stiffness_matrix", "roll_off", "curvature_phase"]
@@ -75,6 +76,9 @@ class CurvatureSettings:
 
     def __post_init__(self):
         check_settings(self)
+        for name in ("modes", "rounds"):
+            if getattr(self, name) < 1:
+                raise SolverError(f"CurvatureSettings.{name} = {getattr(self, name)!r}: must be at least 1")
 
 
 @dataclass
