@@ -99,3 +99,41 @@ def test_one_cables_rejection_only_stiffens_the_rate():
     solver = SteadySolver(build_model(duct(1)))
     solver.spring.axial_share = 1e-6
     assert solver.stiffen(2.0) == 8.0 and solver.spring.axial_share == 1e-6
+
+
+def test_the_relaxation_hands_over_early_then_lower(monkeypatch):
+    """SteadySolver.relax_dynamic's ladder: the relaxation hands its state to the one-iteration
+    continuation at bundle_relax_handover stop tolerances; where that fails, it goes on from its
+    state to a residual bundle_relax_handover_fall times smaller, down to bundle_relax_within;
+    every phase after starts from the last relaxed state."""
+    import exucable.solve.relax as rx
+
+    solver = SteadySolver(build_bundle_model(duct(3)))
+    s, tol = solver.settings, solver.tolerance_N
+    targets, relaxed = [], []
+    real = rx.relax_bundle
+
+    def recorded(model, settings, *a, **k):
+        targets.append(settings.residual_N)
+        out = real(model, settings, *a, **k)
+        relaxed.append(out.q.copy())
+        return out
+
+    monkeypatch.setattr(rx, "relax_bundle", recorded)
+    answers = iter([(False, "stalled"), (False, "stalled"), (True, "")])
+    monkeypatch.setattr(solver, "relax_one_iteration", lambda lam: next(answers))
+    ok, note = solver.relax_dynamic("the one-iteration steps from the start failed")
+    assert ok, note
+    assert targets == pytest.approx([s.bundle_relax_handover * tol, s.bundle_relax_handover * tol / s.bundle_relax_handover_fall,
+                                     s.bundle_relax_within * tol], rel=1e-12)
+    assert solver.relaxation.residual_N <= s.bundle_relax_within * tol
+    assert np.array_equal(solver.start[0][solver.model.ode2_index], relaxed[-1])
+    assert solver.relaxation.steps >= 1
+
+
+def test_a_handover_residual_that_does_not_fall_is_refused():
+    from exucable.errors import SolverError
+    from exucable.solve.steady import SteadySettings
+
+    with pytest.raises(SolverError, match="bundle_relax_handover_fall"):
+        SteadySettings(bundle_relax_handover_fall=1.0)

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from exucable.errors import SolverError
-from exucable.solve.relax import RelaxSettings, block_gershgorin_masses, diagonal_gershgorin_masses, relax
+from exucable.solve.relax import (RelaxSettings, block_gershgorin_masses, diagonal_gershgorin_masses,
+                                  frame_gershgorin_masses, node_frames, relax)
 
 
 def chain_problem(n=12, k=2.0e4, m=1.3, g=9.81):
@@ -63,22 +64,53 @@ def test_masses_too_light_are_made_heavier():
     assert np.max(np.abs(out.q - exact)) < 1e-10
 
 
+def _full(M):
+    nb = len(M)
+    out = np.zeros((3 * nb, 3 * nb))
+    for b in range(nb):
+        out[3 * b:3 * b + 3, 3 * b:3 * b + 3] = M[b]
+    return out
+
+
 def test_the_masses_bound_the_stiffness():
     """Eq. (DR 3): every eigenvalue of M⁻¹K below 4/α, for blocks that are not symmetric on their own
-    (a symmetric K with random off-diagonal blocks)."""
+    (a symmetric K with random off-diagonal blocks); the row sums taken in each block's own frame
+    (random frames, with and without a floor across) bound it as well."""
     rng = np.random.default_rng(3)
     nb = 7
     A = rng.normal(size=(3 * nb, 3 * nb))
     K = A @ A.T
     rows, cols = np.divmod(np.arange(nb * nb), nb)
     blocks = K.reshape(nb, 3, nb, 3).transpose(0, 2, 1, 3).reshape(-1, 3, 3)
-    for bound in (block_gershgorin_masses, diagonal_gershgorin_masses):
-        M = bound(nb, rows, cols, blocks, safety=1.0)
-        Mfull = np.zeros_like(K)
-        for b in range(nb):
-            Mfull[3 * b:3 * b + 3, 3 * b:3 * b + 3] = M[b]
-        lam = np.linalg.eigvals(np.linalg.solve(Mfull, K)).real
+    frames = node_frames(rng.normal(size=(nb, 3)))
+    assert np.allclose(np.einsum("bki,bkj->bij", frames, frames), np.eye(3)[None], atol=1e-14)
+    bounds = [block_gershgorin_masses(nb, rows, cols, blocks, safety=1.0),
+              diagonal_gershgorin_masses(nb, rows, cols, blocks, safety=1.0)]
+    bounds += [frame_gershgorin_masses(nb, rows, cols, blocks, frames, safety=1.0, floor_across=floor)
+               for floor in (None, rng.uniform(0.0, 5.0, nb))]
+    for M in bounds:
+        lam = np.linalg.eigvals(np.linalg.solve(_full(M), K)).real
         assert lam.max() <= 4.0 * (1 + 1e-12)
+
+
+def test_contact_stiffness_across_a_cable_leaves_its_tangent_light():
+    """A node of a cable along t between two axial springs k_a, pressed by a contact of stiffness
+    k_c ≫ k_a across it (normal n ⊥ t, the cable turned off the coordinate axes as in a bend): in
+    the node's frame the tangent's mass is the axial springs' (α/4)·2k_a, as in a straight
+    cable without the contact, and the contact's stiffness lands on the normals only; the row sums
+    on the coordinates load k_c onto every axis it has a component on, the tangent too."""
+    k_a, k_c = 1.0e5, 1.0e8
+    t = np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
+    n = np.array([-1.0, 1.0, 0.0]) / np.sqrt(2.0)
+    K_node = 2.0 * k_a * np.outer(t, t) + k_c * np.outer(n, n)
+    frames = node_frames(t[None])
+    M = frame_gershgorin_masses(1, [0], [0], K_node[None], frames, safety=1.0)
+    assert t @ M[0] @ t == pytest.approx(0.25 * 2.0 * k_a, rel=1e-12)
+    assert n @ M[0] @ n == pytest.approx(0.25 * k_c, rel=1e-12)
+    diag = diagonal_gershgorin_masses(1, [0], [0], K_node[None])
+    assert t @ diag[0] @ t == pytest.approx(0.25 * k_c, rel=1e-12)   # the row sums: the contact on the tangent
+    floor = frame_gershgorin_masses(1, [0], [0], np.zeros((1, 3, 3)), frames, floor_across=[8.0])[0]
+    assert t @ floor @ t == pytest.approx(0.0, abs=1e-12) and n @ floor @ n == pytest.approx(2.0, rel=1e-12)
 
 
 def test_a_chain_on_a_hertz_floor_relaxes_to_its_penetrations():

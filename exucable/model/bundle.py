@@ -540,12 +540,14 @@ class BundleModel:
         n1 = 6 * (self.cables[0].n_elements + 1)
         return (n1 * np.arange(self.n_cables)[:, None] + (n1 - 6) + np.arange(3)[None, :]).reshape(-1)
 
-    def steady_force(self, q) -> np.ndarray:
+    def steady_force(self, q, between=None) -> np.ndarray:
         """The resultant generalized force [N, N·m] on the cables' displacement coordinates ``q``
         (:attr:`ode2_index`'s order) of the steady model at its current load scale: wall contact with
         the steady sliding friction, the cables' elastic forces and weight, the contact between the
         cables and the end loads; the eye's reactions left out (its rows are not balanced). Equal to
         the static solver's residual on the free coordinates, bit for bit (``tests/test_relax.py``).
+        ``between``: the pair kernel's result at ``q`` when the caller has it (with its Jacobian,
+        :mod:`exucable.solve.block_sweeps`), else evaluated here.
         Needs the compiled cable element (``solver.cable_element = "compiled"``)."""
         q = np.asarray(q, dtype=float)
         self._need_compiled()
@@ -553,7 +555,9 @@ class BundleModel:
         f = np.empty(q.size)
         for i, coupling in enumerate(self.wall_couplings):
             f[i * n1:(i + 1) * n1] = coupling.force(q[i * n1:(i + 1) * n1], 1.0, jacobian=False)
-        f += self.between.evaluate(self.between_coupling.q_ref + q, jacobian=False).generalized_force
+        if between is None:
+            between = self.between.evaluate(self.between_coupling.q_ref + q, jacobian=False)
+        f += between.generalized_force
         for i, rows in self._load_rows():
             f[rows] += np.asarray(self.mbs.GetLoadParameter(i, "loadVector"), dtype=float)
         return f

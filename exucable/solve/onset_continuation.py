@@ -51,6 +51,21 @@ class OnsetSettings:
     tolerance : float
         Relative difference [-] between an answer at a finite layer and the extrapolated s → 0 one
         within which the finite layer's answer stands when the next layer stalls.
+    skipped_steps : int
+        Each thinner layer's one-iteration continuation begins at the spring rate and axial share
+        reached after this many accepted steps (``skip`` of
+        :meth:`~exucable.solve.steady.SteadySolver.relax_one_iteration`) [-]. Why 0: a layer
+        halved moves every loaded contact, and on the 100 m three-cable route (cradled) the state
+        solved at 500 µm has a residual of 1511 N at 250 µm; from there the steps begun as after 3
+        accepted ones (c0/512) ran to 2e4-4e4 N, those begun at c0 converged in 15 Newton
+        iterations (reference/README.md, "The relaxation handed over early, and the layers' descent
+        from c0").
+    exact_steps : bool
+        Where a thinner layer's one-iteration continuation fails, try the exact-step continuation
+        (:meth:`~exucable.solve.steady.SteadySolver.relax`) there before going back to a thicker
+        layer. Why not: on the 100 m three-cable route (cradled) the one-iteration steps at 15.6 µm
+        alternate at 7.83 mN (stop 2.2 mN), two cables' contact at one node flipping, and the exact
+        steps then spent 39 s CPU to stop at 7.8 mN; the layer between (22.1 µm), tried next, solved.
     """
 
     first_m: float = 5.0e-4
@@ -60,6 +75,8 @@ class OnsetSettings:
     # the steady error bar's floor, exucable.solve.error_bar.RESOLUTION_FLOOR (which imports the
     # steady solve, hence not imported here; tests/test_onset_layer.py holds them equal)
     tolerance: float = 1e-4
+    skipped_steps: int = 0
+    exact_steps: bool = False
 
     def __post_init__(self):
         from ..errors import SolverError
@@ -70,6 +87,9 @@ class OnsetSettings:
             raise SolverError(f"OnsetSettings.factor = {self.factor!r}: must be > 1")
         if not (0.0 < self.floor_m <= self.first_m):
             raise SolverError(f"OnsetSettings.floor_m = {self.floor_m!r}: must be in (0, first_m = {self.first_m!r}] m")
+        if isinstance(self.skipped_steps, bool) or not isinstance(self.skipped_steps, (int, np.integer)) \
+                or self.skipped_steps < 0:
+            raise SolverError(f"OnsetSettings.skipped_steps = {self.skipped_steps!r}: must be a whole number >= 0")
         if not 1.0 < self.min_factor <= self.factor:
             raise SolverError(f"OnsetSettings.min_factor = {self.min_factor!r}: must be in (1, factor = {self.factor!r}]")
         if not self.tolerance > 0.0:
@@ -164,7 +184,9 @@ class OnsetContinuation:
 
     def descend(self, solver, message: str) -> tuple[str, str]:
         """From the state ``solver`` converged to at the first layer, smaller layers in turn, each
-        by its one-iteration, then exact-step continuation at full load: status and message.
+        by its one-iteration continuation at full load from c0 (``skipped_steps``), held to that
+        layer's own best residual (then the exact-step continuation where ``exact_steps``): status
+        and message.
 
         The layer falls by ``factor`` while its solves converge; a layer that stalls is tried again
         closer to the last one solved (the factor's square root: a loaded contact sits at
@@ -179,8 +201,10 @@ class OnsetContinuation:
             layer = 0.0 if self.layer_m <= s.floor_m * (1.0 + 1e-12) else max(self.layer_m / factor, s.floor_m)
             before, before_layer = solver.store.saved, self.layer_m
             self._set(solver.model, layer)
-            ok, why = solver.relax_one_iteration(1.0, skip=solver.settings.warm_start_skipped_steps)
-            if not ok and not solver.timed_out:
+            # another layer, another residual: the steps are held to this layer's best, not the last one's
+            solver.best = (np.inf, None)
+            ok, why = solver.relax_one_iteration(1.0, skip=s.skipped_steps)
+            if not ok and s.exact_steps and not solver.timed_out:
                 solver.store.saved = before
                 ok, why = solver.relax(1.0)
             self._stage(solver, ok)

@@ -183,6 +183,39 @@ def diagonal_gershgorin_masses(n_blocks: int, rows, cols, blocks, safety: float 
     return M
 
 
+def node_frames(slopes: np.ndarray) -> np.ndarray:
+    """Orthonormal frames R = [t, n₁, n₂] (columns) of nodes with slope vectors ``slopes`` (m, 3):
+    t the unit tangent, n₁ and n₂ across the cable."""
+    t = slopes / np.linalg.norm(slopes, axis=1, keepdims=True)
+    # n₁: the unit axis least aligned with t, made orthogonal to it
+    e = np.eye(3)[np.argmin(np.abs(t), axis=1)]
+    n1 = e - np.einsum("mi,mi->m", e, t)[:, None] * t
+    n1 /= np.linalg.norm(n1, axis=1, keepdims=True)
+    return np.stack([t, n1, np.cross(t, n1)], axis=2)
+
+
+def frame_gershgorin_masses(n_blocks: int, rows, cols, blocks, frames: np.ndarray, safety: float = 1.0,
+                            floor_across=None) -> np.ndarray:
+    """Underwood's masses (Eq. DR 3 on 1 × 1 blocks) in each block's own frame Rᵢ (``frames``,
+    (n_blocks, 3, 3), columns tangent and two normals): with K' = Rᵀ K R (R block diagonal,
+    orthogonal) the row sums dᵢₖ = Σⱼₗ |K'ᵢⱼ,ₖₗ| bound K' as in Eq. (DR 3), and
+    Mᵢ = (α/4) Rᵢ diag(dᵢ) Rᵢᵀ has M⁻¹K similar to diag(d)⁻¹K', so the same bound holds. In the
+    cable's frame a contact's stiffness (across the cable) stays off the tangent, whose masses then
+    carry the axial stiffness EA only: the axial modes are not slowed by the contacts. ``floor_across``
+    (n_blocks,) is added on the two normals (what an open contact may add before the next update)
+    [as the blocks' units]; other arguments as :func:`block_gershgorin_masses`."""
+    B = np.asarray(blocks, dtype=float).reshape(-1, 3, 3)
+    rows = np.asarray(rows, dtype=np.int64)
+    cols = np.asarray(cols, dtype=np.int64)
+    d = np.zeros((n_blocks, 3))
+    if len(B):
+        Bl = np.einsum("mki,mkl,mlj->mij", frames[rows], B, frames[cols])
+        np.add.at(d, rows, np.abs(Bl).sum(axis=2))
+    if floor_across is not None:
+        d[:, 1:] += np.asarray(floor_across, dtype=float)[:, None]
+    return (0.25 * safety) * np.einsum("bik,bk,bjk->bij", frames, d, frames)
+
+
 def block_gershgorin_masses(n_blocks: int, rows, cols, blocks, safety: float = 1.0) -> np.ndarray:
     """Block masses of Eq. (DR 3) from the stiffness K = Σ blocks [N/m, or per the coordinates].
 
@@ -382,6 +415,10 @@ def bundle_masses(model, safety: float, reference_penetration_m: float, contacts
             M = diagonal_gershgorin_masses(nb, rows, cols, blocks, safety)
             M += (0.25 * safety) * floor[:, None, None] * np.eye(3)[None]
             return M
+        if kind == "frame":
+            slope = (q_ref + q).reshape(-1, 6)[:, 3:]
+            return frame_gershgorin_masses(nb, rows, cols, blocks, np.repeat(node_frames(slope), 2, axis=0),
+                                           safety, floor)
         M = block_gershgorin_masses(nb, rows, cols, blocks, safety)
         slope = (q_ref + q).reshape(-1, 6)[:, 3:]
         t = slope / np.linalg.norm(slope, axis=1, keepdims=True)

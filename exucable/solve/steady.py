@@ -68,7 +68,9 @@ alone from the best state it converged at λ = 0.5). The loads' ramp from the st
 a keystone laid in a straight drops into a cradle that way, and not from the best state.
 And where the one-iteration steps from the start fail, a bundle is first relaxed by a fictitious
 explicit dynamics on the same residual (:mod:`exucable.solve.relax`, :meth:`SteadySolver.relax_dynamic`)
-to ``bundle_relax_within`` stop tolerances, and every phase after runs from the relaxed state: the
+until the one-iteration continuation from its state converges (handed over at ``bundle_relax_handover``
+stop tolerances, then at residuals 10× smaller down to ``bundle_relax_within``: Newton's basin is wider
+than the relaxation's last digits cost), and every phase after runs from the relaxed state: the
 implicit steps stalled at newtons where the cables must rearrange across the duct (three cables in an
 up-bend: the triangle turns over onto the upper wall), and the relaxation, like a physical settle, moves
 off the unstable balances on the way (reference/README.md, the up-bend study: 12 of 12 cases solve, 5
@@ -99,6 +101,7 @@ from ..post.tension import TensionStations, profile_stations_m
 from .steady_advice import TIME_LIMIT_KEY, failure_advice
 from .newton_system import ExudynStatic, static_backend
 from .relax import check_settings
+from .block_sweeps import node_block_masses
 from .onset_continuation import OnsetContinuation, OnsetSettings
 from .negative_curvature import curvature_phase
 
@@ -196,8 +199,25 @@ class SteadySettings:
         Several cables: steps of the dynamic relaxation (:mod:`exucable.solve.relax`) at most, run
         where the one-iteration continuation from the start fails [-]; 0 skips it (the module's notes).
     bundle_relax_within : float
-        Residual, in stop tolerances, at which the dynamic relaxation hands its state to the
-        one-iteration continuation [-].
+        Residual, in stop tolerances, below which the dynamic relaxation does not go [-]: its last
+        hand-over to the one-iteration continuation (:meth:`SteadySolver.relax_dynamic`).
+    bundle_relax_handover : float
+        Residual, in stop tolerances, of the dynamic relaxation's first hand-over to the
+        one-iteration continuation [-]. Measured (the 100 m three-cable route, cradled, stop
+        tolerance 2.2e-3 N): that continuation converged from relaxed states at 2.96 and 7.9 N,
+        not from 23.6 N (``studies/bundle_relax_handover.py``).
+    bundle_relax_handover_fall : float
+        Factor by which the hand-over residual falls after a hand-over whose continuation failed [-].
+    bundle_block_sweeps : int
+        Several cables: sweeps of block Gauss–Seidel by cable (:mod:`exucable.solve.block_sweeps`) at
+        most, run from the rope start at full load in the onset layer's first width before any other
+        phase, whose start the swept state then is [-]; 0 (the default) skips it. Why off: on the 100 m
+        route the sweeps stall at a coupled residual of ~170 N (the coupled steps' best is 62 N) and
+        the solve from their state fails as from the rope start (reference/README.md, "Block
+        Gauss–Seidel by cable").
+    bundle_block_coarse_steps : int
+        The block sweeps' coarse correction: steps after each sweep at most
+        (:attr:`exucable.solve.block_sweeps.BlockSweepSettings.coarse_steps`) [-]; 0 (the default): none.
     bundle_curvature_rounds : int
         Several cables: rounds of negative-curvature steps (:mod:`exucable.solve.negative_curvature`),
         each followed by the one-iteration continuation, where the dynamic relaxation's hand-over
@@ -235,11 +255,18 @@ class SteadySettings:
     max_warm_start_steps: int = 20
     bundle_relax_steps: int = 100000
     bundle_relax_within: float = 30.0
+    bundle_relax_handover: float = 3000.0
+    bundle_relax_handover_fall: float = 10.0
     bundle_curvature_rounds: int = 0
     max_backtracks: int = 6
+    bundle_block_sweeps: int = 0
+    bundle_block_coarse_steps: int = 0
 
     def __post_init__(self):
         check_settings(self)
+        if self.bundle_relax_handover_fall <= 1.0:
+            raise SolverError(f"SteadySettings.bundle_relax_handover_fall = {self.bundle_relax_handover_fall!r}: "
+                              f"must be > 1 (the hand-over residual must fall)")
 
     @classmethod
     def from_solver(cls, solver) -> "SteadySettings":
@@ -291,20 +318,11 @@ class PseudoTimeSpring:
     def __init__(self, model, axial_share: float = SteadySettings.axial_share):
         from exudyn.itemInterface import ObjectGenericODE2
 
-        Le = np.asarray(model.layout.element_length_m, dtype=float)
-        rho_a = model.properties.mass_per_length_kg_per_m
-        m_node = rho_a * (np.concatenate([Le, [0.0]]) + np.concatenate([[0.0], Le])) / 2
-        L_node = np.maximum(np.concatenate([Le, [0.0]]), np.concatenate([[0.0], Le]))
-        # several cables meshed alike (exucable.model.bundle): their nodes one cable after another
-        cables = getattr(model.layout, "n_cables", 1)
-        m_node, L_node = np.tile(m_node, cables), np.tile(L_node, cables)
         self._q_ref = np.asarray(model.layout.coordinates, dtype=float).reshape(-1)
-        self.n_nodes = len(m_node)
-        self.n = 6 * self.n_nodes
         # per 3-block (positions, slopes of each node): its mass
-        self.block_mass = np.empty((self.n_nodes, 2))
-        self.block_mass[:, 0] = m_node
-        self.block_mass[:, 1] = m_node * L_node**2
+        self.block_mass = node_block_masses(model)
+        self.n_nodes = len(self.block_mass)
+        self.n = 6 * self.n_nodes
         self.rate = 0.0                       # c [1/s²]
         self.axial_share = axial_share        # weight along the tangent [-]
         self.anchor = np.zeros(self.n)        # q̄ (displacement coordinates)
@@ -551,6 +569,7 @@ class SteadySolver:
         self.best = (np.inf, None)       # the smallest true residual [N] of an accepted step and its state
         self.friction_only = False       # the load ramp scales the friction only (a bundle's first ramp)
         self.relaxation = None           # a bundle's dynamic relaxation (exucable.solve.relax.RelaxOutcome), if run
+        self.sweeps = None               # a bundle's block sweeps (exucable.solve.block_sweeps.BlockSweepOutcome), if run
         self.curvature_note = ""         # what a bundle's negative-curvature steps found (bundle_curvature_rounds)
         #: several cables: solved through a smooth contact onset first (exucable.solve.onset_continuation)
         self.onset = OnsetContinuation(onset) if onset is not None and self.bundle else None
@@ -702,27 +721,76 @@ class SteadySolver:
 
     def relax_dynamic(self, why: str) -> tuple[bool, str]:
         """Several cables, where the one-iteration continuation from the start failed (``why``):
-        dynamic relaxation (:func:`exucable.solve.relax.relax_bundle`) from the start at full load to
-        ``bundle_relax_within`` stop tolerances, then the one-iteration continuation from the relaxed
-        state, which is the start of every phase after: converged?, and why not."""
+        dynamic relaxation (:func:`exucable.solve.relax.relax_bundle`) from the start at full load,
+        handed to the one-iteration continuation at ``bundle_relax_handover`` stop tolerances; where
+        that continuation fails, the relaxation goes on from its state to a residual
+        ``bundle_relax_handover_fall`` times smaller, and so on down to ``bundle_relax_within`` stop
+        tolerances. The last relaxed state is the start of every phase after: converged?, and why not.
+
+        Why a ladder: Newton's basin is wider than the relaxation's last digits cost. On the 100 m
+        three-cable route (cradled) the one-iteration continuation converges from relaxed states at
+        2.96 and 7.9 N (20 and 79 Newton iterations, 1.1 and 4.2 s CPU), where the relaxation had
+        taken ~3000 steps (30 s) to reach 3 N and was at 1.15 N after 40 s, far from 30 stop
+        tolerances (0.066 N); a failed attempt costs at most ``max_one_iteration_steps`` Newton
+        iterations (``studies/bundle_relax_handover.py``; reference/README.md, "The relaxation
+        handed over early, and the layers' descent from c0")."""
         from .relax import RelaxSettings, relax_bundle
+
+        s = self.settings
+        self.at_scale(1.0)
+        self.store.saved = self.start
+        floor = s.bundle_relax_within * self.tolerance_N
+        target = max(s.bundle_relax_handover * self.tolerance_N, floor)
+        steps = restarts = 0
+        cpu = 0.0
+        notes = []
+        while True:
+            self.store.saved = self.start
+            self.store.restore_as_initial()
+            left = s.time_limit_s - (time.process_time() - self._cpu_start)
+            out = relax_bundle(self.model, RelaxSettings(residual_N=target, max_steps=max(s.bundle_relax_steps - steps, 1),
+                                                         time_limit_s=max(left, 1e-3)))
+            steps, restarts, cpu = steps + out.steps, restarts + out.restarts, cpu + out.cpu_s
+            self.relaxation = replace(out, steps=steps, restarts=restarts, cpu_s=cpu)
+            self.store.save()
+            self.start = self.store.saved
+            note = (f"{why}; then dynamic relaxation: {steps} steps, {restarts} restarts, residual "
+                    f"{out.residual_N:.3g} N ({out.message})")
+            if self.out_of_time():
+                return False, note
+            ok, message = self.relax_one_iteration(1.0)
+            if ok:
+                return True, note
+            notes.append(f"from {out.residual_N:.3g} N: {message}")
+            if not out.converged or target <= floor or steps >= s.bundle_relax_steps or self.timed_out:
+                return False, f"{note}; the continuation " + "; ".join(notes)
+            target = max(target / s.bundle_relax_handover_fall, floor)
+
+    def sweep_cables(self) -> None:
+        """Several cables: block Gauss–Seidel by cable (:func:`exucable.solve.block_sweeps.block_sweeps`)
+        from the start at full load, at most ``bundle_block_sweeps`` sweeps, to ``bundle_relax_within``
+        stop tolerances; its best state becomes the start of every phase after (:attr:`sweeps` holds
+        the outcome)."""
+        from .block_sweeps import BlockSweepSettings, block_sweeps
 
         s = self.settings
         self.at_scale(1.0)
         self.store.saved = self.start
         self.store.restore_as_initial()
         left = s.time_limit_s - (time.process_time() - self._cpu_start)
-        out = relax_bundle(self.model, RelaxSettings(residual_N=s.bundle_relax_within * self.tolerance_N,
-                                                     max_steps=s.bundle_relax_steps, time_limit_s=max(left, 1e-3)))
-        self.relaxation = out
+        model = self.model
+        out = block_sweeps(model, self.start[0][model.ode2_index], self.c0,
+                           BlockSweepSettings(residual_N=s.bundle_relax_within * self.tolerance_N,
+                                              max_sweeps=s.bundle_block_sweeps, time_limit_s=max(left, 1e-3),
+                                              coarse_steps=s.bundle_block_coarse_steps))
+        self.sweeps = out
+        sd = self.mbs.systemData
+        ode2 = np.array(self.start[0])
+        ode2[model.ode2_index] = out.q
+        for cfg in (exu.ConfigurationType.Initial, exu.ConfigurationType.Current):
+            sd.SetODE2Coordinates(ode2, configuration=cfg)
         self.store.save()
         self.start = self.store.saved
-        note = (f"{why}; then dynamic relaxation: {out.steps} steps, {out.restarts} restarts, residual "
-                f"{out.residual_N:.3g} N ({out.message})")
-        if self.out_of_time():
-            return False, note
-        ok, message = self.relax_one_iteration(1.0)
-        return ok, note if ok else f"{note}; from there: {message}"
 
     def shorten_step(self, residual_N: float, limit_N: float) -> float:
         """Go back along the one-iteration step just made (its true residual ``residual_N`` above
@@ -853,6 +921,9 @@ class SteadySolver:
                 warm_note = f" (from the coarse mesh's state: {why}; again from the rope start)"
                 self.forget_history()
         if not ok:
+            if (self.bundle and self.settings.bundle_block_sweeps and not self.timed_out
+                    and model.steady_force_supported):
+                self.sweep_cables()
             self.store.saved = self.start
             ok, first_message = self.relax_one_iteration(1.0)
             if (not ok and self.bundle and self.settings.bundle_relax_steps and not self.timed_out
@@ -870,9 +941,15 @@ class SteadySolver:
                 if not ok and self.curvature_note:
                     first_message += f" (before it, {self.curvature_note})"
             first_message += warm_note
+            if self.sweeps is not None:
+                b = self.sweeps
+                first_message = (f"from the state of {b.sweeps} block sweeps by cable ({b.cpu_s:.3g} s CPU, "
+                                 f"residual {b.residual_N:.3g} N: {b.message}): {first_message}")
         if ok:
             message = (f"{self.accepted} pseudo-time steps from the coarse mesh's state" if started_from != "rope"
                        else f"{self.accepted} pseudo-time steps{warm_note}")
+            if self.sweeps is not None:
+                message += f" ({first_message.split('): ')[0]})"
             if self.relaxation is not None:
                 r = self.relaxation
                 message += (f" (after the one-iteration steps from the rope start failed, from the state of a "
