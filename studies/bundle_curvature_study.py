@@ -10,7 +10,7 @@ continuation's smallest residual in 40 steps from the relaxed state, from the ro
 relaxed state moved by ``--moves`` [m] along every mode below −15 s⁻² (signed by the forces' work). ``--quick``: two cables, 34 m, 2 s
 of relaxation (a smoke run).
 
-    nice .venv/bin/python studies/bundle_curvature_study.py [--relax 15] [--moves 0,0.002,0.01]
+    nice .venv/bin/python studies/bundle_curvature_study.py [--relax 15] [--moves 0,0.002,0.01] [--scenario FILE]
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import time
 import numpy as np
 
 from exucable.model.bundle import build_bundle_model
+from exucable.scenario.specs import load_scenario
 from exucable.solve import steady as st
 from exucable.solve import negative_curvature as nc
 from exucable.solve.onset_continuation import OnsetSettings
@@ -51,12 +52,14 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--relax", type=float, default=15.0, help="CPU time of the dynamic relaxation [s]")
     p.add_argument("--moves", default="0,0.002,0.01", help="nodal moves along the negative modes [m]")
+    p.add_argument("--scenario", help="a bundle scenario file instead of the 100 m route (steady mode)")
     p.add_argument("--quick", action="store_true")
     a = p.parse_args(argv)
     count, length = (2, 12.0) if a.quick else (3, 100.0)
     if a.quick:
         a.relax, a.moves = 2.0, "0,0.002"
-    scenario = route_scenario(count, length)
+    scenario = route_scenario(count, length) if a.scenario is None else \
+        load_scenario(a.scenario).replace(**{"solver.mode": "steady", "solver.cable_element": "compiled"})
     model, solver = _solver(scenario)
     t0 = time.process_time()
     solver.store.saved = solver.start
