@@ -25,6 +25,9 @@ and CPU follow the table, with the first layer ``--onset`` [m] (the solve's defa
 ``--no-onset``, the law of one cable throughout (the stall).
 
     nice .venv/bin/python studies/bundle_upbend_study.py [--limit 60] [--quick] [--onset 5e-4 | --no-onset]
+        [--start clearance | statics | axis]
+
+``--start``: the bundle's start (``build_bundle_model``'s ``start_path``; the default's when not given).
 
 ``--quick``: the up-bend and the down-bend only (triangular, frictionless between the cables), with a
 5 s CPU limit, and the diagnosis of what the up-bend reached in it.
@@ -75,9 +78,9 @@ class RecordingSolver(st.SteadySolver):
         self.accepted_states.append((lam, residual, q.copy(), ae.copy()))
 
 
-def run_case(bend, arrangement, cf, limit, onset=None):
+def run_case(bend, arrangement, cf, limit, onset=None, start=None):
     sc = scenario(bend, arrangement, cf, limit)
-    model = build_bundle_model(sc)
+    model = build_bundle_model(sc) if start is None else build_bundle_model(sc, start_path=start)
     solver = RecordingSolver(model, st.SteadySettings.from_solver(sc.solver), onset=onset)
     c0 = time.process_time()
     out = solver.solve()
@@ -176,6 +179,7 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="the up- and down-bend only, 5 s CPU each")
     p.add_argument("--onset", type=float, default=OnsetSettings().first_m, help="the first onset layer [m]")
     p.add_argument("--no-onset", action="store_true", help="the law of one cable throughout (no onset layer)")
+    p.add_argument("--start", choices=("clearance", "statics", "axis"), help="the bundle's start (default: the model's)")
     args = p.parse_args(argv)
     onset = None if args.no_onset else OnsetSettings(first_m=args.onset)
     cases = CASES
@@ -188,7 +192,7 @@ def main(argv=None) -> int:
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     kept, layers = None, []
     for bend, arrangement, cf in cases:
-        model, solver, out, cpu, smallest, pull = run_case(bend, arrangement, cf, args.limit, onset)
+        model, solver, out, cpu, smallest, pull = run_case(bend, arrangement, cf, args.limit, onset, args.start)
         print(f"| {bend} | {arrangement} | {cf:g} | {out.status} | {cpu:.2f} | {out.newton_iterations} | {smallest:.3g} "
               f"| {solver.tolerance_N:.3g} | {pull:.6g} |", flush=True)
         if out.onset_layer is not None:

@@ -31,13 +31,13 @@ R_CABLE, R_DUCT, DENSITY, MU, G = 0.015, 0.05, 2000.0, 0.3, 9.81
 BACK_TENSION_N = 1000.0
 
 
-def scenario():
-    route = xc.Route(inner_radius=R_DUCT).straight(3.0).bend(90, radius=5.0, turn="left").straight(3.0)
+def scenario(route=None, back_tension_N=BACK_TENSION_N):
+    route = route or xc.Route(inner_radius=R_DUCT).straight(3.0).bend(90, radius=5.0, turn="left").straight(3.0)
     return xc.Scenario(route=route,
                        cable=xc.Cable(radius=R_CABLE, density=DENSITY, youngs_modulus=2e8, count=3,
                                       arrangement="triangular"),
                        contact=xc.Contact(friction=MU, check_points_per_element=8),
-                       pull=xc.Pull(speed=0.1, back_tension=BACK_TENSION_N), gravity=xc.Gravity(g=G),
+                       pull=xc.Pull(speed=0.1, back_tension=back_tension_N), gravity=xc.Gravity(g=G),
                        solver=xc.Solver(mode="steady", steady_lead_out=0.0))
 
 
@@ -89,3 +89,26 @@ def test_from_the_path_the_bend_solves_to_the_calculators_bracket(models):
     lo, hi = sorted((calculators_pull_N(centre, R_DUCT - R_CABLE),
                      calculators_pull_N(centre, R_DUCT - R_CABLE * (1.0 + 2.0 / math.sqrt(3.0)))))
     assert lo * (1 - 5e-3) <= F <= hi * (1 + 5e-3)
+
+
+def test_the_statics_start_lies_inside_the_duct_and_the_cables_clear_of_each_other():
+    """``start_path = "statics"`` on the bend and on the up-bend of ``studies/bundle_upbend_study.py``
+    (30°, 5 m radius, 300 N back tension), where its cables cross the duct: in 200 planes across the
+    duct every cable's axis is at most R − r from the duct's axis and at least 2r from the others'
+    (20 µm: the cubic elements between the nodes laid on the statics' rests)."""
+    from exucable.model.bundle import bundle_cross_sections
+
+    up = xc.Route(inner_radius=R_DUCT).straight(3.0).bend(30, radius=5.0, turn="up").straight(3.0)
+    for sc in (scenario(), scenario(up, 300.0)):
+        model = build_bundle_model(sc, start_path="statics")
+        L = model.conduit.centreline.length_m
+        x = bundle_cross_sections(model, np.linspace(0.05, L - 0.05, 200))          # (200, 3, 2)
+        assert np.max(np.hypot(x[..., 0], x[..., 1])) <= R_DUCT - R_CABLE + 2e-5
+        for i in range(3):
+            for j in range(i + 1, 3):
+                assert np.min(np.hypot(*(x[:, i] - x[:, j]).T)) >= 2 * R_CABLE - 2e-5
+
+
+def test_an_unknown_start_is_refused_naming_the_choices():
+    with pytest.raises(xc.ModelError, match="statics"):
+        build_bundle_model(scenario(), start_path="rolled")

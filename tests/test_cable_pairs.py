@@ -190,3 +190,30 @@ def test_compiled_assembly_on_a_long_bent_bundle(window):
     b = kernel("numba", n_el=n_el, Le=Le, n_k=12, window=window).evaluate(q)
     assert a.n_in_contact > 100
     assert abs(a.jacobian - b.jacobian).max() <= 1e-11 * abs(a.jacobian).max()
+
+
+def test_without_cable_friction_the_rates_sweep_is_left_out_bit_for_bit():
+    """Without friction and damping between the cables ∂Q/∂u is zero entry by entry, and the steady
+    Jacobian's assembly leaves its sweep out: the same matrix, bit for bit, as with the sweep (and
+    the numpy path's sparse products to round-off); S q and Sᵀ f compiled are the sparse products' bits."""
+    from dataclasses import replace
+
+    n_el, Le, bend_R = 40, 0.02, 0.3
+    q = bundle_q(np.random.default_rng(11), n_el=n_el, Le=Le, wobble=2e-4).reshape(-1, 6)
+    x, y = q[:, 0].copy(), q[:, 1].copy()
+    q[:, 0], q[:, 1] = (bend_R + y) * np.sin(x / bend_R), bend_R - (bend_R + y) * np.cos(x / bend_R)
+    q = q.reshape(-1)
+    law = replace(LAW, friction=0.0)
+    k = kernel("numba", n_el=n_el, Le=Le, n_k=12, law=law)
+    res = k.evaluate(q)
+    c = k.contacts(q, jacobian=True)
+    assert len(c["t"]) > 100 and not np.any(c["jac_u"])
+    full = k._assemble([(c["jac_x"], k._coef, 1.0), (c["jac_u"], k._coef_d, k.speed_m_per_s)], c["index"])
+    assert (res.jacobian != full).nnz == 0
+    a = kernel("numpy", n_el=n_el, Le=Le, n_k=12, law=law).evaluate(q)
+    assert abs(a.jacobian - res.jacobian).max() <= 1e-11 * abs(a.jacobian).max()
+    X, U = k.points(q)
+    np.testing.assert_array_equal(X.reshape(-1), k.S @ q)
+    np.testing.assert_array_equal(U.reshape(-1), k.speed_m_per_s * (k.dS @ q))
+    np.testing.assert_array_equal(res.generalized_force, k.St @ (np.bincount(
+        (3 * c["index"][:, :, None] + np.arange(3)).reshape(-1), weights=c["force"].reshape(-1), minlength=X.size)))

@@ -35,6 +35,12 @@ def _iterates(sc, backend: str, steps: int = 3):
     if backend == "exudyn":
         solver.static = ExudynStatic(model.mbs, static_settings)
     assert type(solver.static).__name__ == {"exudyn": "ExudynStatic", "exucable": "OwnStaticNewton"}[backend]
+    return one_iteration_steps(model, solver, steps)
+
+
+def one_iteration_steps(model, solver, steps: int):
+    """``steps`` one-iteration pseudo-time steps of ``solver`` from its stored state, each from the
+    last (the rate falling by 8 per step): per step the tuple of :func:`_iterates`."""
     out = []
     rate = solver.c0
     for _ in range(steps):

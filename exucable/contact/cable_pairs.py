@@ -30,10 +30,13 @@ in a dynamic run U = S q̇, the nodal rates mapped to the point, and ∂Q/∂q̇
 Broad phase: the cables are meshed alike and laid side by side, so the check point at index p of
 one cable lies beside the points near index p of the others. Only the segments within ``window``
 indices of p are searched, linear in the route length. The compiled search goes by blocks of
-G ≈ √(2·window) segments, each in a bounding ball: a block whose ball lies farther from P than a
-segment already found is skipped, so it finds the full scan's segment (the same one, ties included)
-in about 2√(2·window) tests instead of 2·window (at 69 check points per element, window 209:
-a pass 26 → 3.4 ms).
+G = g² segments, each in a bounding ball and split into g sub-blocks of g segments in balls of their
+own (g ≈ (2·window/3)^⅓): a block or sub-block whose ball lies farther from P than a segment already
+found (the previous point's nearest segment and its neighbours) is skipped, so it finds the full
+scan's segment (the same one, ties included: the segments left are scanned in index order) in about
+3·(2·window/3)^⅓ tests instead of 2·window (at 69 check points per element, window 209: a pass 26 →
+3.4 ms with one level of blocks; on the 100 m three-cable route, 60 check points, window 182: 5.2 →
+2.4 ms with two, the same contacts bit for bit).
 A closest segment at the window's edge (not at a cable's end) is counted (``at_window_edge``), so
 that a run whose cables slid apart along the route by more than the window says so.
 
@@ -246,39 +249,118 @@ def _segment_distance2(X, j, px, py, pz):
 
 
 @njit(**_JIT)
+def _hermite_points(q, n_cables, n_el, n_k, coef, out):
+    """S q without the sparse matrix: out[c·n_points + p, i] = Σ_a coef[p, a] q[slot a of point p's
+    element, i] of cable c, summed in S's stored order (a = 0..3 after 0.0, as scipy's CSR product
+    does: the same bits)."""
+    n_points = n_el * n_k
+    n1 = 6 * (n_el + 1)
+    for c in range(n_cables):
+        for e in range(n_el):
+            b = c * n1 + 6 * e
+            for k in range(n_k):
+                p = e * n_k + k
+                row = c * n_points + p
+                for i in range(3):
+                    s = 0.0
+                    s += coef[p, 0] * q[b + i]
+                    s += coef[p, 1] * q[b + 3 + i]
+                    s += coef[p, 2] * q[b + 6 + i]
+                    s += coef[p, 3] * q[b + 9 + i]
+                    out[row, i] = s
+
+
+@njit(**_JIT)
+def _hermite_transpose(f, n_cables, n_el, n_k, coef, out):
+    """Sᵀ f without the sparse matrix (f: 3 per point, all cables): each coordinate of node n sums its
+    points in increasing order (element n - 1's, then element n's), as Sᵀ's stored rows do."""
+    n_points = n_el * n_k
+    n1 = 6 * (n_el + 1)
+    for c in range(n_cables):
+        for node in range(n_el + 1):
+            for slot in range(2):
+                for i in range(3):
+                    s = 0.0
+                    if node >= 1:
+                        for k in range(n_k):
+                            p = (node - 1) * n_k + k
+                            s += coef[p, 2 + slot] * f[3 * (c * n_points + p) + i]
+                    if node < n_el:
+                        for k in range(n_k):
+                            p = node * n_k + k
+                            s += coef[p, slot] * f[3 * (c * n_points + p) + i]
+                    out[c * n1 + 6 * node + 3 * slot + i] = s
+
+
+@njit(**_JIT)
+def _beyond(centre, radius, px, py, pz, reach):
+    """Whether the ball (``centre``, ``radius``) lies farther than ``reach`` from P (squared distances)."""
+    dx = px - centre[0]
+    dy = py - centre[1]
+    dz = pz - centre[2]
+    lim = reach + radius
+    return dx * dx + dy * dy + dz * dz > lim * lim
+
+
+@njit(**_JIT)
+def _point_forces(index, force, m, out):
+    """Each check point's force (3 per point, all cables) summed from the contacts' ``force`` (m, 9)
+    on their points ``index`` (m, 3), in the contacts' order: numpy's ``bincount`` of the same
+    entries, bit for bit, without its index and weight arrays."""
+    for c in range(m):
+        for al in range(3):
+            base = 3 * index[c, al]
+            for k in range(3):
+                out[base + k] += force[c, 3 * al + k]
+
+
+@njit(**_JIT)
+def _balls(X, ob, n_seg, size, n_blocks, cen, rad):
+    """Bounding balls (centre ``cen`` (n_blocks, 3), radius ``rad``) of the polyline X[ob..]'s blocks
+    of ``size`` consecutive segments (each ball holds its segments' end points, so the segments)."""
+    for k in range(n_blocks):
+        j0 = k * size
+        j1 = min(j0 + size, n_seg)
+        for v in range(j0, j1 + 1):
+            for l in range(3):
+                cen[k, l] += X[ob + v, l]
+        for l in range(3):
+            cen[k, l] /= j1 - j0 + 1
+        r2 = 0.0
+        for v in range(j0, j1 + 1):
+            dx = X[ob + v, 0] - cen[k, 0]
+            dy = X[ob + v, 1] - cen[k, 1]
+            dz = X[ob + v, 2] - cen[k, 2]
+            r2 = max(r2, dx * dx + dy * dy + dz * dz)
+        rad[k] = np.sqrt(r2)
+
+
+@njit(**_JIT)
 def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps2, C, dd, jacobian,
                    index, tpar, pen, force, jac_x, jac_u, edge, layer):
     """Compiled :func:`pair_contacts_reference`; fills the output arrays, returns the contact count."""
     m = 0
-    # the search's blocks: G consecutive segments of a polyline inside a bounding ball (centre,
-    # radius); a block whose ball is farther from P than a segment already found cannot hold the
-    # nearest one and is skipped, so the result is the full window scan's, at a fraction of its cost
-    G = max(4, int(np.sqrt(2.0 * window + 1.0)))
+    # the search's blocks, on two levels: G = g² consecutive segments of a polyline inside a bounding
+    # ball (centre, radius), each split into g sub-blocks of g segments in balls of their own; a
+    # (sub-)block whose ball is farther from P than a segment already found cannot hold the nearest
+    # one and is skipped, so the result is the full window scan's, at a fraction of its cost
+    g = max(2, int(((2.0 * window + 1.0) / 3.0) ** (1.0 / 3.0) + 0.5))
+    G = g * g
     n_seg = n_points - 1
     nb = max(1, (n_seg + G - 1) // G)
+    ns = max(1, (n_seg + g - 1) // g)
     cen = np.zeros((n_cables, nb, 3))
     rad = np.zeros((n_cables, nb))
+    scen = np.zeros((n_cables, ns, 3))
+    srad = np.zeros((n_cables, ns))
     for b in range(n_cables):
         ob = b * n_points
-        for k in range(nb):
-            j0 = k * G
-            j1 = min(j0 + G, n_seg)
-            for v in range(j0, j1 + 1):
-                for l in range(3):
-                    cen[b, k, l] += X[ob + v, l]
-            for l in range(3):
-                cen[b, k, l] /= j1 - j0 + 1
-            r2 = 0.0
-            for v in range(j0, j1 + 1):
-                dx = X[ob + v, 0] - cen[b, k, 0]
-                dy = X[ob + v, 1] - cen[b, k, 1]
-                dz = X[ob + v, 2] - cen[b, k, 2]
-                r2 = max(r2, dx * dx + dy * dy + dz * dz)
-            rad[b, k] = np.sqrt(r2)
+        _balls(X, ob, n_seg, G, nb, cen[b], rad[b])
+        _balls(X, ob, n_seg, g, ns, scen[b], srad[b])
     dr, dn, dvt, dFf = np.empty((3, 9)), np.empty((3, 9)), np.empty((3, 9)), np.empty((3, 9))
     df, dfu, M, MPn = np.empty(9), np.empty(9), np.empty((3, 3)), np.empty((3, 3))
     e, av, n, v, vt, Ff = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    dt, g, u = np.empty(9), np.empty(9), np.empty(9)
+    dt, g9, u = np.empty(9), np.empty(9), np.empty(9)
     for a in range(n_cables):
         for b in range(a + 1, n_cables):
             ob = b * n_points
@@ -290,28 +372,28 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 if last <= first:
                     continue
                 px, py, pz = X[i, 0], X[i, 1], X[i, 2]
-                # an upper bound on the nearest distance: the block of the last point's nearest
-                # segment (or of p's own index)
+                # an upper bound on the nearest distance: the last point's nearest segment and its
+                # neighbours (or p's own index)
                 guess = previous if first <= previous < last else min(max(p, first), last - 1)
-                kg = guess // G
                 ub = np.inf
-                for j in range(max(first, kg * G), min(last, kg * G + G)):
+                for j in range(max(first, guess - 1), min(last, guess + 2)):
                     d2 = _segment_distance2(X, ob + j, px, py, pz)[1]
                     if d2 < ub:
                         ub = d2
                 reach = np.sqrt(ub) + 1e-9
                 best_j, best_t, best_d2 = -1, 0.0, np.inf
                 for k in range(first // G, (last - 1) // G + 1):
-                    if k != kg:
-                        dx = px - cen[b, k, 0]
-                        dy = py - cen[b, k, 1]
-                        dz = pz - cen[b, k, 2]
-                        if np.sqrt(dx * dx + dy * dy + dz * dz) - rad[b, k] > reach:
+                    if _beyond(cen[b, k], rad[b, k], px, py, pz, reach):
+                        continue
+                    for sk in range(k * g, min(k * g + g, ns)):
+                        j0 = max(first, sk * g)
+                        j1 = min(last, sk * g + g)
+                        if j0 >= j1 or _beyond(scen[b, sk], srad[b, sk], px, py, pz, reach):
                             continue
-                    for j in range(max(first, k * G), min(last, k * G + G)):
-                        t, d2 = _segment_distance2(X, ob + j, px, py, pz)
-                        if d2 < best_d2:
-                            best_j, best_t, best_d2 = j, t, d2
+                        for j in range(j0, j1):
+                            t, d2 = _segment_distance2(X, ob + j, px, py, pz)
+                            if d2 < best_d2:
+                                best_j, best_t, best_d2 = j, t, d2
                 if best_j < 0:
                     continue
                 previous = best_j
@@ -341,9 +423,9 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                         dt[3 + k] = -e[k] / c - q
                         dt[6 + k] = q
                 for k in range(3):
-                    g[k] = n[k]
-                    g[3 + k] = -(1.0 - t) * n[k]
-                    g[6 + k] = -t * n[k]
+                    g9[k] = n[k]
+                    g9[3 + k] = -(1.0 - t) * n[k]
+                    g9[6 + k] = -t * n[k]
                 w = weight[p]
                 f = w * K * phi ** ex
                 for k in range(3):
@@ -366,7 +448,7 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                 for k in range(3):
                     Ff[k] = -mu * f * h * vt[k]
                 for k in range(9):
-                    force[m, k] = f * g[k]
+                    force[m, k] = f * g9[k]
                 for k in range(3):
                     force[m, k] += Ff[k]
                     force[m, 3 + k] -= (1.0 - t) * Ff[k]
@@ -396,14 +478,14 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                     coef = -w * K * ex * phi ** (ex - 1.0) * dphi
                     ud0, ud1, ud2 = u[3] - u[6], u[4] - u[7], u[5] - u[8]      # U0 - U1
                     for l in range(9):
-                        df[l] = coef * g[l]
+                        df[l] = coef * g9[l]
                         dfu[l] = 0.0
                     if C > 0.0:
                         n_ud = n[0] * ud0 + n[1] * ud1 + n[2] * ud2
                         for l in range(9):
                             drate = -(v[0] * dn[0, l] + v[1] * dn[1, l] + v[2] * dn[2, l] + n_ud * dt[l])
-                            df[l] += w * C * (-don * (-vn) * g[l] + on * drate)
-                            dfu[l] = -w * C * on * g[l]
+                            df[l] += w * C * (-don * (-vn) * g9[l] + on * drate)
+                            dfu[l] = -w * C * on * g9[l]
                     # M = ∂(h v_τ)/∂v_τ; ∂v_τ/∂x = (I - n nᵀ)(U0 - U1) ⊗ ∂t/∂x - (n vᵀ + (n·v) I) ∂n/∂x
                     for k in range(3):
                         for j in range(3):
@@ -435,13 +517,13 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                             sw = 0.0 if blk == 0 else (n[k] if blk == 1 else -n[k])
                             fs = 0.0 if blk == 0 else (Ff[k] if blk == 1 else -Ff[k])
                             for l in range(9):
-                                jac_x[m, r_, l] = (g[r_] * df[l] + f * (ab * dn[k, l] + sw * dt[l])
+                                jac_x[m, r_, l] = (g9[r_] * df[l] + f * (ab * dn[k, l] + sw * dt[l])
                                                    + ab * dFf[k, l] + fs * dt[l])
                             for blk2 in range(3):
                                 ac = a0 if blk2 == 0 else (a1 if blk2 == 1 else a2)
                                 for j in range(3):
                                     l = 3 * blk2 + j
-                                    jac_u[m, r_, l] = g[r_] * dfu[l] + ab * (-mu * (h * vt[k]) * dfu[l]
+                                    jac_u[m, r_, l] = g9[r_] * dfu[l] + ab * (-mu * (h * vt[k]) * dfu[l]
                                                                             - mu * f * (MPn[k, j] * ac))
                 m += 1
     return m
@@ -589,6 +671,9 @@ class CableContactKernel:
         self._acc = None
         one = sparse.csr_matrix((vals, (rows, cols)), shape=(3 * self.n_points, self.n_coordinates_per_cable))
         done = sparse.csr_matrix((dvals, (rows, cols)), shape=one.shape)
+        # S's and S''s values per point and slot, in their stored order (for _hermite_points)
+        self._s_coef = np.ascontiguousarray(one.data.reshape(self.n_points, 3, 4)[:, 0, :])
+        self._ds_coef = np.ascontiguousarray(done.data.reshape(self.n_points, 3, 4)[:, 0, :])
         self.S = sparse.block_diag([one] * self.n_cables, format="csr")
         self.dS = sparse.block_diag([done] * self.n_cables, format="csr")
         self.St = self.S.T.tocsr()
@@ -616,8 +701,14 @@ class CableContactKernel:
         steady-sliding V ∂r/∂x, or with the nodal rates ``q_t`` (a dynamic state) S q̇."""
         q = np.asarray(q, dtype=float).reshape(-1)
         if q_t is not None:
-            return (self.S @ q).reshape(-1, 3), (self.S @ np.asarray(q_t, dtype=float).reshape(-1)).reshape(-1, 3)
-        return (self.S @ q).reshape(-1, 3), (self.speed_m_per_s * (self.dS @ q)).reshape(-1, 3)
+            return self._map(self._s_coef, q), self._map(self._s_coef, np.asarray(q_t, dtype=float).reshape(-1))
+        return self._map(self._s_coef, q), self.speed_m_per_s * self._map(self._ds_coef, q)
+
+    def _map(self, coef, q) -> np.ndarray:
+        """S q (or S' q) as (n_cables·n_points, 3), compiled (the sparse product's bits, 8x faster)."""
+        out = np.empty((self.n_cables * self.n_points, 3))
+        _hermite_points(np.ascontiguousarray(q, dtype=float), self.n_cables, self.n_el, self.n_k, coef, out)
+        return out
 
     def contacts(self, q, jacobian: bool = False, q_t=None, copy: bool = True) -> dict:
         """Every contact at absolute coordinates ``q`` (see :func:`pair_contacts_reference`), the
@@ -694,18 +785,23 @@ class CableContactKernel:
 
         c = self.contacts(q, jacobian, q_t, copy=False)
         n3 = 3 * self.n_points * self.n_cables
-        dof = (3 * c["index"][:, :, None] + np.arange(3)[None, None, :]).reshape(-1, 9)   # (m, 9)
-        f_pts = np.bincount(dof.reshape(-1), weights=c["force"].reshape(-1), minlength=n3)
-        Q = self.St @ f_pts
+        f_pts = np.zeros(n3)
+        _point_forces(c["index"], c["force"], len(c["index"]), f_pts)
+        Q = np.empty(self.n_coordinates)
+        _hermite_transpose(f_pts, self.n_cables, self.n_el, self.n_k, self._s_coef, Q)       # Sᵀ f
         J = J_t = None
         if jacobian and self.backend == "numba":
             # Sᵀ J S summed into node blocks in one compiled pass (the same sums as the sparse
             # products below, in another order: round-off only)
+            # without friction and damping between the cables ∂Q/∂u is zero entry by entry (its
+            # terms are multiples of μ_c and C), so its sweep would add zeros only (half the cost)
+            moving = self.law.friction != 0.0 or self.law.damping != 0.0
             J = self._assemble([(c["jac_x"], self._coef, 1.0)] + (
-                [(c["jac_u"], self._coef_d, self.speed_m_per_s)] if q_t is None else []), c["index"])
+                [(c["jac_u"], self._coef_d, self.speed_m_per_s)] if q_t is None and moving else []), c["index"])
             if q_t is not None:
                 J_t = self._assemble([(c["jac_u"], self._coef, 1.0)], c["index"])
         elif jacobian:
+            dof = (3 * c["index"][:, :, None] + np.arange(3)[None, None, :]).reshape(-1, 9)   # (m, 9)
             r = np.broadcast_to(dof[:, :, None], (len(dof), 9, 9)).reshape(-1)
             k = np.broadcast_to(dof[:, None, :], (len(dof), 9, 9)).reshape(-1)
             Jx = sparse.csr_matrix((c["jac_x"].reshape(-1), (r, k)), shape=(n3, n3))

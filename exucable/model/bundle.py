@@ -41,7 +41,7 @@ from .generic import add_user_force_object
 from .layout import CableLayout, lay_cable, plan_cable_mesh, steady_lead_out_m
 from .rig import Drive, add_drive, add_end_force
 
-__all__ = ["BundleModel", "arrangement_offsets", "load_turn_rad", "start_tensions", "build_bundle_model", "check_bundle_supported",
+__all__ = ["BundleModel", "arrangement_offsets", "load_turn_rad", "start_tensions", "build_bundle_model", "statics_start", "check_bundle_supported",
            "bundle_arrangement", "bundle_report", "bundle_tension_profile", "straight_weight_correction",
            "bundle_sections", "bundle_cross_sections", "bundle_tension_along_conduit"]
 
@@ -251,6 +251,110 @@ def _centroid_path(centreline, offsets_m, friction: float, weight_per_length_N_p
                                          cable_length_m=cable_length_m)
     except ModelError:
         return None
+
+
+#: Stations of the statics start per blend length (the cable's bending length or one element) [-].
+STATIONS_PER_BLEND = 10
+
+
+@dataclass
+class StaticsStart:
+    """The cables' places across the duct from the cross-section's statics (:func:`statics_start`).
+
+    Attributes
+    ----------
+    s_m : ndarray (m,)
+        Stations along the pull-oriented centreline [m].
+    offsets : ndarray (m, n_cables, 2)
+        Each cable's axis (horizontal, up) from the duct's axis [m].
+    forward : ndarray (m, n_cables, 2)
+        The continuation from the trailing end alone [m].
+    join_s_m : float or None
+        Where the continuation back from the eye's arrangement meets the forward one and takes over
+        [m]; None where they never meet (the forward one kept, blended into the eye's in the last element).
+    newton_steps : int
+        Newton steps of the two continuations together.
+    """
+
+    s_m: np.ndarray
+    offsets: np.ndarray
+    forward: np.ndarray
+    join_s_m: float | None
+    newton_steps: int
+
+    def offsets_m(self, s_m, cable: int) -> np.ndarray:
+        """Cable ``cable``'s axis (horizontal, up) from the duct's axis at ``s_m`` [m], shape (m, 2)."""
+        s = np.asarray(s_m, dtype=float)
+        return np.stack([np.interp(s, self.s_m, self.offsets[:, cable, j]) for j in range(2)], axis=1)
+
+
+def statics_start(centreline, tension_fns, weight_per_length_N_per_m: float, inner_radius_m: float,
+                  laid_radius_m: float, laid_offsets_m, s_grid_m, turn_rad, blend_length_m: float,
+                  own_tensions: bool = False) -> StaticsStart:
+    """The cables across the duct along the route from the statics of each cross-section
+    (:mod:`exucable.quasistatic.cross_section`), continued station by station so that the cables'
+    order and contacts carry over.
+
+    Cable i's lateral load per length is the rope equation's p = T κ n − w (e_z − (e_z·t) t) with T
+    the cables' mean start tension (``tension_fns``: :func:`start_tensions`), smoothed along s with a
+    Gaussian of ``blend_length_m`` as the cable's bending stiffness spreads a bend's end: equal loads,
+    so the arrangement moves as a whole where the load turns (a triangle lifting in an up-bend until
+    its top cable meets the upper wall, the two others sliding up beside it). ``own_tensions``: each
+    cable's own start tension instead, so a cable resting on the others presses with its lower one;
+    at an up-bend's entry the top cable of a triangle then drops between the two others as they lift
+    (the frictionless rigid circles' answer under those loads), a turn over the cables cannot make
+    within the few elements the smoothing gives it (overlaps of millimetres between the nodes;
+    ``benchmarks/bundle_start.py`` measures both). The circles are the laid ones (``laid_radius_m``,
+    :data:`START_GAP` larger than the cables), stations :data:`STATIONS_PER_BLEND` per blend length.
+
+    Two continuations: forward from the trailing end (``laid_offsets_m`` turned by ``turn_rad`` at
+    the first station), and back from the eye's arrangement (``laid_offsets_m`` turned by the last
+    station's ``turn_rad``, as the eye holds the cables) until the two agree within 2 % of a radius at
+    every cable; the back one is used from there to the eye. Rigid circles snap across the duct
+    where their loads turn (a triangle lifting in an up-bend within one station); a cable takes a
+    bending length at least and the mesh an element or two, so the rests are smoothed over
+    ``blend_length_m`` and then pushed apart where the smoothing made two overlap
+    (:func:`~exucable.quasistatic.cross_section.separate_circles`).
+    """
+    from ..quasistatic.cross_section import rest_along, separate_circles
+
+    s_grid = np.asarray(s_grid_m, dtype=float)
+    L = float(s_grid[-1])
+    m = max(int(math.ceil(STATIONS_PER_BLEND * (L - s_grid[0]) / max(blend_length_m, 1e-9))), 2) + 1
+    s = np.linspace(s_grid[0], L, m)
+    t = np.atleast_2d(centreline.tangent(s))
+    kn = np.atleast_2d(centreline.curvature_vector(s))
+    ez = np.array([0.0, 0.0, 1.0])
+    across = ez[None, :] - (t @ ez)[:, None] * t
+    eh, ev = _cross_section_frame(centreline, s)
+    sigma = blend_length_m / (s[1] - s[0])
+    loads = []
+    T_own = [np.asarray(fn(s), dtype=float) for fn in tension_fns]
+    T_mean = np.mean(T_own, axis=0)
+    for T in T_own:
+        p = _smooth_rows((T if own_tensions else T_mean)[:, None] * kn - weight_per_length_N_per_m * across, sigma)
+        loads.append(np.stack([np.einsum("ij,ij->i", p, eh), np.einsum("ij,ij->i", p, ev)], axis=1))
+    loads = np.stack(loads, axis=1)                                     # (m, n, 2)
+    turn = np.interp(s, s_grid, turn_rad)
+    laid = np.asarray(laid_offsets_m, dtype=float)
+
+    def turned(phi):
+        c, sn = math.cos(phi), math.sin(phi)
+        return np.stack([laid[:, 0] * c - laid[:, 1] * sn, laid[:, 0] * sn + laid[:, 1] * c], axis=1)
+
+    fwd, steps_f = rest_along(loads, inner_radius_m, laid_radius_m, turned(turn[0]))
+    back, steps_b = rest_along(loads[::-1], inner_radius_m, laid_radius_m, turned(turn[-1]),
+                               stop_near=fwd[::-1], tolerance_m=0.02 * laid_radius_m)
+    out = fwd.copy()
+    join = None
+    if len(back) < m:             # met: from the meeting station on, the back continuation
+        k = m - len(back)
+        out[k:] = back[::-1]
+        join = float(s[k])
+    out = _smooth_rows(out.reshape(m, -1), sigma).reshape(out.shape)
+    for i in range(m):
+        out[i] = separate_circles(out[i], inner_radius_m, laid_radius_m)
+    return StaticsStart(s_m=s, offsets=out, forward=fwd, join_s_m=join, newton_steps=steps_f + steps_b)
 
 
 @dataclass
@@ -614,7 +718,14 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
     ``start_path``: ``"clearance"`` lays the bundle's centroid on the rope with clearance's path
     (:func:`_centroid_path`; where that rope has no solution, as ``"axis"``); ``"axis"`` lays the
     arrangement about the duct's axis, turned toward the centreline rope's lateral load
-    (:func:`load_turn_rad`), the start before the path was used, kept to compare the two.
+    (:func:`load_turn_rad`), the start before the path was used, kept to compare the two;
+    ``"statics"`` lays each cable where the statics of its cross-section puts it, continued along
+    the route so that the cables keep their order (:func:`statics_start`; no free spans: the
+    cables rest on the wall or each other at every station), except in the last element, blended
+    into the circles the eye holds as the other starts lay them there (equal loads on the cables;
+    ``"statics_own"``: each cable's load from its own start tension). Measured against
+    ``"clearance"`` in ``benchmarks/bundle_start.py`` (``reference/README.md``, "A start from the
+    cross-section's statics"): not the default.
 
     Raises
     ------
@@ -667,8 +778,11 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
     # the wall and 2 mm into each other at 1 m elements and a 0.5 m roll)
     T_ref = max(float(np.max(rope.tension_N)), 1e-6)
     blend = max(L_cable / n_el, math.sqrt(c.bending_stiffness_N_m2 / T_ref))
+    if start_path not in ("clearance", "axis", "statics", "statics_own"):
+        raise ModelError("start_path", f"{start_path!r} is not a bundle start; use \"clearance\", \"statics\", "
+                                       "\"statics_own\" or \"axis\"")
     path = _centroid_path(centre, offsets, sc.contact.friction * wcf, w, back, L_cable - lead_out) \
-        if start_path == "clearance" else None
+        if start_path != "axis" else None
     start_rope = rope if path is None else path
     tension_fns = start_tensions(centre, start_rope, offsets, sc.conduit.inner_radius_m - c.radius_m, w, back)
     if path is None:
@@ -693,20 +807,33 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
     # laid as circles START_GAP·r larger: the cables start that far off the wall and apart, so what
     # the fit and the roll leave over is a gap the first steps close, not an overlap they must undo
     try:
-        laid = arrangement_offsets(n, arrangement, sc.conduit.inner_radius_m, (1.0 + START_GAP) * c.radius_m)
+        laid_r = (1.0 + START_GAP) * c.radius_m
+        laid = arrangement_offsets(n, arrangement, sc.conduit.inner_radius_m, laid_r)
     except ModelError:
-        laid = offsets
+        laid, laid_r = offsets, c.radius_m
 
     # ...except in the last element before the exit and beyond: the eye holds the leading ends where
     # they are laid, and there they are the rigid circles (a gap held open at the eye is not the pull's)
     L_e = L_cable / n_el
     layouts = []
     mid0, mid1 = offsets.mean(axis=0), laid.mean(axis=0)
+    statics = None
+    if start_path in ("statics", "statics_own"):
+        statics = statics_start(centre, tension_fns, w, sc.conduit.inner_radius_m, laid_r, laid, s_grid, turn, blend,
+                                own_tensions=start_path == "statics_own")
     laid_radius = float(np.max(np.hypot(laid[:, 0], laid[:, 1])))   # the laid circles' distance to the wall
     for (h0, v0), (h1, v1), cable_tension_fn in zip(offsets, laid, tension_fns):
-        def offset_fn(s, h0=h0, v0=v0, h1=h1, v1=v1):
+        def offset_fn(s, h0=h0, v0=v0, h1=h1, v1=v1, i=len(layouts)):
             eh, ev = _cross_section_frame(centre, s)
             f = np.clip((centre.length_m - np.asarray(s, dtype=float)) / L_e, 0.0, 1.0)[:, None]
+            if statics is not None:
+                # the cross-section's statics, blended in the last element into the circles the eye
+                # holds (the rigid arrangement turned as the other starts turn it there)
+                phi = np.interp(s, s_grid, turn)[:, None]
+                x = statics.offsets_m(s, i)
+                h = f * x[:, :1] + (1.0 - f) * (h0 * np.cos(phi) - v0 * np.sin(phi))
+                v = f * x[:, 1:] + (1.0 - f) * (h0 * np.sin(phi) + v0 * np.cos(phi))
+                return h * eh + v * ev
             h, v = h0 + f * (h1 - h0), v0 + f * (v1 - v0)
             phi = np.interp(s, s_grid, turn)[:, None]
             o = (h * np.cos(phi) - v * np.sin(phi)) * eh + (h * np.sin(phi) + v * np.cos(phi)) * ev

@@ -354,11 +354,11 @@ FIELDS: tuple[Field, ...] = (
            "system use Exudyn's element"),
     F("solver.static_solver", "static_solver", "choice", "", "exucable", choices=("exucable", "exudyn"), ours=True,
       rule="steady mode: who runs the static solves' Newton iterations: `\"exucable\"`, our own Newton loop on the "
-           "assembled system (the rig's coordinates eliminated, a banded LU of the node-major chain; "
-           "`exucable/solve/newton_system.py`), with Exudyn's stop test, so the iterates are Exudyn's to round-off; "
-           "`\"exudyn\"`, Exudyn's static solver (sparse assembly from triplets, the rig's multipliers, Eigen's "
-           "SparseLU). Ours needs one cable with `cable_element = \"compiled\"`; other models (several cables, "
-           "Exudyn's element) use Exudyn's, and the summary's "
+           "assembled system (the rig's coordinates eliminated, a banded LU of the node-major chain, several "
+           "cables' nodes interleaved; `exucable/solve/newton_system.py`), with Exudyn's stop test, so the iterates "
+           "are Exudyn's to round-off; `\"exudyn\"`, Exudyn's static solver (sparse assembly from triplets, the "
+           "rig's multipliers, Eigen's SparseLU). Ours needs `cable_element = \"compiled\"`; other models "
+           "(Exudyn's element, items of a user's own) use Exudyn's, and the summary's "
            "`static_solver` says which ran (docs/decisions/0005-own-static-newton.md)"),
     # ---- output
     F("output.snapshots", "snapshots_s", "custom", "s", (), ours=True, default_doc="none",

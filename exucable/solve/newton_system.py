@@ -38,7 +38,7 @@ import exudyn as exu
 from scipy.linalg import lapack
 
 __all__ = ["NewtonOutcome", "StaticBackend", "ExudynStatic", "OwnStaticNewton", "own_newton_unsupported",
-           "static_backend", "HALF_BANDWIDTH"]
+           "OwnBundleNewton", "own_bundle_newton_unsupported", "static_backend", "HALF_BANDWIDTH"]
 
 #: Half bandwidth of the node-major chain's Jacobian: a row of node k reaches nodes k ± 1 (6 each).
 HALF_BANDWIDTH = 11
@@ -211,16 +211,8 @@ class OwnStaticNewton(StaticBackend):
         sd = self.mbs.systemData
         where = np.empty(n, dtype=np.int64)
         where[self.index] = np.arange(n)
-        held, ae = [], []
-        for drive in (model.lead_drive, model.trail_drive):
-            if drive is None:
-                continue
-            for c in drive.constraints:
-                marker = self.mbs.GetMarker(self.mbs.GetObject(c)["markerNumbers"][1])
-                held.append(where[self.mbs.GetNodeODE2Index(marker["nodeNumber"]) + int(marker["coordinate"])])
-                ae.append(int(np.asarray(sd.GetObjectLTGAE(c))[0]))
-        self.held = np.asarray(held, dtype=np.int64)
-        self.ae = np.asarray(ae, dtype=np.int64)
+        self.held, self.ae = _held_rows(self.mbs, [d for d in (model.lead_drive, model.trail_drive) if d is not None],
+                                        where)
         self.n_ae = len(sd.GetAECoordinates())
         is_held = np.zeros(n, dtype=bool)
         is_held[self.held] = True
@@ -496,6 +488,20 @@ class OwnStaticNewton(StaticBackend):
         return float(np.sqrt(_squared_norm(r)))
 
 
+def _held_rows(mbs, drives, where) -> tuple[np.ndarray, np.ndarray]:
+    """The coordinates the rig's ``drives`` hold (their constraints' coordinates, as indices into the
+    cables' coordinates through ``where``: system ODE2 index → cable order) and their constraints'
+    multipliers (indices into the AE coordinates)."""
+    sd = mbs.systemData
+    held, ae = [], []
+    for drive in drives:
+        for c in drive.constraints:
+            marker = mbs.GetMarker(mbs.GetObject(c)["markerNumbers"][1])
+            held.append(where[mbs.GetNodeODE2Index(marker["nodeNumber"]) + int(marker["coordinate"])])
+            ae.append(int(np.asarray(sd.GetObjectLTGAE(c))[0]))
+    return np.asarray(held, dtype=np.int64), np.asarray(ae, dtype=np.int64)
+
+
 def _squared_norm(r: np.ndarray) -> float:
     """r·r without BLAS: OpenBLAS splits a dot product of over 10 000 entries across its threads,
     whose start-up cost 7.7 ms of CPU per 77 000-entry residual on this loaded 2-core machine
@@ -503,10 +509,237 @@ def _squared_norm(r: np.ndarray) -> float:
     return float(np.einsum("i,i->", r, r))
 
 
+def own_bundle_newton_unsupported(model, spring=None) -> str:
+    """Why :class:`OwnBundleNewton` cannot solve ``model`` ("" when it can): it needs a steady
+    bundle (:class:`exucable.model.bundle.BundleModel`) whose cables' forces are the compiled
+    element's (``BundleModel.steady_force`` assembles the whole residual), the eye as coordinate
+    constraints on the leading nodes, point forces on node positions as the only loads, and no
+    item but the contacts', the spring's and the eye's."""
+    if getattr(model, "n_cables", 1) < 2 or not hasattr(model, "steady_force"):
+        return "not a bundle"
+    if not model.steady_force_supported:
+        return "the cables are Exudyn's elements (solver.cable_element = \"exudyn\")"
+    mbs = model.mbs
+    sd = mbs.systemData
+    if len(sd.GetODE2Coordinates()) != model.ode2_index.size:
+        return "coordinates other than the cables'"
+    held = {int(c) for d in model.lead_drives for c in getattr(d, "constraints", ())}
+    if len(held) != model.held_coordinates().size or model.trail_drive is not None:
+        return "a rig other than the eye's coordinate constraints"
+    known = {int(c.object) for c in model.wall_couplings} | {int(model.between_coupling.object)} \
+        | ({int(spring.object)} if spring is not None else set())
+    for i in range(sd.NumberOfObjects()):
+        kind = mbs.GetObject(i)["objectType"]
+        if kind == "ConnectorCoordinate" and i in held:
+            continue
+        if kind != "GenericODE2" or i not in known:
+            return f"object {i} ({kind})"
+    for i in range(sd.NumberOfLoads()):
+        load = mbs.GetLoad(i)
+        if load["loadType"] != "ForceVector" or load.get("loadVectorUserFunction", 0) not in (0, None) \
+                or mbs.GetMarker(load["markerNumber"])["markerType"] != "NodePosition":
+            return f"load {i} ({load['loadType']})"
+    return ""
+
+
+class OwnBundleNewton(OwnStaticNewton):
+    """Exudyn's static Newton iterations (the module's notes) on a steady bundle's own assembled
+    system: :class:`OwnStaticNewton`'s loop, with the residual of
+    :meth:`exucable.model.bundle.BundleModel.steady_force`'s parts (each cable's wall coupling, the
+    cable-cable coupling, the end loads) plus the pseudo-time spring, and the stiffness of its parts
+    (the walls' element blocks, the pair kernel's exact Jacobian, the spring's blocks).
+
+    The cables' coordinates are ordered node by node along the route, the cables interleaved
+    (coordinate d of node k of cable c at 6 (k n_cables + c) + d): the elements couple the
+    neighbouring stations and the pairs the stations beside one another, so the matrix is banded;
+    its half bandwidths are read off each iteration's pattern (a pair contact reaches a few nodes
+    along the other cable). ``linear_solver``: ``"banded"`` (LAPACK ``dgbsv`` on that order; SuperLU
+    where the band would be over a quarter of the matrix) or ``"splu"`` (SuperLU, its own column
+    order). Measured on the 100 m three-cable route (half bandwidths 53): dgbsv 1.8 ms with the band's
+    assembly, SuperLU 3.9 ms (COLAMD) or 2.5 ms (the natural order) plus 1.0 ms for its CSC matrix
+    (``benchmarks/bundle_iteration.py``). The couplings' evaluations are their cached ones
+    (force and Jacobian in one kernel pass at a state, as Exudyn's user functions get them), so a
+    Jacobian at a state whose residual was evaluated costs no kernel pass.
+
+    A shortened step's evaluation (:meth:`OwnStaticNewton.evaluate_at`, the line search of
+    ``SteadySolver.shorten_step``) is off unless ``line_search``: with it the continuation takes
+    other steps than Exudyn's solver would (the up-bend's two steady states: the path picks one).
+    """
+
+    name = "exucable"
+
+    #: kl (kl + ku + 1) above which the banded LU (work ∝ n kl (kl + ku)) gives way to SuperLU:
+    #: 2.5 times the work of the route's band at kl = ku = 53 (1.8 ms), about SuperLU's 4.5 ms there
+    BAND_WORK_LIMIT = 14000
+
+    def __init__(self, model, spring, time_s: float = 1.0, linear_solver: str = "banded", checked: bool = False,
+                 line_search: bool = False):
+        why = "" if checked else own_bundle_newton_unsupported(model, spring)
+        if why:
+            raise ValueError(f"our static Newton cannot solve this bundle: {why}")
+        if linear_solver not in ("banded", "splu"):
+            raise ValueError(f"linear_solver must be 'banded' or 'splu', got {linear_solver!r}")
+        if not line_search:
+            self.evaluate_at = None          # SteadySolver.shorten_step reads None as "cannot"
+        self.model, self.mbs, self.spring = model, model.mbs, spring
+        self.time_s = float(time_s)
+        self.linear_solver = linear_solver
+        self.index = np.asarray(model.ode2_index, dtype=np.int64)
+        n = self.n = self.index.size
+        n_c = model.n_cables
+        n1 = self.n1 = n // n_c
+        n_el = n1 // 6 - 1
+        # the interleaved order: cable coordinate k (cable c = k // n1, node, d) -> its place
+        c, rest = np.divmod(np.arange(n), n1)
+        node, d = np.divmod(rest, 6)
+        self.order = 6 * (node * n_c + c) + d
+        # the walls' element blocks (12 x 12 on the element's two nodes) and the spring's 3 x 3 blocks
+        loc = 6 * np.arange(n_el)[:, None] + np.arange(12)[None, :]                    # (n_el, 12)
+        first = n1 * np.arange(n_c)[:, None, None, None]
+        wr = (first + loc[None, :, :, None] + 0 * loc[None, :, None, :]).reshape(-1)
+        wc = (first + loc[None, :, None, :] + 0 * loc[None, :, :, None]).reshape(-1)
+        self._fixed_rows = np.concatenate([wr, spring._rows.astype(np.int64)])
+        self._fixed_cols = np.concatenate([wc, spring._cols.astype(np.int64)])
+        self._fixed_prow, self._fixed_pcol = self.order[self._fixed_rows], self.order[self._fixed_cols]
+        off = self._fixed_prow - self._fixed_pcol
+        self._fixed_kl, self._fixed_ku = int(off.max()), int(-off.min())
+        # the eye's held coordinates (cable order) and their constraints' multipliers (AE order)
+        sd = self.mbs.systemData
+        where = np.empty(n, dtype=np.int64)
+        where[self.index] = np.arange(n)
+        self.held, self.ae = _held_rows(self.mbs, model.lead_drives, where)
+        self.n_ae = len(sd.GetAECoordinates())
+        self._is_held = np.zeros(n, dtype=bool)
+        self._is_held[self.held] = True
+        self._loads = list(model._load_rows())
+        self._guide = None
+        self._residual = np.zeros(n)
+        self._last_spring = np.zeros(n)
+        self.time_parts_s = {"forces": 0.0, "assembly": 0.0, "factorisation": 0.0, "glue": 0.0}
+        self._start = None
+
+    def _forces(self, q, lam, loads) -> np.ndarray:
+        """ODE2 residual rows in cable order: f(q) + C_qᵀλ (f: the walls' couplings, the pairs',
+        the spring, the end loads)."""
+        t0 = time.process_time()
+        model, n1 = self.model, self.n1
+        r = self.model.between_coupling._evaluate(q).generalized_force.copy()
+        for i, coupling in enumerate(model.wall_couplings):
+            r[i * n1:(i + 1) * n1] += coupling.force(q[i * n1:(i + 1) * n1], self.time_s, jacobian=True)
+        spring = self.spring.force(q)
+        r += spring
+        r += loads
+        r[self.held] += lam
+        self._last_spring = spring
+        self.time_parts_s["forces"] += time.process_time() - t0
+        return r
+
+    def stiffness_triplets(self, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """K = -∂f/∂q of :meth:`_forces` at ``q`` as (rows, columns, values) in cable order, a
+        pair repeating where parts overlap (K is their sum)."""
+        model, n1 = self.model, self.n1
+        walls = [coupling.stiffness_blocks(q[i * n1:(i + 1) * n1], self.time_s).reshape(-1)
+                 for i, coupling in enumerate(model.wall_couplings)]
+        J = model.between_coupling._evaluate(q).jacobian
+        rows = np.concatenate([self._fixed_rows, np.repeat(np.arange(self.n), np.diff(J.indptr))])
+        cols = np.concatenate([self._fixed_cols, J.indices])
+        vals = np.concatenate(walls + [self.spring.block_values(), -J.data])
+        return rows, cols, vals
+
+    def _newton_step(self, q, r, dq_held):
+        """As :meth:`OwnStaticNewton._newton_step`, in the interleaved order (the class notes)."""
+        t0 = time.process_time()
+        rows, cols, vals = self.stiffness_triplets(q)
+        n_fixed = self._fixed_prow.size
+        pr = np.concatenate([self._fixed_prow, self.order[rows[n_fixed:]]])
+        pc = np.concatenate([self._fixed_pcol, self.order[cols[n_fixed:]]])
+        t1 = time.process_time()
+        rhs = -r
+        rhs[self.held] = 0.0
+        b = np.empty(self.n)
+        b[self.order] = rhs
+        ph = self.order[self.held]
+        if self.linear_solver == "banded":
+            off = pr[n_fixed:] - pc[n_fixed:]
+            kl = max(self._fixed_kl, int(off.max()) if off.size else 0)
+            ku = max(self._fixed_ku, int(-off.min()) if off.size else 0)
+            if kl * (kl + ku + 1) <= self.BAND_WORK_LIMIT:
+                return self._band_step(pr, pc, vals, b, r, ph, dq_held, kl, ku, (t0, t1))
+            # cables slid far apart along the route (a diverging iterate): SuperLU's own order is cheaper
+        # SuperLU on the triplets, the held rows and columns dropped and the identity put there
+        held_r, held_c = self._is_held[rows], self._is_held[cols]
+        if np.any(dq_held):
+            full = np.zeros(self.n)
+            full[self.held] = dq_held
+            b[self.order] -= np.bincount(rows, weights=np.where(held_r, 0.0, vals * full[cols]), minlength=self.n)
+        b[ph] = dq_held
+        keep = ~(held_r | held_c)
+        t2 = time.process_time()
+        x = self._splu_solve(np.concatenate([pr[keep], ph]), np.concatenate([pc[keep], ph]),
+                             np.concatenate([vals[keep], np.ones(ph.size)]), b)
+        t3 = time.process_time()
+        dq = x[self.order]
+        in_held_row = np.flatnonzero(held_r)
+        h_of = np.full(self.n, -1, dtype=np.int64)
+        h_of[self.held] = np.arange(self.held.size)
+        dlam = r[self.held] + np.bincount(h_of[rows[in_held_row]], weights=vals[in_held_row] * dq[cols[in_held_row]],
+                                          minlength=self.held.size)
+        self._count_time(t0, t1, t2, t3)
+        return dq, dlam
+
+    def _band_step(self, pr, pc, vals, b, r, ph, dq_held, kl, ku, times):
+        """:meth:`_newton_step` by LAPACK's banded LU (``dgbsv``): the triplets (interleaved order,
+        duplicates summed) into the band, the held rows and columns read and replaced by the identity."""
+        n = self.n
+        ld = 2 * kl + ku + 1
+        top = kl + ku
+        # LAPACK's band storage, Fortran order: entry (i, j) at row kl + ku + i - j of column j
+        memory = np.bincount(pc * ld + top + pr - pc, weights=vals, minlength=ld * n)
+        band = memory.reshape(n, ld).T
+        rows_k = []
+        for h, dqh in zip(ph, dq_held):
+            j = np.arange(max(0, h - kl), min(n, h + ku + 1))          # row h's columns in the band
+            row_pos = j * ld + top + h - j
+            i = np.arange(max(0, h - ku), min(n, h + kl + 1))          # column h's rows in the band
+            col_pos = h * ld + top + i - h
+            rows_k.append((j, memory[row_pos].copy(), row_pos, col_pos))
+            if dqh != 0.0:
+                b[i] -= memory[col_pos] * dqh
+        for _, _, row_pos, col_pos in rows_k:
+            memory[row_pos] = 0.0
+            memory[col_pos] = 0.0
+        memory[ph * ld + top] = 1.0
+        b[ph] = dq_held
+        t2 = time.process_time()
+        _, _, x, info = lapack.dgbsv(kl, ku, band, b, overwrite_ab=True, overwrite_b=True)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"the system matrix is singular (LAPACK dgbsv info {info})")
+        t3 = time.process_time()
+        dlam = r[self.held] + np.array([k @ x[j] for j, k, _, _ in rows_k])
+        self._count_time(times[0], times[1], t2, t3)
+        return x[self.order], dlam
+
+    def _splu_solve(self, rows, cols, vals, b) -> np.ndarray:
+        """Solve the matrix of triplets (duplicates summed) by SuperLU."""
+        from scipy.sparse import csc_matrix
+        from scipy.sparse.linalg import splu
+
+        try:
+            return splu(csc_matrix((vals, (rows, cols)), shape=(self.n, self.n))).solve(b)
+        except RuntimeError as exc:
+            raise np.linalg.LinAlgError(f"the system matrix is singular ({exc})") from exc
+
+
 def static_backend(model, spring, settings_of, choice: str):
     """The backend for ``[solver] static_solver`` = ``choice``: ours where the model allows it
-    (:func:`own_newton_unsupported`), else Exudyn's; and why Exudyn's when ours was asked for."""
+    (:func:`own_newton_unsupported`; a bundle's :func:`own_bundle_newton_unsupported`), else
+    Exudyn's; and why Exudyn's when ours was asked for."""
     if choice == "exucable":
+        if getattr(model, "n_cables", 1) > 1:
+            why = own_bundle_newton_unsupported(model, spring)
+            if not why:
+                return OwnBundleNewton(model, spring, checked=True), ""
+            return ExudynStatic(model.mbs, settings_of), why
         why = own_newton_unsupported(model, spring)
         if not why:
             return OwnStaticNewton(model, spring, checked=True), ""
