@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from exucable.scenario.specs import parse_scenario
@@ -56,3 +57,35 @@ def make_scenario(**tables):
 @pytest.fixture
 def scenario_factory():
     return make_scenario
+
+
+def upbend_bundle_scenario():
+    """Three cables (triangular) through 2 m straight, a 30° up-bend of 5 m radius and 1 m straight, steady
+    mode, 8 check points per element: a small bundle whose residual and stiffness tests compare with Exudyn's."""
+    import exucable as xc
+
+    route = xc.Route(inner_radius=0.05).straight(2.0).bend(30, radius=5.0, turn="up").straight(1.0)
+    return xc.Scenario(route=route, cable=xc.Cable(radius=0.015, density=2000.0, youngs_modulus=2e8, count=3,
+                                                   arrangement="triangular"),
+                       contact=xc.Contact(friction=0.3, check_points_per_element=8),
+                       pull=xc.Pull(speed=0.1, back_tension=300.0), gravity=xc.Gravity(g=9.81),
+                       solver=xc.Solver(mode="steady", steady_lead_out=0.0))
+
+
+def exudyn_static_residual_jacobian(model):
+    """Exudyn's static solver's residual and Newton Jacobian at ``model``'s current state (one Newton
+    setup, plain settings), on the cables' coordinates (``model.ode2_index``): (q, r, J), q the
+    cables' displacement coordinates."""
+    import exudyn as exu
+    from exucable.solve import steady as st
+
+    mbs = model.mbs
+    idx = model.ode2_index
+    q_all = np.array(mbs.systemData.GetODE2Coordinates())
+    settings = st.static_settings(tolerance=1.0, max_iterations=1)
+    s = exu.MainSolverStatic()
+    s.InitializeSolver(mbs, settings)
+    s.ComputeNewtonResidual(mbs, settings)
+    r = np.array(s.GetSystemResidual())[:q_all.size][idx]
+    s.ComputeNewtonJacobian(mbs, settings)
+    return q_all[idx], r, np.asarray(s.GetSystemJacobian())[np.ix_(idx, idx)]

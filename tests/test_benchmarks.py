@@ -44,6 +44,7 @@ SCRIPTS = {
     "studies/beam_conduit_study.py": "| case | EJ [N m²] | model: stiff vs its EJ → 0 limit",
     "studies/bundle_upbend_study.py": "| bend | arrangement | cable friction | status",
     "studies/bundle_route_onset.py": "| check | result |",
+    "studies/bundle_curvature_study.py": "| eigenvalue [1/s²] | mode largest on cable |",
     "studies/bundle_relax_handover.py": "| relaxed state below [N] | its residual [N] | one-iteration continuation",
     "studies/bundle_block_sweeps.py": "| sweep | coupled residual [N]",
     "studies/bundle_plan_stall.py": "| steps | CPU [s] | residual [N] | cable 3's height",

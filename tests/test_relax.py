@@ -176,33 +176,18 @@ def test_bad_settings_are_refused_by_name():
 def test_the_bundle_residual_is_the_static_solvers():
     """BundleModel.steady_force equals Exudyn's static residual on the free coordinates bit for bit,
     and the blocks of stiffness_blocks3 sum to minus Exudyn's Newton Jacobian there."""
-    import exudyn as exu
-    import exucable as xc
+    from conftest import exudyn_static_residual_jacobian, upbend_bundle_scenario
     from exucable.model.bundle import build_bundle_model
     from exucable.solve import steady as st
 
-    route = xc.Route(inner_radius=0.05).straight(2.0).bend(30, radius=5.0, turn="up").straight(1.0)
-    sc = xc.Scenario(route=route, cable=xc.Cable(radius=0.015, density=2000.0, youngs_modulus=2e8, count=3,
-                                                 arrangement="triangular"),
-                     contact=xc.Contact(friction=0.3, check_points_per_element=8),
-                     pull=xc.Pull(speed=0.1, back_tension=300.0), gravity=xc.Gravity(g=9.81),
-                     solver=xc.Solver(mode="steady", steady_lead_out=0.0))
-    model = build_bundle_model(sc)
+    model = build_bundle_model(upbend_bundle_scenario())
     solver = st.SteadySolver(model)           # its spring (rate 0) is part of Exudyn's system
-    mbs = model.mbs
+    q, r, J = exudyn_static_residual_jacobian(model)
     idx = model.ode2_index
-    q_all = np.array(mbs.systemData.GetODE2Coordinates())
-    settings = st.static_settings(tolerance=1.0, max_iterations=1)
-    s = exu.MainSolverStatic()
-    s.InitializeSolver(mbs, settings)
-    s.ComputeNewtonResidual(mbs, settings)
-    r = np.array(s.GetSystemResidual())[:q_all.size][idx]
-    s.ComputeNewtonJacobian(mbs, settings)
-    J = np.asarray(s.GetSystemJacobian())[np.ix_(idx, idx)]
     free = np.setdiff1d(np.arange(idx.size), model.held_coordinates())
-    f = model.steady_force(q_all[idx])
+    f = model.steady_force(q)
     assert np.array_equal(f[free], r[free])
-    rows, cols, blocks = model.stiffness_blocks3(q_all[idx])
+    rows, cols, blocks = model.stiffness_blocks3(q)
     K = np.zeros((idx.size, idx.size))
     for a, b, B in zip(rows, cols, blocks):
         K[3 * a:3 * a + 3, 3 * b:3 * b + 3] += B

@@ -103,6 +103,7 @@ from .newton_system import ExudynStatic, static_backend
 from .relax import check_settings
 from .block_sweeps import node_block_masses
 from .onset_continuation import OnsetContinuation, OnsetSettings
+from .negative_curvature import curvature_phase
 
 __all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
 
@@ -217,6 +218,13 @@ class SteadySettings:
     bundle_block_coarse_steps : int
         The block sweeps' coarse correction: steps after each sweep at most
         (:attr:`exucable.solve.block_sweeps.BlockSweepSettings.coarse_steps`) [-]; 0 (the default): none.
+    bundle_curvature_rounds : int
+        Several cables: rounds of negative-curvature steps (:mod:`exucable.solve.negative_curvature`),
+        each followed by the one-iteration continuation, where the dynamic relaxation's hand-over
+        stalled [-]; 0 (the default) skips them. Off: on the 100 m three-cable route the steps left no
+        negative mode, but the continuation after them put the top cable back on its crest and
+        stalled higher (28.2 N against 18.2 N; reference/README.md, "Negative curvature on the 100 m
+        route").
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -249,6 +257,7 @@ class SteadySettings:
     bundle_relax_within: float = 30.0
     bundle_relax_handover: float = 3000.0
     bundle_relax_handover_fall: float = 10.0
+    bundle_curvature_rounds: int = 0
     max_backtracks: int = 6
     bundle_block_sweeps: int = 0
     bundle_block_coarse_steps: int = 0
@@ -561,6 +570,7 @@ class SteadySolver:
         self.friction_only = False       # the load ramp scales the friction only (a bundle's first ramp)
         self.relaxation = None           # a bundle's dynamic relaxation (exucable.solve.relax.RelaxOutcome), if run
         self.sweeps = None               # a bundle's block sweeps (exucable.solve.block_sweeps.BlockSweepOutcome), if run
+        self.curvature_note = ""         # what a bundle's negative-curvature steps found (bundle_curvature_rounds)
         #: several cables: solved through a smooth contact onset first (exucable.solve.onset_continuation)
         self.onset = OnsetContinuation(onset) if onset is not None and self.bundle else None
 
@@ -919,6 +929,8 @@ class SteadySolver:
             if (not ok and self.bundle and self.settings.bundle_relax_steps and not self.timed_out
                     and model.steady_force_supported):
                 ok, first_message = self.relax_dynamic(first_message)
+                if not ok and self.settings.bundle_curvature_rounds and not self.timed_out:
+                    ok, self.curvature_note = curvature_phase(self, self.settings.bundle_curvature_rounds)
             if not ok and not self.timed_out:
                 self.store.saved = self.start
                 ok, first_message = self.relax(1.0)
@@ -926,6 +938,8 @@ class SteadySolver:
                     r = self.relaxation
                     first_message += (f" (from the state of a dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s "
                                       f"CPU, residual {r.residual_N:.3g} N: {r.message})")
+                if not ok and self.curvature_note:
+                    first_message += f" (before it, {self.curvature_note})"
             first_message += warm_note
             if self.sweeps is not None:
                 b = self.sweeps
