@@ -48,6 +48,7 @@ SCRIPTS = {
     "studies/bundle_relax_handover.py": "| relaxed state below [N] | its residual [N] | one-iteration continuation",
     "studies/bundle_block_sweeps.py": "| sweep | coupled residual [N]",
     "studies/bundle_plan_stall.py": "| steps | CPU [s] | residual [N] | cable 3's height",
+    "studies/bundle_start_masses.py": "| start | masses | status | solve CPU [s]",
     "studies/bending_stiffness_study.py": "| case | gravity | c [mm] | EJ [N m²] | √(EJ/T_in)/R",
     "studies/contact_flips.py": "| t [s] | touching | contact in/out",
     "studies/ex4_study.py": "| clearance R − r [mm] | E [Pa] | pulling force [N]",

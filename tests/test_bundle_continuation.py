@@ -137,3 +137,32 @@ def test_a_handover_residual_that_does_not_fall_is_refused():
 
     with pytest.raises(SolverError, match="bundle_relax_handover_fall"):
         SteadySettings(bundle_relax_handover_fall=1.0)
+
+
+def test_relaxation_masses_other_than_diagonal_or_frame_are_refused():
+    from exucable.errors import SolverError
+    from exucable.solve.steady import SteadySettings
+
+    assert SteadySettings(bundle_relax_masses="frame").bundle_relax_masses == "frame"
+    with pytest.raises(SolverError, match="bundle_relax_masses"):
+        SteadySettings(bundle_relax_masses="block")
+
+
+def test_the_relaxation_takes_the_settings_masses(monkeypatch):
+    """SteadySettings.bundle_relax_masses reaches relax_bundle's ``masses`` (the default "diagonal")."""
+    import exucable.solve.relax as rx
+    from exucable.solve.steady import SteadySettings
+
+    kinds = []
+    real = rx.relax_bundle
+
+    def recorded(model, settings, *a, **k):
+        kinds.append(k.get("masses"))
+        return real(model, settings, *a, **k)
+
+    monkeypatch.setattr(rx, "relax_bundle", recorded)
+    for kind in ("diagonal", "frame"):
+        solver = SteadySolver(build_bundle_model(duct(3)), SteadySettings(bundle_relax_masses=kind))
+        monkeypatch.setattr(solver, "relax_one_iteration", lambda lam: (True, ""))
+        assert solver.relax_dynamic("the one-iteration steps from the start failed")[0]
+    assert kinds == ["diagonal", "frame"]

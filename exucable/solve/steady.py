@@ -208,6 +208,11 @@ class SteadySettings:
         not from 23.6 N (``studies/bundle_relax_handover.py``).
     bundle_relax_handover_fall : float
         Factor by which the hand-over residual falls after a hand-over whose continuation failed [-].
+    bundle_relax_masses : str
+        The dynamic relaxation's masses (:func:`exucable.solve.relax.bundle_masses` ``kind``):
+        ``"diagonal"`` (the default) or ``"frame"`` (row sums in each node's frame); measured with the
+        bundle's starts in ``studies/bundle_start_masses.py`` (reference/README.md, "Starts ×
+        masses on the triangle's route").
     bundle_block_sweeps : int
         Several cables: sweeps of block Gauss–Seidel by cable (:mod:`exucable.solve.block_sweeps`) at
         most, run from the rope start at full load in the onset layer's first width before any other
@@ -257,13 +262,17 @@ class SteadySettings:
     bundle_relax_within: float = 30.0
     bundle_relax_handover: float = 3000.0
     bundle_relax_handover_fall: float = 10.0
+    bundle_relax_masses: str = "diagonal"
     bundle_curvature_rounds: int = 0
     max_backtracks: int = 6
     bundle_block_sweeps: int = 0
     bundle_block_coarse_steps: int = 0
 
     def __post_init__(self):
-        check_settings(self)
+        check_settings(self, skip=("bundle_relax_masses",))
+        if self.bundle_relax_masses not in ("diagonal", "frame"):
+            raise SolverError(f"SteadySettings.bundle_relax_masses = {self.bundle_relax_masses!r}: "
+                              f"use \"diagonal\" or \"frame\"")
         if self.bundle_relax_handover_fall <= 1.0:
             raise SolverError(f"SteadySettings.bundle_relax_handover_fall = {self.bundle_relax_handover_fall!r}: "
                               f"must be > 1 (the hand-over residual must fall)")
@@ -749,7 +758,8 @@ class SteadySolver:
             self.store.restore_as_initial()
             left = s.time_limit_s - (time.process_time() - self._cpu_start)
             out = relax_bundle(self.model, RelaxSettings(residual_N=target, max_steps=max(s.bundle_relax_steps - steps, 1),
-                                                         time_limit_s=max(left, 1e-3)))
+                                                         time_limit_s=max(left, 1e-3)),
+                               masses=s.bundle_relax_masses)
             steps, restarts, cpu = steps + out.steps, restarts + out.restarts, cpu + out.cpu_s
             self.relaxation = replace(out, steps=steps, restarts=restarts, cpu_s=cpu)
             self.store.save()
