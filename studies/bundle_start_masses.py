@@ -76,7 +76,19 @@ def run_variant(start: str, masses: str, limit_s: float, arrangement: str, quick
             "relax_steps": getattr(rel, "steps", 0), "relax_residual": getattr(rel, "residual_N", None),
             "best": float(solver.best[0]),
             "pull": float(model.pull_shares_N().sum()) if out.status == "ok" else None,
-            "message": out.message}
+            "message": out.message, "sections": _arrangements(model) if out.status == "ok" else None}
+
+
+def _arrangements(model) -> str:
+    """The arrangement found per straight and bend of a solved state, with each label's station count."""
+    from exucable.model.bundle import bundle_report, bundle_sections
+
+    rows = bundle_sections(model)["sections"]
+    report = bundle_report(model)
+    shares = 100.0 * model.pull_shares_N() / model.pull_shares_N().sum()
+    return ("; ".join(f"{r['kind']} {r['section']}: {r['arrangement']} {r['arrangements_seen']}" for r in rows)
+            + f"; weight correction {report['weight_correction_factor']:.4g}; pull shares "
+            + " / ".join(f"{x:.1f}" for x in shares) + " %")
 
 
 def main(argv=None) -> int:
@@ -118,6 +130,8 @@ def main(argv=None) -> int:
                   f"{r['relax_steps']} | {rr} | {r['best']:.3g} | {r['its']} | {pull} |", flush=True)
             if r["status"] != "ok":
                 print(f"    ({r['message'][:400]})", flush=True)
+            else:
+                print(f"    ({r['sections']})", flush=True)
     return 0
 
 

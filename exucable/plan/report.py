@@ -290,6 +290,9 @@ def bundle_note(direction: dict, plan: dict) -> str | None:
         return (f"Not simulated: the {fb['asked']} arrangement was asked as given and did not hold ({fb['reason']}); "
                 f"the sections are the calculators' ({plan['arrangement']}).")
     word = "triangle" if fb["asked"] == "triangular" else f"{fb['asked']} arrangement"
+    if direction["status"] == "failed":
+        return (f"Not simulated: the {word} did not hold ({fb['reason']}), and the rule's {fb['simulated']} did not "
+                f"solve either; the sections are the calculators' ({plan['arrangement']}).")
     return f"Simulated as {fb['simulated']} (the {word} did not hold: {fb['reason']}); {formula}."
 
 
