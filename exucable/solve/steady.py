@@ -571,6 +571,9 @@ class SteadySolver:
         self.static, self.static_note = static_backend(model, self.spring, static_settings, _static_choice(model))
         self._solved = False
         self._cpu_start = time.process_time()
+        if hasattr(self.static, "deadline_cpu_s"):
+            # our Newton loop reads the clock between its iterations too: an exact step is up to 12
+            self.static.deadline_cpu_s = self._cpu_start + settings.time_limit_s
         self.timed_out = False           # stopped at settings.time_limit_s
         self._trace_lam, self._trace = 0.0, []   # the load scale of the last accepted steps, their residuals [N]
         #: several cables (exucable.model.bundle): the continuation's bundle rules apply (module notes)
