@@ -230,6 +230,21 @@ class SteadySettings:
         negative mode, but the continuation after them put the top cable back on its crest and
         stalled higher (28.2 N against 18.2 N; reference/README.md, "Negative curvature on the 100 m
         route").
+    bundle_starts : tuple of str
+        Several cables: the starts tried in turn (``build_bundle_model``'s ``start_path``,
+        ``[solver] bundle_starts``; :func:`exucable.solve.bundle_starts.solve_bundle_starts`), each
+        but the last given up where its dynamic relaxation stalls (``bundle_start_stall_work``), the
+        next built and solved in the CPU time left. Why ``("clearance", "statics_own")``: the
+        clearance start solves the up-bend study's 12 cases and the 100 m cradle (their answers
+        unchanged), the cross-section's statics the 100 m triangle, where the clearance start's
+        relaxation stalls at 29.4 N (reference/README.md, "A start sequence").
+    bundle_start_stall_work : float
+        A start that another follows gives up where its dynamic relaxation has not halved its
+        residual in this many steps times the bundle's coordinates [-] (a work measure that does
+        not depend on the machine): 2e6 is 1100 steps on the 100 m route (1818 coordinates; its
+        clearance start stalled after step 1084, its cradle's longest stretch without a halving was
+        655 steps) and 10 100 on the up-bend study's cases (198; their longest 2017 steps), where the
+        relaxation's own rule (5000 steps) comes first.
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -267,9 +282,19 @@ class SteadySettings:
     max_backtracks: int = 6
     bundle_block_sweeps: int = 0
     bundle_block_coarse_steps: int = 0
+    bundle_starts: tuple = ("clearance", "statics_own")
+    bundle_start_stall_work: float = 2.0e6
 
     def __post_init__(self):
-        check_settings(self, skip=("bundle_relax_masses",))
+        from ..model.bundle import BUNDLE_STARTS
+
+        check_settings(self, skip=("bundle_relax_masses", "bundle_starts"))
+        starts = self.bundle_starts
+        if isinstance(starts, str) or not isinstance(starts, (tuple, list)) or not starts \
+                or any(x not in BUNDLE_STARTS for x in starts):
+            allowed = ", ".join(f'"{x}"' for x in BUNDLE_STARTS)
+            raise SolverError(f"SteadySettings.bundle_starts = {starts!r}: give one or more of {allowed}")
+        object.__setattr__(self, "bundle_starts", tuple(starts))
         if self.bundle_relax_masses not in ("diagonal", "frame"):
             raise SolverError(f"SteadySettings.bundle_relax_masses = {self.bundle_relax_masses!r}: "
                               f"use \"diagonal\" or \"frame\"")
@@ -280,8 +305,9 @@ class SteadySettings:
     @classmethod
     def from_solver(cls, solver) -> "SteadySettings":
         """The settings of a scenario's ``[solver]`` table (:class:`exucable.scenario.specs.SolverSpec`):
-        its ``steady_residual`` and ``steady_time_limit_s``, the defaults otherwise."""
-        return cls(steady_residual=float(solver.steady_residual), time_limit_s=float(solver.steady_time_limit_s))
+        its ``steady_residual``, ``steady_time_limit_s`` and ``bundle_starts``, the defaults otherwise."""
+        return cls(steady_residual=float(solver.steady_residual), time_limit_s=float(solver.steady_time_limit_s),
+                   bundle_starts=tuple(solver.bundle_starts))
 
 
 def initial_spring_rate(model) -> float:
@@ -537,11 +563,21 @@ class SteadySolver:
         The system's ODE2 and algebraic coordinates of a state near the steady state to start from
         (:func:`exucable.solve.start.nested_start`); the model's own start (the rope's) is the
         fallback. See the module's notes.
+    onset : OnsetSettings, optional
+        Several cables: the contact onset layer's continuation (:mod:`exucable.solve.onset_continuation`).
+    fallback : bool
+        Several cables: another start follows this one
+        (:func:`exucable.solve.bundle_starts.solve_bundle_starts`). The dynamic relaxation then stops
+        where its residual has not halved in ``bundle_start_stall_work`` / coordinates steps, and
+        where it fails the solve fails at once (no exact-step continuation, no load ramp): the
+        next start gets the time left.
     """
 
     def __init__(self, model, settings: SteadySettings = SteadySettings(), progress: Progress | None = None,
-                 warm_start: tuple | None = None, onset: OnsetSettings | None = None):
+                 warm_start: tuple | None = None, onset: OnsetSettings | None = None, fallback: bool = False):
         self.model = model
+        #: another start follows (exucable.solve.bundle_starts): give up where the relaxation stalls
+        self.fallback = fallback
         self.warm_start = warm_start
         self.settings = settings
         self.progress = progress
@@ -760,8 +796,11 @@ class SteadySolver:
             self.store.saved = self.start
             self.store.restore_as_initial()
             left = s.time_limit_s - (time.process_time() - self._cpu_start)
+            stall = RelaxSettings.stall_steps
+            if self.fallback:
+                stall = min(stall, max(1, int(s.bundle_start_stall_work / self.model.ode2_index.size)))
             out = relax_bundle(self.model, RelaxSettings(residual_N=target, max_steps=max(s.bundle_relax_steps - steps, 1),
-                                                         time_limit_s=max(left, 1e-3)),
+                                                         time_limit_s=max(left, 1e-3), stall_steps=stall),
                                masses=s.bundle_relax_masses)
             steps, restarts, cpu = steps + out.steps, restarts + out.restarts, cpu + out.cpu_s
             self.relaxation = replace(out, steps=steps, restarts=restarts, cpu_s=cpu)
@@ -925,7 +964,7 @@ class SteadySolver:
         outside_at_start = _outside_points(model)
         if self.onset is not None:
             self.onset.begin(model)
-        ok, warm_note, started_from = False, "", "rope"
+        ok, warm_note, started_from, gave_up = False, "", "rope", False
         if self.warm_start is not None:
             ok, why = self.relax_warm()
             if ok:
@@ -944,7 +983,8 @@ class SteadySolver:
                 ok, first_message = self.relax_dynamic(first_message)
                 if not ok and self.settings.bundle_curvature_rounds and not self.timed_out:
                     ok, self.curvature_note = curvature_phase(self, self.settings.bundle_curvature_rounds)
-            if not ok and not self.timed_out:
+            gave_up = not ok and self.fallback and self.relaxation is not None
+            if not ok and not self.timed_out and not gave_up:
                 self.store.saved = self.start
                 ok, first_message = self.relax(1.0)
                 if not ok and self.relaxation is not None:
@@ -967,6 +1007,9 @@ class SteadySolver:
                 r = self.relaxation
                 message += (f" (after the one-iteration steps from the rope start failed, from the state of a "
                             f"dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s CPU, residual {r.residual_N:.3g} N)")
+        elif gave_up:
+            # another start follows: the slower phases are left to the last one (SteadySolver's fallback)
+            status, message = "failed", f"given up for the next start: {first_message}"
         else:
             status, message = self.ramp_loads(first_message)
             if status != "ok" and self.bundle and not self.timed_out:
