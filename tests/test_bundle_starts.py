@@ -70,7 +70,7 @@ def test_a_start_given_up_hands_over_to_the_next():
     sc = scenario()
     model = build_bundle_model(sc)
     # a stall rule that stops the first start's relaxation at once: the up-bend needs it
-    settings = replace(SteadySettings.from_solver(sc.solver), bundle_start_stall_work=1.0)
+    settings = replace(SteadySettings.from_solver(sc.solver), bundle_start_stall_steps=1, bundle_start_stall_work=1.0)
     out = solve_bundle_starts(sc, model, settings=settings)
     assert out.start == "statics_own"
     assert [(a.start, a.status) for a in out.attempts] == [("clearance", "failed"), ("statics_own", "ok")]

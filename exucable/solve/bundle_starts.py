@@ -10,8 +10,8 @@ statics start), so a solve that converges must keep the start it converged from.
 
 So the starts are tried in turn (:func:`solve_bundle_starts`): each but the last gives up where its
 dynamic relaxation stalls (:class:`~exucable.solve.steady.SteadySolver`'s ``fallback``: no halving
-in ``SteadySettings.bundle_start_stall_work`` / coordinates steps, no exact-step continuation or load
-ramp after it), and the next is built and solved in the CPU time left of ``time_limit_s``, which
+in ``SteadySettings.bundle_start_stall_steps`` steps or more, no exact-step continuation or load ramp
+after it), and the next is built and solved in the CPU time left of ``time_limit_s``, which
 holds for the whole sequence. A solve that converges from the first start is the single-start
 solve, step for step.
 """

@@ -233,18 +233,21 @@ class SteadySettings:
     bundle_starts : tuple of str
         Several cables: the starts tried in turn (``build_bundle_model``'s ``start_path``,
         ``[solver] bundle_starts``; :func:`exucable.solve.bundle_starts.solve_bundle_starts`), each
-        but the last given up where its dynamic relaxation stalls (``bundle_start_stall_work``), the
+        but the last given up where its dynamic relaxation stalls (``bundle_start_stall_steps``), the
         next built and solved in the CPU time left. Why ``("clearance", "statics_own")``: the
         clearance start solves the up-bend study's 12 cases and the 100 m cradle (their answers
         unchanged), the cross-section's statics the 100 m triangle, where the clearance start's
         relaxation stalls at 29.4 N (reference/README.md, "A start sequence").
-    bundle_start_stall_work : float
+    bundle_start_stall_steps, bundle_start_stall_work : int, float
         A start that another follows gives up where its dynamic relaxation has not halved its
-        residual in this many steps times the bundle's coordinates [-] (a work measure that does
-        not depend on the machine): 2e6 is 1100 steps on the 100 m route (1818 coordinates; its
-        clearance start stalled after step 1084, its cradle's longest stretch without a halving was
-        655 steps) and 10 100 on the up-bend study's cases (198; their longest 2017 steps), where the
-        relaxation's own rule (5000 steps) comes first.
+        residual in max(``bundle_start_stall_steps``, ``bundle_start_stall_work`` / the bundle's
+        coordinates) steps [-] (at most the relaxation's own 5000), counted in steps, not seconds,
+        so that which start answers does not depend on the machine. Measured (the longest stretch
+        without a halving in relaxations that went on to solve, reference/README.md, "A start
+        sequence"): the up-bend study's cases 867-2017 steps (198 coordinates: 2e6 / 198 = 10 100,
+        the relaxation's own rule applies), the 100 m cradle 655 (1818 coordinates), the industry
+        three-cable plan's cradle 823 (3546); the 100 m triangle's clearance start last halved at
+        step 1084 and never again in 5000. 1100 steps: it gives up at step 2184.
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -283,6 +286,7 @@ class SteadySettings:
     bundle_block_sweeps: int = 0
     bundle_block_coarse_steps: int = 0
     bundle_starts: tuple = ("clearance", "statics_own")
+    bundle_start_stall_steps: int = 1100
     bundle_start_stall_work: float = 2.0e6
 
     def __post_init__(self):
@@ -568,7 +572,7 @@ class SteadySolver:
     fallback : bool
         Several cables: another start follows this one
         (:func:`exucable.solve.bundle_starts.solve_bundle_starts`). The dynamic relaxation then stops
-        where its residual has not halved in ``bundle_start_stall_work`` / coordinates steps, and
+        where its residual has not halved in ``bundle_start_stall_steps`` (or more) steps, and
         where it fails the solve fails at once (no exact-step continuation, no load ramp): the
         next start gets the time left.
     """
@@ -798,7 +802,8 @@ class SteadySolver:
             left = s.time_limit_s - (time.process_time() - self._cpu_start)
             stall = RelaxSettings.stall_steps
             if self.fallback:
-                stall = min(stall, max(1, int(s.bundle_start_stall_work / self.model.ode2_index.size)))
+                stall = min(stall, max(s.bundle_start_stall_steps,
+                                       int(s.bundle_start_stall_work / self.model.ode2_index.size)))
             out = relax_bundle(self.model, RelaxSettings(residual_N=target, max_steps=max(s.bundle_relax_steps - steps, 1),
                                                          time_limit_s=max(left, 1e-3), stall_steps=stall),
                                masses=s.bundle_relax_masses)
@@ -808,7 +813,8 @@ class SteadySolver:
             self.start = self.store.saved
             note = (f"{why}; then dynamic relaxation: {steps} steps, {restarts} restarts, residual "
                     f"{out.residual_N:.3g} N ({out.message})")
-            if self.out_of_time():
+            if self.out_of_time() or (self.fallback and not out.converged):
+                # a start that another follows gives up where its relaxation stalled
                 return False, note
             ok, message = self.relax_one_iteration(1.0)
             if ok:
