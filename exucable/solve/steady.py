@@ -74,7 +74,9 @@ than the relaxation's last digits cost), and every phase after runs from the rel
 implicit steps stalled at newtons where the cables must rearrange across the duct (three cables in an
 up-bend: the triangle turns over onto the upper wall), and the relaxation, like a physical settle, moves
 off the unstable balances on the way (reference/README.md, the up-bend study: 12 of 12 cases solve, 5
-failed at the 60 s limit before).
+failed at the 60 s limit before). Where the relaxation from one start stalls, the next start of
+``bundle_starts`` is built and solved instead (:mod:`exucable.solve.bundle_starts`; the solver's
+``fallback``).
 
 A solve may instead start warm, from a state near its steady state (``warm_start``: the coarse mesh's
 solved state subdivided, :func:`exucable.solve.start.nested_start`). The phases above assume the rope
@@ -1080,7 +1082,8 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float | Non
     given, it replaces that of ``settings`` (default :class:`SteadySettings`). ``warm_start``: a
     state near the steady state to start from, the rope start the fallback (:class:`SteadySolver`).
     Several cables are solved through a smooth contact onset continued to the law without it
-    (:mod:`exucable.solve.onset_continuation`, :class:`OnsetSettings`' defaults).
+    (:mod:`exucable.solve.onset_continuation`, :class:`OnsetSettings`' defaults), from the model's own
+    start only: ``settings.bundle_starts`` in turn is :func:`exucable.solve.bundle_starts.solve_bundle_starts`.
     """
     settings = SteadySettings() if settings is None else settings
     if tolerance is not None:
