@@ -538,8 +538,8 @@ def _bundle_fallback(name: str, engine: str, rope_entry: dict, progress: bool, n
     rule = eng.auto_arrangement(n, D, d)
     left = arrangement_left(first.model, asked, names)
     word = "triangle" if asked == "triangular" else f"{asked} arrangement"
-    reason = (f"no steady state of the {word} within the CPU budget; D/d {D / d:.3g}, where the calculators' rule "
-              f"gives {n} free cables {rule}; {_left_phrase(asked, left)}")
+    reason = (f"its steady solve found no steady state in {first_cpu_s:.3g} s CPU; D/d {D / d:.3g}, where the "
+              f"calculators' rule gives {n} free cables {rule}; {_left_phrase(asked, left)}")
     info = {"asked": asked, "simulated": None if as_given else rule, "rule": rule, "reason": reason, "left": left,
             "attempt_status": first.summary["status"], "attempt_message": first.summary["message"],
             "attempt_cpu_s": first_cpu_s}
