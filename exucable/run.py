@@ -552,6 +552,8 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     h = out.history.arrays()
     report = bundle_report(model)
     cables = bundle_tension_profile(model)
+    uncertainty = _bundle_uncertainty(sc, model, out, report, settings, start, attempts, refine, error_bar,
+                                      time.process_time() - t_cpu, cpu_budget_s)
     if out.status != "failed" and len(h["time_s"]):
         # the result's row is the converged state's: its largest tension is the profile's (from the
         # cables' loads' equilibrium); the steps before it, not in equilibrium, keep EA·ε's
@@ -568,6 +570,7 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         message=message,
         flags=flags,
         pull_force_N=report["pull_force_N"],
+        **uncertainty,
         trailing_tension_N=report["trailing_tension_N"],
         max_tension_N=report["max_tension_N"],
         bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")}
@@ -589,6 +592,28 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
                        cross_sections={"panels": panels, "inner_radius_m": sc.conduit.inner_radius_m,
                                        "cable_radius_m": sc.cable.radius_m} if panels else None)
     return result
+
+
+def _bundle_uncertainty(sc, model, out, report: dict, settings, start: str, attempts: list, refine: float,
+                        error_bar: bool, used_cpu_s: float, cpu_budget_s: float | None) -> dict:
+    """The summary's uncertainty keys of a bundle's steady solve (:func:`exucable.solve.error_bar.bundle_error_bar`).
+
+    The coarse solve is made only when ``error_bar`` and the CPU time left of ``solver.steady_time_limit``
+    (and of ``cpu_budget_s``) after the fine solve's ``used_cpu_s`` [s] is at least
+    ``BUNDLE_COARSE_COST`` × the answering start's CPU time; it may use no more than that time left.
+    """
+    from .solve.error_bar import bundle_error_bar, coarse_solve_skipped
+
+    if out.status == "failed" or not len(out.history.arrays()["time_s"]):
+        return {"pull_force_uncertainty_N": None, "pull_force_uncertainty_method": "none: the steady solve failed"}
+    left = settings.time_limit_s - used_cpu_s
+    if cpu_budget_s is not None:
+        left = min(left, cpu_budget_s - used_cpu_s)
+    fine_cpu = attempts[-1].cpu_s if attempts else used_cpu_s
+    bar = bundle_error_bar(sc, model, report["pull_force_N"], out.onset_layer, settings, start, refine=refine,
+                           cpu_left_s=left, skip=coarse_solve_skipped(error_bar, left, fine_cpu))
+    return {"pull_force_uncertainty_N": bar.uncertainty_N, "pull_force_uncertainty_method": bar.method,
+            "pull_force_uncertainty": bar.to_dict()}
 
 
 def _bundle_panels(sc, model, report: dict, flags: list, solved: bool) -> list | None:

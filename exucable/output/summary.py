@@ -58,8 +58,8 @@ class RunSummary(Mapping):
                                           "references' drift [N]", _TIME)
     reference_drift_N_per_s: float | None = _key("how fast the references move as the cable leaves the "
                                                  "conduit under gravity [N/s]", _TIME)
-    pull_force_uncertainty_N: float | None = _key("uncertainty of pull_force_N [N] (None: none made)", _TIME)
-    pull_force_uncertainty_method: str | None = _key("how pull_force_uncertainty_N was found", _TIME)
+    pull_force_uncertainty_N: float | None = _key("uncertainty of pull_force_N [N] (None: none made)", _BOTH)
+    pull_force_uncertainty_method: str | None = _key("how pull_force_uncertainty_N was found", _BOTH)
     trailing_tension_uncertainty_N: float | None = _key(
         "force-controlled steady solve: uncertainty of trailing_tension_N [N]",
         optional="trailing_tension_uncertainty_method")
@@ -70,7 +70,8 @@ class RunSummary(Mapping):
     pull_force_unexplained_drift_N_per_s: float | None = _key(
         "dynamic mode: that drift less the references' expected drift [N/s]", _TIME)
     pull_force_uncertainty: dict | None = _key("the uncertainty's parts (dynamic: periods and window [s]; "
-                                               "steady: mesh_N, solve_N, wall_N, coarse_value_N, coarse_elements)", _TIME)
+                                               "steady: mesh_N, solve_N, wall_N, coarse_value_N, coarse_elements; "
+                                               "several cables also layer_N, cpu_time_s [s])", _BOTH)
     steady_quantity: str | None = _key("the history column the steady detector watches", _TIME)
     steady_drift_N: float | None = _key("drift of that quantity over the steady window [N]", _TIME)
     trailing_tension_N: float | None = _key("tension at the trailing end [N] (a bundle: its back tension)", _BOTH)

@@ -34,6 +34,25 @@ F_rope + (F − F_rope)·√(1 + δ/c), with δ the deepest penetration of the c
 rope with clearance, and u_wall = ``WALL_FACTOR`` · |F − F_rope|·(√(1 + δ/c) − 1). It is a bound: where
 the cable has room to cut the bend, F − F_rope does not depend on c at all. The pulling force
 reported stays the simulated one; the bar covers the rigid wall's.
+
+Several cables (:func:`bundle_error_bar`): the same parts, each from what a bundle's solve has. The
+solve's part is the stop tolerance (:func:`exucable.solve.steady.stop_tolerance_N`) carried to the eye:
+an unbalanced force f left anywhere on the cables raises the tension behind it by f, and a tension
+increment grows through the bends at most by the capstan factor e^(w μ Θ) (Θ the route's turning
+angle, w the bundle's weight correction factor, the larger of the calculators' and the one that
+emerged), so u_solve = tol · e^(w μ Θ) (:func:`bundle_solve_part_N`). The onset layer's part
+(:func:`onset_layer_part_N`): the contact law is continued from a smooth onset layer s down to 0
+(:mod:`exucable.solve.onset_continuation`); Richardson's step (p = 1) on the two thinnest layers above 0
+gives F₀, and |F − F₀| bounds what the layers leave: the answer's own error where the continuation
+stopped at a finite layer, and where it reached s = 0 the disagreement between the two ways to s → 0
+(reference/README.md, "Through a smooth contact onset": 0.004 to 0.028 N on the up-bend study). The
+mesh part is a second bundle solve on a mesh ``COARSE_RATIO`` times coarser from the start that gave
+the answer (``bundle_starts``: another start may land on another steady state), made only where the
+solve's CPU budget has room for it (a coarse solve costs about half the fine one's,
+:data:`BUNDLE_COARSE_COST`); otherwise the bar is the solve's parts only and its method says that
+the mesh part was not measured, and why. A bundle has several stable steady states in places (the
+up-bend's triangle: 466.6 and 468.455 N, both with every eigenvalue positive); the bar covers the
+one found, not the distance to another. The wall's compliance part is one cable's only.
 """
 
 from __future__ import annotations
@@ -43,8 +62,11 @@ import math
 import time
 from dataclasses import dataclass
 
+import numpy as np
+
 __all__ = ["SteadyErrorBar", "steady_error_bar", "combine", "wall_compliance_N", "with_wall_compliance",
-           "COARSE_RATIO", "ASSUMED_ORDER", "RESOLUTION_FLOOR", "WALL_WARNING", "WALL_FACTOR"]
+           "bundle_error_bar", "bundle_solve_part_N", "onset_layer_part_N", "coarse_solve_skipped",
+           "COARSE_RATIO", "ASSUMED_ORDER", "RESOLUTION_FLOOR", "WALL_WARNING", "WALL_FACTOR", "BUNDLE_COARSE_COST"]
 
 #: The coarse mesh has this many times fewer elements than the solved one.
 COARSE_RATIO = 2.0
@@ -66,6 +88,10 @@ WALL_WARNING = 0.005
 #: The wall's part is the law's estimate times this: the study's runs inside the penetration limit
 #: fell short of the rigid wall by 0.82 to 1.45 times the estimate (stiff cable, c 0.25-2 mm, K 1e6-1e9).
 WALL_FACTOR = 1.5
+
+#: A bundle's coarse solve is made where the CPU time left of the budget is at least this times the
+#: fine solve's (the start that gave the answer): a mesh half as fine has half the unknowns.
+BUNDLE_COARSE_COST = 0.5
 
 
 @dataclass(frozen=True)
@@ -91,6 +117,10 @@ class SteadyErrorBar:
         The coarse solve's wall time, model build included [s].
     wall_N : float or None
         u_wall, the wall's compliance (:func:`wall_compliance_N`) [N]; None until added.
+    layer_N : float or None
+        Several cables: u_layer, the contact onset layer's part (:func:`onset_layer_part_N`) [N].
+    cpu_time_s : float or None
+        Several cables: the coarse solve's CPU time, its build included [s] (None: not made).
     """
 
     uncertainty_N: float | None
@@ -101,12 +131,17 @@ class SteadyErrorBar:
     method: str
     wall_time_s: float
     wall_N: float | None = None
+    layer_N: float | None = None
+    cpu_time_s: float | None = None
 
     def to_dict(self) -> dict:
-        return {"uncertainty_N": self.uncertainty_N, "mesh_N": self.mesh_N, "solve_N": self.solve_N,
-                "wall_N": self.wall_N,
-                "coarse_value_N": self.coarse_value_N, "coarse_elements": self.coarse_elements,
-                "method": self.method, "wall_time_s": self.wall_time_s}
+        out = {"uncertainty_N": self.uncertainty_N, "mesh_N": self.mesh_N, "solve_N": self.solve_N,
+               "wall_N": self.wall_N,
+               "coarse_value_N": self.coarse_value_N, "coarse_elements": self.coarse_elements,
+               "method": self.method, "wall_time_s": self.wall_time_s}
+        if self.layer_N is not None:     # several cables' parts (one cable's keys unchanged)
+            out.update(layer_N=self.layer_N, cpu_time_s=self.cpu_time_s)
+        return out
 
 
 def combine(value_N: float, coarse_N: float, elements: int, coarse_elements: int, solve_N: float,
@@ -209,3 +244,143 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
     if not math.isfinite(total):
         return SteadyErrorBar(None, None, solve_N, coarse_N, m, f"{head}: not finite", time.perf_counter() - t0)
     return SteadyErrorBar(total, mesh_N, solve_N, coarse_N, m, method, time.perf_counter() - t0)
+
+
+def bundle_solve_part_N(model, settings) -> tuple[float, float]:
+    """u_solve of several cables' steady solve: the stop tolerance × e^(w μ Θ) [N], and that
+    capstan factor [-] (module notes).
+
+    An unbalanced force f left at a station raises the tension behind it by at most f; through the
+    bends a tension increment grows at most as the capstan's dT/dθ = w μ T, so by e^(w μ Θ) with Θ
+    the route's whole turning angle, μ the wall's friction and w the larger of the calculators'
+    weight correction factor and 1 (the cables' wedging raises the wall's normal force by w).
+
+    Parameters
+    ----------
+    model : exucable.model.bundle.BundleModel
+        The solved bundle.
+    settings : exucable.solve.steady.SteadySettings
+        The solve's settings (``steady_residual``).
+    """
+    from ..quasistatic import engineering as eng
+    from .steady import stop_tolerance_N
+
+    sc = model.scenario
+    D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
+    w = max(1.0, float(eng.weight_correction_factor(model.n_cables, model.arrangement, D, d)))
+    gain = math.exp(w * float(sc.contact.friction) * model.conduit.centreline.turning_angle_rad)
+    return stop_tolerance_N(model, settings) * gain, gain
+
+
+def onset_layer_part_N(onset: dict | None) -> float:
+    """u_layer: what the contact onset layer's continuation leaves in the answer [N] (module notes).
+
+    ``onset``: the continuation's summary (:meth:`exucable.solve.onset_continuation.OnsetContinuation.summary`).
+    At a finite layer, the answer's distance from Richardson's s → 0 extrapolation (inf where only one
+    layer solved); at s = 0, the solved answer's distance from the extrapolation of the two thinnest
+    layers above 0 (0 where fewer than two solved). None of a summary: 0 (no layer, the law itself).
+    """
+    from .onset_continuation import extrapolate_to_zero
+
+    if not onset:
+        return 0.0
+    if onset["layer_m"] > 0.0:
+        err = onset["layer_error_N"]
+        return float("inf") if err is None else float(err)
+    done = [st for st in onset["stages"] if st["converged"] and st["pull_force_N"] is not None]
+    finite = [st for st in done if st["layer_m"] > 0.0][-2:]
+    if len(finite) < 2 or done[-1]["layer_m"] != 0.0:
+        return 0.0
+    f0, _ = extrapolate_to_zero([st["layer_m"] for st in finite], [st["pull_force_N"] for st in finite])
+    return abs(float(done[-1]["pull_force_N"]) - f0)
+
+
+def coarse_solve_skipped(error_bar: bool, cpu_left_s: float, fine_cpu_s: float) -> str | None:
+    """Why a bundle's coarse solve is not made (None: it is): not asked for, or the CPU budget left,
+    ``cpu_left_s`` [s], is below ``BUNDLE_COARSE_COST`` × the fine solve's ``fine_cpu_s`` [s]."""
+    if not error_bar:
+        return "not asked for (error_bar=False)"
+    need = BUNDLE_COARSE_COST * fine_cpu_s
+    if cpu_left_s < need:
+        return (f"{max(cpu_left_s, 0.0):.3g} s CPU left of the steady budget (solver.steady_time_limit), a coarse "
+                f"solve takes about {need:.3g} s ({BUNDLE_COARSE_COST:g} x the fine solve's {fine_cpu_s:.3g} s)")
+    return None
+
+
+def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settings, start: str,
+                     refine: float = 1.0, cpu_left_s: float = float("inf"), skip: str | None = None) -> SteadyErrorBar:
+    """The uncertainty of several cables' steady pull ``value_N`` [N] (module notes): u_solve + u_layer,
+    plus u_mesh from a second solve on a mesh ``COARSE_RATIO`` coarser unless ``skip`` says why not.
+
+    Parameters
+    ----------
+    scenario : exucable.scenario.Scenario
+        The bundle's scenario.
+    model : exucable.model.bundle.BundleModel
+        The solved bundle (its mesh, stop tolerance and arrangement).
+    value_N : float
+        Its pulling force [N].
+    onset : dict or None
+        The solve's onset layer summary (``SolveOutcome.onset_layer``).
+    settings : exucable.solve.steady.SteadySettings
+        The fine solve's settings; the coarse solve keeps them but for the start and the CPU limit.
+    start : str
+        The start that gave the answer (``bundle_starts``' entry): the coarse solve's only start.
+    refine : float
+        The fine model's ``refine``; the coarse one is built at ``refine / COARSE_RATIO``.
+    cpu_left_s : float
+        The coarse solve's CPU limit [s] (what is left of the budget).
+    skip : str, optional
+        Why the coarse solve is not made (:func:`coarse_solve_skipped`).
+
+    Never raises for a coarse mesh the rule refuses or a coarse solve that fails: the bar is then
+    the solve's parts, and the method says the mesh part was not measured and why.
+    """
+    from dataclasses import replace
+
+    from ..errors import ModelError
+    from ..model.bundle import build_bundle_model
+    from .bundle_starts import solve_bundle_starts
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    solve_N, gain = bundle_solve_part_N(model, settings)
+    layer_N = onset_layer_part_N(onset)
+    parts = solve_N + layer_N
+    solve_text = (f"the steady solve's stop residual {settings.steady_residual:g} x the rope's largest tension x the "
+                  f"capstan factor e^(w mu Theta) = {gain:.3g} = {solve_N:.2g} N; the contact onset layer's "
+                  f"|F - F0| (Richardson on the two thinnest layers) = {layer_N:.2g} N")
+    n = model.mesh.elements
+    head = f"second bundle steady solve on a mesh {COARSE_RATIO:g}x coarser from the start \"{start}\""
+
+    def parts_only(why: str, m=None, coarse_N=None) -> SteadyErrorBar:
+        return SteadyErrorBar(parts, None, solve_N, coarse_N, m,
+                              f"solve parts only, mesh part not measured ({why}): {solve_text}; added; "
+                              "the bar covers the steady state found (a bundle may have several)",
+                              time.perf_counter() - t0, layer_N=layer_N,
+                              cpu_time_s=None if m is None else time.process_time() - c0)
+
+    if skip is not None:
+        return parts_only(skip)
+    try:
+        coarse = build_bundle_model(scenario, refine=refine / COARSE_RATIO, start_path=start)
+    except ModelError as exc:
+        return parts_only(f"{head} not possible: {exc}")
+    m = coarse.mesh.elements
+    if m >= n:
+        return parts_only(f"{head} not possible: {n} elements cannot be coarsened")
+    left = cpu_left_s - (time.process_time() - c0)
+    if left <= 0.0:
+        return parts_only(f"{head}: no CPU time left after its build")
+    out = solve_bundle_starts(scenario, coarse, refine=refine / COARSE_RATIO,
+                              settings=replace(settings, bundle_starts=(start,), time_limit_s=left)).outcome
+    if out.status == "failed":
+        return parts_only(f"{head} failed: {out.message}", m)
+    coarse_N = float(np.sum(coarse.pull_shares_N()))
+    mesh_N, total = combine(value_N, coarse_N, n, m, parts)
+    method = (f"{head} ({m} elements per cable against {n}): mesh = |F - F_coarse| / (r^p - 1) with r = {n / m:.4g} "
+              f"and an assumed order p = {ASSUMED_ORDER:g} (Richardson's error estimate) + {RESOLUTION_FLOOR:g} x |F|; "
+              f"plus {solve_text}; added; the bar covers the steady state found (a bundle may have several)")
+    if not math.isfinite(total):
+        return parts_only(f"{head}: not finite", m, coarse_N)
+    return SteadyErrorBar(total, mesh_N, solve_N, coarse_N, m, method, time.perf_counter() - t0,
+                          layer_N=layer_N, cpu_time_s=time.process_time() - c0)

@@ -107,7 +107,7 @@ from .block_sweeps import node_block_masses
 from .onset_continuation import OnsetContinuation, OnsetSettings
 from .negative_curvature import curvature_phase
 
-__all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings"]
+__all__ = ["SteadySettings", "SteadySolver", "solve_steady", "static_settings", "stop_tolerance_N"]
 
 
 @dataclass(frozen=True)
@@ -547,6 +547,14 @@ def _set_scale(model, lam: float, loads: bool = True) -> None:
         model.coupling.forget_evaluation()
 
 
+
+def stop_tolerance_N(model, settings: SteadySettings) -> float:
+    """The steady solve's stop tolerance [N]: ``steady_residual`` × the rope solution's largest tension
+    (at least the back tension, at least 1 N), the norm below which the unbalanced force must fall."""
+    scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
+                  model.back_tension_N, 1.0)
+    return float(settings.steady_residual) * scale_N
+
 class SteadySolver:
     """The steady sliding state of ``model`` (built with ``solver.mode = "steady"``) by
     pseudo-transient continuation (the module's notes); :meth:`solve` runs it, once.
@@ -597,10 +605,8 @@ class SteadySolver:
         self.backtracks = 0       # force evaluations of shortened one-iteration steps (shorten_step)
         self.steps = 0            # pseudo-time steps tried (rejected and failed ones included)
         self.accepted = 0         # pseudo-time steps kept (the history's rows)
-        scale_N = max(float(np.max(np.abs(model.rope.tension_N))) if model.rope is not None else 0.0,
-                      model.back_tension_N, 1.0)
         #: the stop tolerance [N]
-        self.tolerance_N = float(settings.steady_residual) * scale_N
+        self.tolerance_N = stop_tolerance_N(model, settings)
         self.exact_settings = static_settings(tolerance=settings.newton_tolerance,
                                               absolute_tolerance_N=settings.exact_newton_share * self.tolerance_N)
         self.inexact_settings = static_settings(tolerance=settings.inexact_newton_tolerance,
