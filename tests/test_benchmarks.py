@@ -43,6 +43,7 @@ SCRIPTS = {
     "benchmarks/sweep_throughput.py": "cases/min/core",
     "studies/beam_conduit_study.py": "| case | EJ [N m²] | model: stiff vs its EJ → 0 limit",
     "studies/bundle_upbend_study.py": "| bend | arrangement | cable friction | status",
+    "studies/bundle_error_bar.py": "| bend | arrangement | cable friction | status | F [N] | u [N] (u/F)",
     "studies/bundle_route_onset.py": "| check | result |",
     "studies/bundle_curvature_study.py": "| eigenvalue [1/s²] | mode largest on cable |",
     "studies/bundle_relax_handover.py": "| relaxed state below [N] | its residual [N] | one-iteration continuation",
