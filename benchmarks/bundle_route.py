@@ -13,8 +13,9 @@ scenario without ``cable.arrangement`` gets: the calculators' choice, cradled at
 ``triangular`` (the triangle's top cable falls off the other two in the bends at this D/d; the steady
 solve follows it from the cross-section's statics start, which ``solver.bundle_starts`` tries after
 the clearance start gives up: reference/README.md, "A start sequence"), each with the start that
-answered. Mesh: the scenario's rule (printed); a bundle run states no
-error bar yet (the one-cable run's is the coarse-mesh Richardson estimate). Target (issue "Three
+answered. Mesh: the scenario's rule (printed); each run's error bar is printed with its parts (a
+bundle's: the coarse-mesh solve only where the CPU budget left has room for it,
+``exucable.solve.error_bar.bundle_error_bar``). Target (issue "Three
 cables in one conduit"): ≤ 60 s whole process. The machine is shared: compare the rows of one run
 with each other.
 """
@@ -128,6 +129,11 @@ def _print_bundle(count: int, name: str, row: dict, t1: float, c1: float) -> Non
     print(f"    weight correction factor {_num(b.get('weight_correction_factor'), '.5g')} (calculators' "
           f"{_num(b.get('formula_weight_correction_factor'), '.5g')}); per straight: "
           + ", ".join(_num(st.get("weight_correction_factor"), ".4g") for st in b.get("straights") or []))
+    u = sn.get("pull_force_uncertainty") or {}
+    print(f"    error bar ± {_num(sn.get('pull_force_uncertainty_N'), '.3g')} N (mesh {_num(u.get('mesh_N'), '.3g')} N, "
+          f"solve {_num(u.get('solve_N'), '.2g')} N, onset layer {_num(u.get('layer_N'), '.2g')} N; coarse "
+          f"{_num(u.get('coarse_value_N'), '.6g')} N on {u.get('coarse_elements')} elements, "
+          f"{_num(u.get('cpu_time_s'), '.3g')} s CPU): {(sn.get('pull_force_uncertainty_method') or '')[:200]}")
     print("    pull shares: " + ", ".join(_num(None if c.get("pull_share") is None else 100 * c["pull_share"], ".1f", " %")
                                          for c in b.get("cables") or []))
 

@@ -63,10 +63,11 @@ def test_the_onset_layer_part_is_the_richardson_step():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("bend, arrangement", [("down", "triangular"), ("down", "cradled")])
-def test_the_bar_covers_the_error_against_a_mesh_four_times_finer(bend, arrangement):
+@pytest.mark.parametrize("bend, arrangement, cable_friction", [("down", "triangular", 0.0), ("down", "cradled", 0.0),
+                                                               ("up", "triangular", 0.0), ("left", "triangular", 0.3)])
+def test_the_bar_covers_the_error_against_a_mesh_four_times_finer(bend, arrangement, cable_friction):
     # studies/bundle_error_bar.py: the reference is the same case on the mesh refined 4 times
-    sc = scenario(bend, arrangement, 0.0, 60.0)
+    sc = scenario(bend, arrangement, cable_friction, 60.0)
     ref = run_scenario(sc, refine=4.0, error_bar=False).summary["pull_force_N"]
     for refine in (1.0, 2.0):
         s = run_scenario(sc, refine=refine).summary

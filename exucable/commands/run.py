@@ -123,8 +123,16 @@ def _print_bundle(s: dict, out_dir: Path) -> int:
     """The report of a run of several cables (``cable.count`` > 1); exit status as for one cable."""
     b = s["bundle"]
     wcf = b["weight_correction_factor"]
+    u = s.get("pull_force_uncertainty_N")
+    if s["mode"] == "steady" and u is not None:
+        parts = s.get("pull_force_uncertainty") or {}
+        # the mesh part only where the budget left had room for the coarse solve: say when it is missing
+        spread = (f" (± {_f(u, '.2g')} N: mesh and solve tolerance)" if parts.get("mesh_N") is not None
+                  else f" (± {_f(u, '.2g')} N: solve tolerance only, mesh part not measured)")
+    else:
+        spread = ""
     print(f"{s['name']}: status {s['status']}, {b['count']} cables {b['arrangement']}, pulling force "
-          f"{_f(s['pull_force_N'])} N, back tension {_f(s['trailing_tension_N'])} N, max tension {_f(s['max_tension_N'])} N")
+          f"{_f(s['pull_force_N'])} N{spread}, back tension {_f(s['trailing_tension_N'])} N, max tension {_f(s['max_tension_N'])} N")
     print(f"  weight correction factor {_f(wcf, '.5g')} (the calculators' {b['formula_weight_correction_factor']:.5g})")
     for st in b["straights"]:
         print(f"  straight {st['s_conduit_start_m']:.4g}-{st['s_conduit_end_m']:.4g} m: weight correction "
