@@ -35,9 +35,11 @@ def test_keys_follow_the_kind_of_run():
     assert "bundle" not in one and one["mode_rule"] == "given" and one["rope_pull_force_N"] is None
     assert not {"start", "failed_at_s", "snapshots_s", "files", "pressure_window_m"} & set(one)
     assert "mode_rule" not in bundle and bundle["bundle"] == {"count": 2}
+    # a steady bundle states its pull's uncertainty as one cable does (exucable.solve.error_bar.bundle_error_bar)
     assert set(bundle) == {"name", "mode", "status", "message", "flags", "pull_force_N", "trailing_tension_N",
                            "max_tension_N", "bundle", "steps", "newton_iterations", "wall_time_s", "build_time_s",
-                           "mesh", "warnings", "scenario", "versions"}
+                           "mesh", "warnings", "scenario", "versions", "pull_force_uncertainty_N",
+                           "pull_force_uncertainty_method", "pull_force_uncertainty"}
     assert list(one) == [k for k in SUMMARY_KEYS if k in one]          # written in the record's order
     assert one.get("failed_at_s", "absent") == "absent" and one["flags"] == []
     # a force-controlled steady solve states its trailing tension's uncertainty, null when it has none
