@@ -20,9 +20,13 @@ The geometry (each case's bend between a straight of ``before`` and one of ``aft
   rig at the exit (``solver.steady_lead_out`` 0), from each start.
 
 The dynamic pull starts from (``--from``): ``laid`` (the bundle's laid start, pre-tensioned, not solved:
-the clearance path, the arrangement rolled toward the load), ``clearance`` or ``statics_own`` (the steady
-state of the start geometry solved from that start, the material sliding along it at the pull speed,
-:func:`exucable.model.bundle_rig.solved_bundle_layouts`).
+the clearance path, the arrangement rolled toward the load), ``laid_axis`` and ``laid_statics_own`` (the
+other start paths, laid), ``clearance`` or ``statics_own`` (the steady state of the start geometry solved
+from that start, the material sliding along it at the pull speed,
+:func:`exucable.model.bundle_rig.solved_bundle_layouts`; ``--nudge`` moves cable 3 of it sideways, to break
+a symmetric state). As the straight before the bend shortens, the tension entering the bend falls by the
+straight's friction; ``--hold-entry`` raises the back tension by it as the pull goes on (the steady solves
+of the final geometry then carry the raised back tension).
 
 Per dynamic run: the CPU, steps and Newton iterations; over the last ``--window`` metres pulled the eye's
 force's mean, standard deviation and the drift between the halves' means, against the drift expected as
@@ -34,8 +38,9 @@ force as a tension lower by m V² would, so the bundle's pull is lower by about
 n m V² (e^{μ w_c θ} − 1) (the capstan on the bend, n cables of m kg/m, w_c the weight correction,
 θ the bend's angle); ``--speeds`` runs more than one speed to measure it.
 
-    nice .venv/bin/python studies/bundle_dynamic_judge.py [--cases up03 up0 left03 ind90] [--from laid clearance statics_own]
-        [--pull 6.0] [--speeds 1.0] [--window 1.0] [--limit 60]
+    nice .venv/bin/python studies/bundle_dynamic_judge.py [--cases up03 up0 left03 ind90]
+        [--from laid laid_axis laid_statics_own clearance statics_own] [--pull X] [--speeds 1.0] [--window 1.0]
+        [--limit 60] [--nudge 1] [--hold-entry] [--no-steady | --no-dynamic] [--save DIR]
     nice .venv/bin/python studies/bundle_dynamic_judge.py --quick
 
 ``--quick``: the up-bend with cable friction 0.3, pulled 0.2 m from the laid start, no steady solve
@@ -171,14 +176,22 @@ def nudged(layout, nudge_m: float):
     return dataclasses.replace(layout, position_m=layout.position_m + nudge_m * side)
 
 
+def straight_friction_N_per_m(case: Case) -> float:
+    """The bundle's friction per metre on a horizontal straight by the calculators' weight correction
+    [N/m]: μ w_c · 3 w."""
+    from exucable.quasistatic import engineering as eng
+
+    wc = eng.weight_correction_factor(3, "triangular", 2 * case.duct_radius_m, 2 * R_CABLE)
+    return case.friction * wc * 3 * DENSITY * math.pi * R_CABLE ** 2 * G
+
+
 def dynamic_pull(case: Case, start: str, pull_m: float, speed_m_per_s: float, limit_s: float, samples: int = 10,
-                 nudge_m: float = 0.0):
+                 nudge_m: float = 0.0, hold_entry: bool = False):
     """Pull the case's bundle ``pull_m`` metres at ``speed_m_per_s`` from ``start`` (module notes).
 
     Returns a dict: ``time_s``, ``force_N`` (the eye's pull history), ``sections`` (pulled [m], the
     cables' places in the bend's middle [m]), ``cpu_s`` (build, start's solve and integration),
-    ``outcome`` (the integration's), ``drift_N_per_m`` (the share rope's expected drift per metre
-    pulled), ``start_pull_N`` (the start's steady pull, NaN for ``laid``)."""
+    ``outcome`` (the integration's), ``start_pull_N`` (the start's steady pull, NaN for ``laid``)."""
     from exucable.model.bundle import build_bundle_model, bundle_cross_sections
     from exucable.model.bundle_rig import build_bundle_dynamic_model, solved_bundle_layouts
     from exucable.solve.dynamic import simulate
@@ -216,7 +229,18 @@ def dynamic_pull(case: Case, start: str, pull_m: float, speed_m_per_s: float, li
             sections.append((pulled, bundle_cross_sections(dyn, [s_mid])[0]))
         return True
 
-    mbs.SetPostStepUserFunction(watch)
+    trailing = [(i, np.array(mbs.GetLoadParameter(i, "loadVector"), dtype=float))
+                for hd in dyn.handles for i in hd.end_loads["trailing"]] if hold_entry else []
+    rate = straight_friction_N_per_m(case) * speed_m_per_s / 3 / max(case.back_tension_N / 3, 1e-12)
+
+    def watch_and_hold(mbs_, t):
+        # the back tension raised as the straight before the bend shortens: the bend's entry tension
+        # stays the start's (set after each step: the next step's load, lagging by one step)
+        for i, v0 in trailing:
+            mbs_.SetLoadParameter(i, "loadVector", list(v0 * (1.0 + rate * t)))
+        return watch(mbs_, t)
+
+    mbs.SetPostStepUserFunction(watch_and_hold)
     outcome = simulate(dyn, steady_stop=False)
     cpu = time.process_time() - c0
     h = outcome.history
@@ -255,6 +279,9 @@ def main(argv=None) -> int:
     p.add_argument("--limit", type=float, default=60.0, help="each steady solve's CPU limit [s]")
     p.add_argument("--no-steady", action="store_true", help="the dynamic pulls only")
     p.add_argument("--no-dynamic", action="store_true", help="the steady solves only")
+    p.add_argument("--hold-entry", action="store_true", help="raise the back tension by the straight's friction "
+                   "μ w_c 3w per metre pulled, so that the bend's entry tension stays; the final geometry's steady "
+                   "solves then carry T_b + μ w_c 3w X")
     p.add_argument("--nudge", type=float, default=0.0, help="the solved starts' cable 3 moved this far sideways [mm]")
     p.add_argument("--save", type=Path, help="a folder for each dynamic pull's force history and sections (.npz)")
     p.add_argument("--quick", action="store_true", help="the up-bend with μ_c 0.3 pulled 0.2 m from the laid start")
@@ -273,10 +300,14 @@ def main(argv=None) -> int:
             print("| geometry | start | status | CPU [s] | pull [N] | shares [N] | cables in the bend's middle (horizontal, up) [mm] | "
                   + " | ".join(f"{a:g} m past the bend [mm]" for a in AFTER_M) + " |")
             print("| --- | --- | --- | --- | --- | --- | --- |" + " --- |" * len(AFTER_M))
-            for after, label in ((case.after_m, "study"), (case.after_m + X, "final")):
+            final = case
+            if args.hold_entry:
+                final = dataclasses.replace(case, back_tension_N=case.back_tension_N + straight_friction_N_per_m(case) * X)
+                print(f"(final geometry: back tension {final.back_tension_N:.2f} N, raised as the pull held the bend's entry)\n")
+            for c_, after, label in ((case, case.after_m, "study"), (final, case.after_m + X, "final")):
                 for start in ("clearance", "statics_own"):
                     from exucable.model.bundle import bundle_cross_sections
-                    sc = scenario(case, case.before_m, after, STUDY_SPEED, args.limit)
+                    sc = scenario(c_, case.before_m, after, STUDY_SPEED, args.limit)
                     model, out, cpu, pull = steady(sc, start)
                     xy = bundle_cross_sections(model, places_m(case, case.before_m))
                     print(f"| {label} ({case.before_m:g} / {after:.3g} m) | {start} | {out.status} | {cpu:.2f} | {pull:.3f} | "
@@ -286,9 +317,10 @@ def main(argv=None) -> int:
             print(f"\ndynamic pulls at {V:g} m/s" + (f", the solved starts' cable 3 moved {args.nudge:g} mm aside" if args.nudge else "") + f" (ε {100 * 0.01:g} % of it: {1e3 * 0.01 * V:g} mm/s), inertia's share "
                   f"n m V² (e^(μ w_c θ) − 1) = {inertia_share_N(case, V):+.3f} N; the last {args.window:g} m pulled:\n")
             w_ = args.window
+            # held entry: only the straight after the bend lengthens
             drift = (rope_pull_N(case, case.before_m, case.after_m + X)
-                     - rope_pull_N(case, case.before_m + w_, case.after_m + X - w_))
-            print(f"expected drift (the rope's pull with μ w_c, straights {case.before_m + w_:g} / {case.after_m + X - w_:.3g} m → "
+                     - rope_pull_N(case, case.before_m + (0.0 if args.hold_entry else w_), case.after_m + X - w_))
+            print(f"expected drift (the rope's pull with μ w_c, straights {case.before_m + (0.0 if args.hold_entry else w_):g} / {case.after_m + X - w_:.3g} m → "
                   f"{case.before_m:g} / {case.after_m + X:.3g} m): {drift / w_:+.3f} N/m\n")
             print("| from | start's steady pull [N] | status | CPU [s] | steps | Newton its | mean [N] | std [N] | "
                   "drift between halves [N/m] | at the end, fitted [N] | cables in the bend's middle at the end [mm] |")
@@ -296,7 +328,8 @@ def main(argv=None) -> int:
             runs = []
             for start in args.starts:
                 try:
-                    r = dynamic_pull(case, start, X, V, args.limit, nudge_m=1e-3 * args.nudge)
+                    r = dynamic_pull(case, start, X, V, args.limit, nudge_m=1e-3 * args.nudge,
+                                     hold_entry=args.hold_entry)
                 except RuntimeError as exc:
                     print(f"| {start} | {exc} | | | | | | | | | |", flush=True)
                     continue
