@@ -10,8 +10,10 @@ and times ``exucable run SCENARIO --no-plots`` in a fresh process per repeat (sc
 timed in the same run, and prints the ratio, the bundle's pull force, its weight correction factor
 beside the calculators' and its status, for each arrangement given: by default ``auto`` (what a
 scenario without ``cable.arrangement`` gets: the calculators' choice, cradled at this D/d) and
-``triangular`` (the triangle's top cable falls off the other two in the bends at this D/d, which the
-steady solve does not follow yet: reference/README.md). Mesh: the scenario's rule (printed); a bundle run states no
+``triangular`` (the triangle's top cable falls off the other two in the bends at this D/d; the steady
+solve follows it from the cross-section's statics start, which ``solver.bundle_starts`` tries after
+the clearance start gives up: reference/README.md, "A start sequence"), each with the start that
+answered. Mesh: the scenario's rule (printed); a bundle run states no
 error bar yet (the one-cable run's is the coarse-mesh Richardson estimate). Target (issue "Three
 cables in one conduit"): ≤ 60 s whole process. The machine is shared: compare the rows of one run
 with each other.
@@ -112,8 +114,9 @@ def _print_bundle(count: int, name: str, row: dict, t1: float, c1: float) -> Non
     sn = row["summary"]
     b = sn.get("bundle") or {}
     laid = b.get("arrangement", name)
+    tried = ", ".join(f"{a['start']} {a['status']} {a['cpu_s']:.3g} s" for a in b.get("starts_tried") or [])
     print(f"  {count} cables, arrangement {name}{f' ({laid})' if laid != name else ''}: {tn:7.2f} s wall, {cn:7.2f} s CPU, "
-          f"status {sn['status']}, pull {_num(sn['pull_force_N'], '.6g')} N, "
+          f"status {sn['status']}, pull {_num(sn['pull_force_N'], '.6g')} N, starts tried: {tried or 'n/a'}, "
           f"{sn['mesh']['elements']} elements each ({sn['mesh']['element_length_m']:.3g} m, {sn['mesh']['check_points_per_element']} check points), {sn['newton_iterations']} Newton iterations"
           + (f" ({sn['message']})" if sn["status"] == "ok" else ""))
     print(f"    ratio bundle / one cable: {tn / t1:.2f}x wall, {cn / c1:.2f}x CPU; target ≤ 60 s whole process: "

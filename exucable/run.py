@@ -509,7 +509,8 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     (no files here: :func:`run_scenario` writes them)."""
     from .model.bundle import build_bundle_model, bundle_report, bundle_tension_profile, check_bundle_supported
     from .solve.dynamic import Progress
-    from .solve.steady import SteadySettings, solve_steady
+    from .solve.bundle_starts import solve_bundle_starts
+    from .solve.steady import SteadySettings
 
     if check_points_per_element is not None:
         raise ModelError("contact.check_points_per_element", "several cables take the scenario's check points; "
@@ -517,13 +518,17 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     check_bundle_supported(sc)
     if sc.solver.mode == "dynamic":
         return _solve_bundle_dynamic(sc, quiet, steady_stop, refine)
+    settings = SteadySettings.from_solver(sc.solver)
     t_start = time.perf_counter()
-    model = build_bundle_model(sc, refine=refine)
+    model = build_bundle_model(sc, refine=refine, start_path=settings.bundle_starts[0])
     build_s = time.perf_counter() - t_start
     t_cpu = time.process_time()
     progress = _budgeted(Progress(1.0, label=sc.name, enabled=not quiet), cpu_budget_s)
+    start, attempts = settings.bundle_starts[0], []
     try:
-        out = solve_steady(model, progress=progress, settings=SteadySettings.from_solver(sc.solver))
+        # the starts in turn, each but the last given up where its relaxation stalls (solve.bundle_starts)
+        solved = solve_bundle_starts(sc, model, refine=refine, settings=settings, progress=progress)
+        model, out, start, attempts = solved.model, solved.outcome, solved.start, solved.attempts
     except _OverBudget:
         from .model.recorder import History
         from .solve.dynamic import SolveOutcome
@@ -558,7 +563,9 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
         trailing_tension_N=report["trailing_tension_N"],
         max_tension_N=report["max_tension_N"],
         bundle={k: v for k, v in report.items() if k not in ("pull_force_N", "trailing_tension_N", "max_tension_N")}
-        | {"onset_layer": out.onset_layer},
+        | {"onset_layer": out.onset_layer, "start": start,
+           "starts_tried": [{"start": a.start, "status": a.status, "cpu_s": a.cpu_s,
+                             "newton_iterations": a.newton_iterations} for a in attempts]},
         steps=out.steps,
         newton_iterations=out.newton_iterations,
         wall_time_s=out.wall_time_s,

@@ -41,13 +41,16 @@ from .generic import add_user_force_object
 from .layout import CableLayout, lay_cable, plan_cable_mesh, steady_lead_out_m
 from .rig import Drive, add_drive, add_end_force
 
-__all__ = ["BundleModel", "arrangement_offsets", "load_turn_rad", "start_tensions", "build_bundle_model", "statics_start", "check_bundle_supported",
+__all__ = ["BUNDLE_STARTS", "BundleModel", "arrangement_offsets", "load_turn_rad", "start_tensions", "build_bundle_model", "statics_start", "check_bundle_supported",
            "bundle_arrangement", "bundle_report", "bundle_tension_profile", "straight_weight_correction",
            "bundle_sections", "bundle_cross_sections", "bundle_tension_along_conduit"]
 
 
 #: Gap left at the start between the cables and to the wall, in cable radii [-] (see build_bundle_model).
 START_GAP = 0.05
+
+#: the bundle's starts (``build_bundle_model``'s ``start_path``; ``[solver] bundle_starts`` tries them in turn)
+BUNDLE_STARTS = ("clearance", "statics_own", "statics", "axis")
 
 
 def bundle_arrangement(scenario) -> str:
@@ -778,9 +781,9 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
     # the wall and 2 mm into each other at 1 m elements and a 0.5 m roll)
     T_ref = max(float(np.max(rope.tension_N)), 1e-6)
     blend = max(L_cable / n_el, math.sqrt(c.bending_stiffness_N_m2 / T_ref))
-    if start_path not in ("clearance", "axis", "statics", "statics_own"):
-        raise ModelError("start_path", f"{start_path!r} is not a bundle start; use \"clearance\", \"statics\", "
-                                       "\"statics_own\" or \"axis\"")
+    if start_path not in BUNDLE_STARTS:
+        raise ModelError("start_path", f"{start_path!r} is not a bundle start; use one of "
+                                       + ", ".join(f'"{x}"' for x in BUNDLE_STARTS))
     path = _centroid_path(centre, offsets, sc.contact.friction * wcf, w, back, L_cable - lead_out) \
         if start_path != "axis" else None
     start_rope = rope if path is None else path

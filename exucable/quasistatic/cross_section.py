@@ -17,6 +17,8 @@ carry over from station to station, as the cables' do.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 __all__ = ["rest_in_duct", "rest_along", "separate_circles"]
@@ -27,6 +29,20 @@ PENALTY = 1e4
 STEP_CAP = 0.25
 
 
+@lru_cache(maxsize=8)
+def _pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs i < j of n circles (``np.triu_indices(n, 1)``), kept: the start's build evaluates
+    Eq. (1) tens of thousands of times, and making them anew was a third of its cost."""
+    I, J = np.triu_indices(n, 1)
+    I.flags.writeable = False
+    J.flags.writeable = False
+    return I, J
+
+
+_EYE2 = np.eye(2)
+_EYE2.flags.writeable = False
+
+
 def _energy_parts(x, p, rho, d, k, spring, target, hessian=True):
     """Π of Eq. (1) (plus the centroid spring's (s/2)|x̄ − target|²), its gradient (n, 2) and
     Hessian (2n, 2n) at positions ``x`` (n, 2), all in cable radii and loads scaled to order one."""
@@ -35,7 +51,7 @@ def _energy_parts(x, p, rho, d, k, spring, target, hessian=True):
     g = -p.copy()
     size = np.hypot(x[:, 0], x[:, 1])
     wall = size > rho
-    I, J = np.triu_indices(n, 1)
+    I, J = _pairs(n)
     v = x[I] - x[J]
     dist = np.hypot(v[:, 0], v[:, 1])
     pair = dist < d
@@ -55,7 +71,7 @@ def _energy_parts(x, p, rho, d, k, spring, target, hessian=True):
     if not hessian:
         return E, g, None
     H = np.zeros((n, n, 2, 2))
-    eye = np.eye(2)
+    eye = _EYE2
     uu = uw[:, :, None] * uw[:, None, :]
     w_idx = np.nonzero(wall)[0]
     H[w_idx, w_idx] += k * (uu + (over / size[wall])[:, None, None] * (eye - uu))

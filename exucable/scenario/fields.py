@@ -342,6 +342,16 @@ FIELDS: tuple[Field, ...] = (
       rule="≥ 0; steady mode and `solver.start_from = \"steady\"`: cable laid out past the conduit's exit at the start (the state a dynamic pull "
            "reaches after pulling that far: `exucable validate` sets it to the dynamic run's "
            "`reference_pulled_out_m` to compare both modes in the same state)", le=1.0e4, why="keeps the run's size finite"),
+    F("solver.bundle_starts", "bundle_starts", "strings", "", ("clearance", "statics_own"),
+      choices=("clearance", "statics_own", "statics", "axis"), ours=True,
+      default_doc='`["clearance", "statics_own"]`',
+      rule="steady mode, several cables: the starts tried in turn, each but the last given up where its dynamic "
+           "relaxation stalls, the next solved in the CPU time left of `solver.steady_time_limit` (the summary's "
+           "`bundle.start` says which gave the answer, `bundle.starts_tried` each one's CPU): `\"clearance\"`, the "
+           "bundle's centroid on the rope-with-clearance path; `\"statics_own\"`, each cable where the statics of "
+           "its cross-section puts it under its own start tension (`\"statics\"`: the cables' mean tension; "
+           "`\"axis\"`: the arrangement about the duct's axis). Where there are several steady states the start "
+           "chooses among them (reference/README.md, \"A start sequence\"); one start given alone is the only one tried"),
     F("solver.cable_element", "cable_element", "choice", "", "compiled", choices=("compiled", "exudyn"), ours=True,
       rule="steady mode (one cable or several): who assembles the ANCF cables' elastic forces and their Jacobian: `\"compiled\"`, "
            "exucable's compiled copy of Exudyn's `ObjectANCFCable` (`exucable/contact/ancf_cable.py`, equal to "

@@ -129,9 +129,14 @@ def coerce_value(f: Field, value):
     if f.kind == "strings":
         if isinstance(value, str) or not isinstance(value, (list, tuple)):
             raise ScenarioError(key, f"must be an array of strings, e.g. [\"A\", \"B\"], got {_describe(value)}")
+        if f.choices and not value:
+            raise ScenarioError(key, f"must name at least one of {', '.join(repr(c) for c in f.choices)}")
         for i, item in enumerate(value):
             if not isinstance(item, str) or not item.strip():
                 raise ScenarioError(f"{key}[{i}]", f"must be a non-empty string, got {_describe(item)}")
+            if f.choices and item not in f.choices:
+                allowed = ", ".join(f'"{c}"' for c in f.choices)
+                raise ScenarioError(f"{key}[{i}]", f"must be one of {allowed}, got {_describe(item)}")
         return tuple(value)
     if f.kind == "vector3":
         return _vector3(key, value, f.unit, nonzero=f.nonzero, max_abs=f.max_abs, why=f.why)
@@ -679,6 +684,8 @@ class SolverSpec(_Spec):
         Steady mode: who runs the static solves' Newton iterations: our own loop on the assembled
         system where the model allows it (:mod:`exucable.solve.newton_system`), or Exudyn's
         static solver.
+    bundle_starts : tuple of str
+        Steady mode, several cables: the starts tried in turn (:mod:`exucable.solve.bundle_starts`).
     """
 
     _SECTION: ClassVar[str] = "solver"
@@ -704,6 +711,7 @@ class SolverSpec(_Spec):
     start_from: str = _default("solver.start_from")
     cable_element: str = _default("solver.cable_element")
     static_solver: str = _default("solver.static_solver")
+    bundle_starts: tuple = _default("solver.bundle_starts")
 
     @property
     def mode_rule(self) -> str:

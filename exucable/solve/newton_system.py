@@ -174,9 +174,16 @@ class OwnStaticNewton(StaticBackend):
     time_parts_s : dict
         CPU time [s] per part: ``"forces"`` (kernel, cable, spring: the residual), ``"assembly"``
         (values into the banded matrix), ``"factorisation"`` (factor and solve), ``"glue"`` (the rest).
+    deadline_cpu_s : float
+        Process CPU time (``time.process_time()``) [s] after which :meth:`solve` takes no further
+        iteration and says that it stopped (inf, the default: never). The steady solve sets it to
+        the end of its budget: an exact pseudo-time step is up to 12 iterations (~1.5 s on the
+        100 m three-cable route), and a solve that read its clock only between steps overran its
+        limit by seconds.
     """
 
     name = "exucable"
+    deadline_cpu_s = float("inf")
 
     def __init__(self, model, spring, time_s: float = 1.0, linear_solver: str = "banded", checked: bool = False):
         why = "" if checked else own_newton_unsupported(model, spring)
@@ -418,6 +425,9 @@ class OwnStaticNewton(StaticBackend):
             if initial <= absolute_tolerance_N:
                 initial = 2.0 * absolute_tolerance_N     # at least one step
             while not converged and iterations < max_iterations:
+                if iterations and time.process_time() > self.deadline_cpu_s:
+                    message = f"Newton stopped at the CPU time limit after {iterations} iterations (residual {residual:.3g} N)"
+                    break
                 iterations += 1
                 try:
                     dq, dlam = self._newton_step(q, r, c)

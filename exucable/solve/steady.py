@@ -74,7 +74,9 @@ than the relaxation's last digits cost), and every phase after runs from the rel
 implicit steps stalled at newtons where the cables must rearrange across the duct (three cables in an
 up-bend: the triangle turns over onto the upper wall), and the relaxation, like a physical settle, moves
 off the unstable balances on the way (reference/README.md, the up-bend study: 12 of 12 cases solve, 5
-failed at the 60 s limit before).
+failed at the 60 s limit before). Where the relaxation from one start stalls, the next start of
+``bundle_starts`` is built and solved instead (:mod:`exucable.solve.bundle_starts`; the solver's
+``fallback``).
 
 A solve may instead start warm, from a state near its steady state (``warm_start``: the coarse mesh's
 solved state subdivided, :func:`exucable.solve.start.nested_start`). The phases above assume the rope
@@ -230,6 +232,24 @@ class SteadySettings:
         negative mode, but the continuation after them put the top cable back on its crest and
         stalled higher (28.2 N against 18.2 N; reference/README.md, "Negative curvature on the 100 m
         route").
+    bundle_starts : tuple of str
+        Several cables: the starts tried in turn (``build_bundle_model``'s ``start_path``,
+        ``[solver] bundle_starts``; :func:`exucable.solve.bundle_starts.solve_bundle_starts`), each
+        but the last given up where its dynamic relaxation stalls (``bundle_start_stall_steps``), the
+        next built and solved in the CPU time left. Why ``("clearance", "statics_own")``: the
+        clearance start solves the up-bend study's 12 cases and the 100 m cradle (their answers
+        unchanged), the cross-section's statics the 100 m triangle, where the clearance start's
+        relaxation stalls at 29.4 N (reference/README.md, "A start sequence").
+    bundle_start_stall_steps, bundle_start_stall_work : int, float
+        A start that another follows gives up where its dynamic relaxation has not halved its
+        residual in max(``bundle_start_stall_steps``, ``bundle_start_stall_work`` / the bundle's
+        coordinates) steps [-] (at most the relaxation's own 5000), counted in steps, not seconds,
+        so that which start answers does not depend on the machine. Measured (the longest stretch
+        without a halving in relaxations that went on to solve, reference/README.md, "A start
+        sequence"): the up-bend study's cases 867-2017 steps (198 coordinates: 2e6 / 198 = 10 100,
+        the relaxation's own rule applies), the 100 m cradle 655 (1818 coordinates), the industry
+        three-cable plan's cradle 823 (3546); the 100 m triangle's clearance start last halved at
+        step 1084 and never again in 5000. 1100 steps: it gives up at step 2184.
     max_backtracks : int
         Halvings of a one-iteration step whose residual grew more than ``reject_growth``-fold before
         it is rejected [-] (the module's notes; each costs one force evaluation, no Newton
@@ -267,9 +287,20 @@ class SteadySettings:
     max_backtracks: int = 6
     bundle_block_sweeps: int = 0
     bundle_block_coarse_steps: int = 0
+    bundle_starts: tuple = ("clearance", "statics_own")
+    bundle_start_stall_steps: int = 1100
+    bundle_start_stall_work: float = 2.0e6
 
     def __post_init__(self):
-        check_settings(self, skip=("bundle_relax_masses",))
+        from ..model.bundle import BUNDLE_STARTS
+
+        check_settings(self, skip=("bundle_relax_masses", "bundle_starts"))
+        starts = self.bundle_starts
+        if isinstance(starts, str) or not isinstance(starts, (tuple, list)) or not starts \
+                or any(x not in BUNDLE_STARTS for x in starts):
+            allowed = ", ".join(f'"{x}"' for x in BUNDLE_STARTS)
+            raise SolverError(f"SteadySettings.bundle_starts = {starts!r}: give one or more of {allowed}")
+        object.__setattr__(self, "bundle_starts", tuple(starts))
         if self.bundle_relax_masses not in ("diagonal", "frame"):
             raise SolverError(f"SteadySettings.bundle_relax_masses = {self.bundle_relax_masses!r}: "
                               f"use \"diagonal\" or \"frame\"")
@@ -280,8 +311,9 @@ class SteadySettings:
     @classmethod
     def from_solver(cls, solver) -> "SteadySettings":
         """The settings of a scenario's ``[solver]`` table (:class:`exucable.scenario.specs.SolverSpec`):
-        its ``steady_residual`` and ``steady_time_limit_s``, the defaults otherwise."""
-        return cls(steady_residual=float(solver.steady_residual), time_limit_s=float(solver.steady_time_limit_s))
+        its ``steady_residual``, ``steady_time_limit_s`` and ``bundle_starts``, the defaults otherwise."""
+        return cls(steady_residual=float(solver.steady_residual), time_limit_s=float(solver.steady_time_limit_s),
+                   bundle_starts=tuple(solver.bundle_starts))
 
 
 def initial_spring_rate(model) -> float:
@@ -537,11 +569,21 @@ class SteadySolver:
         The system's ODE2 and algebraic coordinates of a state near the steady state to start from
         (:func:`exucable.solve.start.nested_start`); the model's own start (the rope's) is the
         fallback. See the module's notes.
+    onset : OnsetSettings, optional
+        Several cables: the contact onset layer's continuation (:mod:`exucable.solve.onset_continuation`).
+    fallback : bool
+        Several cables: another start follows this one
+        (:func:`exucable.solve.bundle_starts.solve_bundle_starts`). The dynamic relaxation then stops
+        where its residual has not halved in ``bundle_start_stall_steps`` (or more) steps, and
+        where it fails the solve fails at once (no exact-step continuation, no load ramp): the
+        next start gets the time left.
     """
 
     def __init__(self, model, settings: SteadySettings = SteadySettings(), progress: Progress | None = None,
-                 warm_start: tuple | None = None, onset: OnsetSettings | None = None):
+                 warm_start: tuple | None = None, onset: OnsetSettings | None = None, fallback: bool = False):
         self.model = model
+        #: another start follows (exucable.solve.bundle_starts): give up where the relaxation stalls
+        self.fallback = fallback
         self.warm_start = warm_start
         self.settings = settings
         self.progress = progress
@@ -571,6 +613,9 @@ class SteadySolver:
         self.static, self.static_note = static_backend(model, self.spring, static_settings, _static_choice(model))
         self._solved = False
         self._cpu_start = time.process_time()
+        if hasattr(self.static, "deadline_cpu_s"):
+            # our Newton loop reads the clock between its iterations too: an exact step is up to 12
+            self.static.deadline_cpu_s = self._cpu_start + settings.time_limit_s
         self.timed_out = False           # stopped at settings.time_limit_s
         self._trace_lam, self._trace = 0.0, []   # the load scale of the last accepted steps, their residuals [N]
         #: several cables (exucable.model.bundle): the continuation's bundle rules apply (module notes)
@@ -757,8 +802,12 @@ class SteadySolver:
             self.store.saved = self.start
             self.store.restore_as_initial()
             left = s.time_limit_s - (time.process_time() - self._cpu_start)
+            stall = RelaxSettings.stall_steps
+            if self.fallback:
+                stall = min(stall, max(s.bundle_start_stall_steps,
+                                       int(s.bundle_start_stall_work / self.model.ode2_index.size)))
             out = relax_bundle(self.model, RelaxSettings(residual_N=target, max_steps=max(s.bundle_relax_steps - steps, 1),
-                                                         time_limit_s=max(left, 1e-3)),
+                                                         time_limit_s=max(left, 1e-3), stall_steps=stall),
                                masses=s.bundle_relax_masses)
             steps, restarts, cpu = steps + out.steps, restarts + out.restarts, cpu + out.cpu_s
             self.relaxation = replace(out, steps=steps, restarts=restarts, cpu_s=cpu)
@@ -766,7 +815,8 @@ class SteadySolver:
             self.start = self.store.saved
             note = (f"{why}; then dynamic relaxation: {steps} steps, {restarts} restarts, residual "
                     f"{out.residual_N:.3g} N ({out.message})")
-            if self.out_of_time():
+            if self.out_of_time() or (self.fallback and not out.converged):
+                # a start that another follows gives up where its relaxation stalled
                 return False, note
             ok, message = self.relax_one_iteration(1.0)
             if ok:
@@ -922,7 +972,7 @@ class SteadySolver:
         outside_at_start = _outside_points(model)
         if self.onset is not None:
             self.onset.begin(model)
-        ok, warm_note, started_from = False, "", "rope"
+        ok, warm_note, started_from, gave_up = False, "", "rope", False
         if self.warm_start is not None:
             ok, why = self.relax_warm()
             if ok:
@@ -941,7 +991,8 @@ class SteadySolver:
                 ok, first_message = self.relax_dynamic(first_message)
                 if not ok and self.settings.bundle_curvature_rounds and not self.timed_out:
                     ok, self.curvature_note = curvature_phase(self, self.settings.bundle_curvature_rounds)
-            if not ok and not self.timed_out:
+            gave_up = not ok and self.fallback and self.relaxation is not None
+            if not ok and not self.timed_out and not gave_up:
                 self.store.saved = self.start
                 ok, first_message = self.relax(1.0)
                 if not ok and self.relaxation is not None:
@@ -964,6 +1015,9 @@ class SteadySolver:
                 r = self.relaxation
                 message += (f" (after the one-iteration steps from the rope start failed, from the state of a "
                             f"dynamic relaxation: {r.steps} steps, {r.cpu_s:.3g} s CPU, residual {r.residual_N:.3g} N)")
+        elif gave_up:
+            # another start follows: the slower phases are left to the last one (SteadySolver's fallback)
+            status, message = "failed", f"given up for the next start: {first_message}"
         else:
             status, message = self.ramp_loads(first_message)
             if status != "ok" and self.bundle and not self.timed_out:
@@ -1028,7 +1082,8 @@ def solve_steady(model, progress: Progress | None = None, tolerance: float | Non
     given, it replaces that of ``settings`` (default :class:`SteadySettings`). ``warm_start``: a
     state near the steady state to start from, the rope start the fallback (:class:`SteadySolver`).
     Several cables are solved through a smooth contact onset continued to the law without it
-    (:mod:`exucable.solve.onset_continuation`, :class:`OnsetSettings`' defaults).
+    (:mod:`exucable.solve.onset_continuation`, :class:`OnsetSettings`' defaults), from the model's own
+    start only: ``settings.bundle_starts`` in turn is :func:`exucable.solve.bundle_starts.solve_bundle_starts`.
     """
     settings = SteadySettings() if settings is None else settings
     if tolerance is not None:

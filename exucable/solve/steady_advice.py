@@ -40,10 +40,11 @@ def _triangle_note(model) -> str:
 
     Why: pressed onto a bend's wall by tensions far above their weight, the triangle's top cable
     sits on a crest of the other two (its stiffness with them held has negative eigenvalues) and
-    falls into the cradle's place, climbing back on the straights; the steady solve has not
-    followed that rearrangement on the 100 m route or the industry plan, where the cradled
-    arrangement solves (reference/README.md, "Block Gauss–Seidel by cable" and "The industry
-    three-cable plan: the top cable falls off in the bends")."""
+    falls into the cradle's place, climbing back on the straights; the steady solve follows that
+    rearrangement on the 100 m route only from the cross-section's statics start (the default
+    ``solver.bundle_starts``' second), and not on the industry plan from any start, where the
+    cradled arrangement solves (reference/README.md, "The industry three-cable plan: the top cable
+    falls off in the bends" and "A start sequence")."""
     from ..quasistatic.engineering import auto_arrangement
 
     sc = getattr(model, "scenario", None)
@@ -54,7 +55,7 @@ def _triangle_note(model) -> str:
         return ""
     return (f"; or `cable.arrangement = \"cradled\"` (the calculators' arrangement at D/d {D / d:.3g} ≥ 2.5): "
             "at this D/d a triangle's top cable falls off the other two in the bends, a rearrangement the "
-            "steady solve does not follow yet")
+            "steady solve does not always follow")
 
 
 def head_strain(model) -> tuple[float, float, float]:
