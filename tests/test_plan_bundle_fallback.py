@@ -83,6 +83,11 @@ def test_a_triangle_that_does_not_hold_is_simulated_cradled_and_labelled(runs, t
         (row,) = d["sections"]
         assert (row["formula_arrangement"], row["simulated_arrangement"], row["arrangement_found"]) == \
             ("triangular", "cradled", "cradled")
+        # the check names what was simulated; the solve's details stay on the direction's status line
+        (check,) = [c for c in d["checks"] if c["name"] == "multibody_run"]
+        head = d["message"].split("; ")[0]
+        assert check["passed"] and check["where"].startswith("status ok: simulated as cradled (the triangle did not")
+        assert len(check["where"]) < len(d["message"]) and check["where"].endswith(")") and head in check["where"]
     write_plan(tmp_path, plan, sc, "si")
     with open(tmp_path / "sections_forward.csv", newline="") as fh:
         (row,) = list(csv.DictReader(fh))
@@ -93,6 +98,7 @@ def test_a_triangle_that_does_not_hold_is_simulated_cradled_and_labelled(runs, t
     page = (tmp_path / "report.html").read_text()
     assert "Simulated as cradled (the triangle did not hold:" in page
     assert "triangular (given: triangular); simulated as cradled" in page
+    assert "multibody model of 3 cables in one duct" in page and "multibody model of one cable" not in page
 
 
 def test_the_triangle_as_given_fails_with_the_reason(runs):

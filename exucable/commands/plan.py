@@ -44,7 +44,7 @@ def add_arguments(p) -> None:
     p.add_argument("--engine", choices=ENGINES, default="auto",
                    help="auto (default): steady for one cable, rope for cable.count > 1; steady (one static solve "
                         "per direction, seconds) or dynamic (a dynamic run per direction, with progress; needs "
-                        "solver.end_time): the multibody model of one cable, the rope's values beside; rope "
+                        "solver.end_time): the multibody model of the cable (or of cable.count cables in one duct), the rope's values beside; rope "
                         "(instant, any cable.count)")
     p.add_argument("--arrangement-as-given", action="store_true",
                    help="several cables, --engine steady: simulate cable.arrangement only, even where the "

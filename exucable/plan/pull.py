@@ -42,7 +42,7 @@ from exucable.scenario.units import SYSTEMS
 from exucable.output.versions import versions
 
 __all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "pull_in_rope",
-           "arrangement_left", "BUNDLE_CPU_BUDGET_S",
+           "arrangement_left", "run_headline", "BUNDLE_CPU_BUDGET_S",
            "ENGINES", "CHECKS", "point_names"]
 
 ENGINES = ("auto", "rope", "steady", "dynamic")
@@ -558,6 +558,21 @@ def _bundle_fallback(name: str, engine: str, rope_entry: dict, progress: bool, n
     return dict(entry, arrangement_fallback=info, simulated_arrangement=rule)
 
 
+def run_headline(entry: dict) -> str:
+    """The run's message for the ``multibody_run`` check: whole where the run is not trusted (its
+    reason and fix), else its first clause (what was simulated), the solve's details, which the
+    direction's status line prints in full, left out."""
+    message = entry["message"]
+    if entry["status"] not in TRUSTED_STATUSES:
+        return message
+    depth = 0
+    for i, ch in enumerate(message):
+        depth += {"(": 1, ")": -1}.get(ch, 0)
+        if depth == 0 and message.startswith("; ", i):
+            return message[:i]
+    return message
+
+
 def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry: dict, progress: bool,
                          names: list[str] | None = None, as_given: bool = False, notify=None) -> dict:
     """One direction's plan entry from the multibody model, the rope's values kept beside.
@@ -784,7 +799,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
             # a run that failed or is flagged (exucable.post.trust) gives numbers no check should pass on
             entry["checks"].append({"name": "multibody_run", "passed": entry["status"] in TRUSTED_STATUSES,
                                     "value": None, "limit": None, "margin": None, "quantity": None,
-                                    "where": f"status {entry['status']}" + (f": {entry['message']}" if entry["message"] else "")})
+                                    "where": f"status {entry['status']}" + (f": {run_headline(entry)}" if entry["message"] else "")})
         entry["passed"] = all(c["passed"] for c in entry["checks"])
         if spec.feed_from_reel:
             entry["pull_in"] = _pull_in_history(curve, rope)

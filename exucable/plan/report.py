@@ -30,7 +30,7 @@ from exucable.errors import ExucableError
 from exucable.io import atomic_write_text, new_figure
 from exucable.scenario.units import display_unit, from_si
 
-__all__ = ["plan_report_html", "section_rows", "bundle_note", "simulated_arrangement_phrase", "check_in_units",
+__all__ = ["plan_report_html", "section_rows", "engine_note", "bundle_note", "simulated_arrangement_phrase", "check_in_units",
            "fmt_number", "direction_label", "report_pdf", "find_browser"]
 
 # Screen: a readable column. Print: 182 mm of text (A4 210 mm and Letter 216 mm, less 14 mm margins), no
@@ -347,6 +347,19 @@ _ENGINE_NOTE = {
 }
 
 
+def engine_note(plan: dict) -> str:
+    """What the plan's engine simulated, in words: the note of ``_ENGINE_NOTE``, with "one cable" made
+    the bundle's cables where ``cable.count`` > 1 (each cable its own ANCF cable, the cable–cable
+    contact between them; the calculators' weight-corrected rope beside)."""
+    note = _ENGINE_NOTE[plan["engine"]]
+    count = int(plan.get("count") or plan.get("inputs", {}).get("count") or 1)
+    if count > 1 and plan["engine"] != "rope":
+        note = note.replace("multibody model of one cable", f"multibody model of {count} cables in one duct "
+                            "(one ANCF cable each, cable–cable contact)").replace(
+            "the rope's values beside", "the calculators' formula values beside")
+    return note
+
+
 def _check_phrase(c: dict, units: str) -> str:
     value, limit, unit = check_in_units(c, units)
     if value is None or limit is None:
@@ -397,7 +410,7 @@ def _meta_rows(plan: dict, meta: dict) -> list[tuple[str, str]]:
             ("Revision", meta.get("revision") or blank), ("Date", meta.get("date") or blank),
             ("Scenario", f"{inp['scenario']}" + (f": {inp['description']}" if inp.get("description") else "")),
             ("Scenario file", meta.get("scenario_file") or inp.get("scenario_file") or "–"),
-            ("Engine", f"{plan['engine']}: {_ENGINE_NOTE[plan['engine']]}"),
+            ("Engine", f"{plan['engine']}: {engine_note(plan)}"),
             ("Software", f"exucable {v.get('exucable', '?')} (Exudyn {v.get('exudyn', '?')}, numpy "
                          f"{v.get('numpy', '?')}, Python {v.get('python', '?')})")]
     return rows
