@@ -176,6 +176,9 @@ def test_plan_simulates_a_bundle_with_the_calculators_values_beside():
         b = d["bundle"]
         assert b["formula_weight_correction_factor"] == plan["weight_correction_factor"]
         assert b["sections"][0]["arrangement"] == "cradled" and b["jam"] is False
+        # the run's error bar carried over (exucable.solve.error_bar.bundle_error_bar), with its method
+        assert 0.0 < d["pull_force_uncertainty_N"] < 0.05 * d["pull_force_N"]
+        assert "coarser" in d["pull_force_uncertainty_method"] or "mesh part not measured" in d["pull_force_uncertainty_method"]
     engine, rule = resolve_engine("auto", 3)
     assert engine == "rope" and "bends" in rule
     with pytest.raises(ScenarioError) as err:
@@ -222,6 +225,7 @@ def test_a_plan_whose_bundle_does_not_solve_in_its_budget_fails_cleanly(monkeypa
         assert d["status"] == "failed" and "CPU budget" in d["message"] and "--engine rope" in d["message"]
         assert d["sections"][0]["tension_out_N"] == d["rope_pull_force_N"]
         assert d["bundle"]["weight_correction_factor"] is None      # no simulated number from an unsolved state
+        assert d["pull_force_uncertainty_N"] is None and "failed" in d["pull_force_uncertainty_method"]
         (check,) = [c for c in d["checks"] if c["name"] == "multibody_run"]
         assert not check["passed"]
     assert not plan["passed"]

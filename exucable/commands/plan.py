@@ -188,7 +188,10 @@ def main(args) -> int:
         if "rope_pull_force_N" in d:
             u = d.get("pull_force_uncertainty_N")
             if u is not None:
-                print(f"  pull force uncertainty ± {from_si(u, 'force', units):.2g} {f}")
+                # a bundle's bar without its coarse solve (no CPU time left for it) is the solve's parts only: say so
+                partial = (d.get("pull_force_uncertainty_method") or "").startswith("solve parts only")
+                print(f"  pull force uncertainty ± {from_si(u, 'force', units):.2g} {f}"
+                      + (" (solve parts only, mesh part not measured)" if partial else ""))
             # a bundle's rope is the calculators' formula (the weight correction of the plan's arrangement)
             rope = (f"the calculators' formula ({plan['arrangement']}, weight correction "
                     f"{fmt_number(plan['weight_correction_factor'])})" if "bundle" in d else "rope")
