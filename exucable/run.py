@@ -219,7 +219,9 @@ def run_scenario(scenario: Scenario | str | Path, out_dir=None, quiet: bool = Tr
     scenario's (``exucable converge``); ``mode`` (``"dynamic"`` or ``"steady"``) overrides
     ``solver.mode``. ``error_bar``: a steady solve states its uncertainty from a second solve on a
     coarser mesh (:mod:`exucable.solve.error_bar`); False skips that solve (its uncertainty is then
-    None), as ``exucable converge`` does, whose levels are the error bar. ``cpu_budget_s`` (several
+    None), as ``exucable converge`` does, whose levels are the error bar; several cables' steady solve
+    then states the solve's parts only (:func:`exucable.solve.error_bar.bundle_error_bar`, which makes
+    the coarse solve only where the CPU budget left has room for it). ``cpu_budget_s`` (several
     cables only): the steady solve gives up once it has used this much CPU time [s], checked after
     each accepted pseudo-time step (status ``failed``, saying so). ``plots`` may be a
     :class:`~exucable.output.figure_process.Figures` the caller started before anything loaded Exudyn

@@ -45,6 +45,21 @@ def test_a_bar_without_the_coarse_solve_is_the_solve_parts_and_says_so(down_bend
     assert b["layer_N"] == down_bend["pull_force_uncertainty"]["layer_N"]
 
 
+def test_a_coarse_solve_out_of_time_leaves_the_solve_parts_and_says_why():
+    from exucable.solve.error_bar import bundle_error_bar
+    from exucable.solve.steady import SteadySettings
+
+    sc = scenario("down", "triangular", 0.0, 60.0)
+    r = run_scenario(sc)
+    s = r.summary
+    bar = bundle_error_bar(sc, r.model, s["pull_force_N"], s["bundle"]["onset_layer"],
+                           SteadySettings.from_solver(sc.solver), s["bundle"]["start"], cpu_left_s=1e-3)
+    assert bar.mesh_N is None and bar.coarse_elements == s["mesh"]["elements"] // 2
+    assert bar.uncertainty_N == pytest.approx(s["pull_force_uncertainty"]["solve_N"] + s["pull_force_uncertainty"]["layer_N"])
+    assert bar.method.startswith("solve parts only, mesh part not measured (second bundle steady solve")
+    assert "failed" in bar.method or "no CPU time left" in bar.method
+
+
 @pytest.mark.parametrize("left_s, fine_s, skipped", [(10.0, 40.0, True), (39.0, 40.0, True), (45.0, 40.0, False), (5.0, 4.0, False)])
 def test_the_coarse_solve_waits_for_its_budget(left_s, fine_s, skipped):
     why = coarse_solve_skipped(True, left_s, fine_s)

@@ -381,7 +381,7 @@ def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settin
         return parts_only(f"{head} not possible: {n} elements cannot be coarsened")
     left = cpu_left_s - (time.process_time() - c0)
     if left <= 0.0:
-        return parts_only(f"{head}: no CPU time left after its build")
+        return parts_only(f"{head}: no CPU time left after its build", m)
     out = solve_bundle_starts(scenario, coarse, refine=refine / COARSE_RATIO,
                               settings=replace(settings, bundle_starts=(start,), time_limit_s=left)).outcome
     if out.status == "failed":
