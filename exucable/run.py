@@ -613,7 +613,8 @@ def _bundle_uncertainty(sc, model, out, report: dict, settings, start: str, atte
         left = min(left, cpu_budget_s - used_cpu_s)
     fine_cpu = attempts[-1].cpu_s if attempts else used_cpu_s
     bar = bundle_error_bar(sc, model, report["pull_force_N"], out.onset_layer, settings, start, refine=refine,
-                           cpu_left_s=left, skip=coarse_solve_skipped(error_bar, left, fine_cpu))
+                           cpu_left_s=left, skip=coarse_solve_skipped(error_bar, left, fine_cpu),
+                           weight_correction=report.get("weight_correction_factor"))
     return {"pull_force_uncertainty_N": bar.uncertainty_N, "pull_force_uncertainty_method": bar.method,
             "pull_force_uncertainty": bar.to_dict()}
 

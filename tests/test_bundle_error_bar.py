@@ -53,7 +53,8 @@ def test_a_coarse_solve_out_of_time_leaves_the_solve_parts_and_says_why():
     r = run_scenario(sc)
     s = r.summary
     bar = bundle_error_bar(sc, r.model, s["pull_force_N"], s["bundle"]["onset_layer"],
-                           SteadySettings.from_solver(sc.solver), s["bundle"]["start"], cpu_left_s=1e-3)
+                           SteadySettings.from_solver(sc.solver), s["bundle"]["start"], cpu_left_s=1e-3,
+                           weight_correction=s["bundle"]["weight_correction_factor"])
     assert bar.mesh_N is None and bar.coarse_elements == s["mesh"]["elements"] // 2
     assert bar.uncertainty_N == pytest.approx(s["pull_force_uncertainty"]["solve_N"] + s["pull_force_uncertainty"]["layer_N"])
     assert bar.method.startswith("solve parts only, mesh part not measured (second bundle steady solve")

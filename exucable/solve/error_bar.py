@@ -100,8 +100,9 @@ BUNDLE_ASSUMED_ORDER = 0.5
 
 #: A bundle's coarse solve is made where the CPU time left of the budget is at least this times the
 #: fine solve's (the start that gave the answer). Half the unknowns, but not half the cost: the coarse
-#: solve took 0.83 times the fine one's CPU on the 100 m cradle (its dynamic relaxation's steps do not
-#: halve) and 0.3 to 0.7 times on the up-bend study's cases (reference/README.md, "A bundle's error bar").
+#: solve took 0.84 times the fine one's CPU on the 100 m cradle (its dynamic relaxation's steps do not
+#: halve) and 0.31 to 2.1 times on the up-bend study's cases (reference/README.md, "A bundle's error
+#: bar"); it may use no more than the time left, so the budget holds whatever it costs.
 BUNDLE_COARSE_COST = 1.0
 
 
@@ -257,14 +258,15 @@ def steady_error_bar(scenario, model, value_N: float, quantity: str, coarse=None
     return SteadyErrorBar(total, mesh_N, solve_N, coarse_N, m, method, time.perf_counter() - t0)
 
 
-def bundle_solve_part_N(model, settings) -> tuple[float, float]:
+def bundle_solve_part_N(model, settings, weight_correction: float | None = None) -> tuple[float, float]:
     """u_solve of several cables' steady solve: the stop tolerance × e^(w μ Θ) [N], and that
     capstan factor [-] (module notes).
 
     An unbalanced force f left at a station raises the tension behind it by at most f; through the
     bends a tension increment grows at most as the capstan's dT/dθ = w μ T, so by e^(w μ Θ) with Θ
-    the route's whole turning angle, μ the wall's friction and w the larger of the calculators'
-    weight correction factor and 1 (the cables' wedging raises the wall's normal force by w).
+    the route's whole turning angle, μ the wall's friction and w the largest of the calculators'
+    weight correction factor, ``weight_correction`` (the one that emerged, where known) and 1 (the
+    cables' wedging raises the wall's normal force by w).
 
     Parameters
     ----------
@@ -278,7 +280,8 @@ def bundle_solve_part_N(model, settings) -> tuple[float, float]:
 
     sc = model.scenario
     D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
-    w = max(1.0, float(eng.weight_correction_factor(model.n_cables, model.arrangement, D, d)))
+    w = max(1.0, float(eng.weight_correction_factor(model.n_cables, model.arrangement, D, d)),
+            float(weight_correction or 0.0))
     gain = math.exp(w * float(sc.contact.friction) * model.conduit.centreline.turning_angle_rad)
     return stop_tolerance_N(model, settings) * gain, gain
 
@@ -319,7 +322,8 @@ def coarse_solve_skipped(error_bar: bool, cpu_left_s: float, fine_cpu_s: float) 
 
 
 def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settings, start: str,
-                     refine: float = 1.0, cpu_left_s: float = float("inf"), skip: str | None = None) -> SteadyErrorBar:
+                     refine: float = 1.0, cpu_left_s: float = float("inf"), skip: str | None = None,
+                     weight_correction: float | None = None) -> SteadyErrorBar:
     """The uncertainty of several cables' steady pull ``value_N`` [N] (module notes): u_solve + u_layer,
     plus u_mesh from a second solve on a mesh ``COARSE_RATIO`` coarser unless ``skip`` says why not.
 
@@ -343,6 +347,8 @@ def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settin
         The coarse solve's CPU limit [s] (what is left of the budget).
     skip : str, optional
         Why the coarse solve is not made (:func:`coarse_solve_skipped`).
+    weight_correction : float, optional
+        The weight correction factor that emerged [-] (:func:`bundle_solve_part_N`).
 
     Never raises for a coarse mesh the rule refuses or a coarse solve that fails: the bar is then
     the solve's parts, and the method says the mesh part was not measured and why.
@@ -354,7 +360,7 @@ def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settin
     from .bundle_starts import solve_bundle_starts
 
     t0, c0 = time.perf_counter(), time.process_time()
-    solve_N, gain = bundle_solve_part_N(model, settings)
+    solve_N, gain = bundle_solve_part_N(model, settings, weight_correction)
     layer_N = onset_layer_part_N(onset)
     parts = solve_N + layer_N
     solve_text = (f"the steady solve's stop residual {settings.steady_residual:g} x the rope's largest tension x the "
