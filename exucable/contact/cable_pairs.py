@@ -373,15 +373,17 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                     continue
                 px, py, pz = X[i, 0], X[i, 1], X[i, 2]
                 # an upper bound on the nearest distance: the last point's nearest segment and its
-                # neighbours (or p's own index)
+                # neighbours (or p's own index), kept as the first candidates (not evaluated again);
+                # no farther than the layer's edge gap + s, beyond which a point has no contact
                 guess = previous if first <= previous < last else min(max(p, first), last - 1)
-                ub = np.inf
-                for j in range(max(first, guess - 1), min(last, guess + 2)):
-                    d2 = _segment_distance2(X, ob + j, px, py, pz)[1]
-                    if d2 < ub:
-                        ub = d2
-                reach = np.sqrt(ub) + 1e-9
+                g0 = max(first, guess - 1)
+                g1 = min(last, guess + 2)
                 best_j, best_t, best_d2 = -1, 0.0, np.inf
+                for j in range(g0, g1):
+                    t, d2 = _segment_distance2(X, ob + j, px, py, pz)
+                    if d2 < best_d2:
+                        best_j, best_t, best_d2 = j, t, d2
+                reach = min(np.sqrt(best_d2), gap + layer) + 1e-9
                 for k in range(first // G, (last - 1) // G + 1):
                     if _beyond(cen[b, k], rad[b, k], px, py, pz, reach):
                         continue
@@ -391,8 +393,11 @@ def _pair_contacts(X, U, n_cables, n_points, window, gap, weight, K, ex, mu, eps
                         if j0 >= j1 or _beyond(scen[b, sk], srad[b, sk], px, py, pz, reach):
                             continue
                         for j in range(j0, j1):
+                            if g0 <= j < g1:
+                                continue
                             t, d2 = _segment_distance2(X, ob + j, px, py, pz)
-                            if d2 < best_d2:
+                            # the lowest index among equals, as the scan in index order finds it
+                            if d2 < best_d2 or (d2 == best_d2 and j < best_j):
                                 best_j, best_t, best_d2 = j, t, d2
                 if best_j < 0:
                     continue
