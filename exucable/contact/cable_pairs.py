@@ -279,17 +279,30 @@ def _hermite_transpose(f, n_cables, n_el, n_k, coef, out):
     for c in range(n_cables):
         for node in range(n_el + 1):
             for slot in range(2):
-                for i in range(3):
-                    s = 0.0
-                    if node >= 1:
-                        for k in range(n_k):
-                            p = (node - 1) * n_k + k
-                            s += coef[p, 2 + slot] * f[3 * (c * n_points + p) + i]
-                    if node < n_el:
-                        for k in range(n_k):
-                            p = node * n_k + k
-                            s += coef[p, slot] * f[3 * (c * n_points + p) + i]
-                    out[c * n1 + 6 * node + 3 * slot + i] = s
+                # the three components side by side (contiguous in f), each summed in that order
+                s0 = 0.0
+                s1 = 0.0
+                s2 = 0.0
+                if node >= 1:
+                    for k in range(n_k):
+                        p = (node - 1) * n_k + k
+                        cf = coef[p, 2 + slot]
+                        base = 3 * (c * n_points + p)
+                        s0 += cf * f[base]
+                        s1 += cf * f[base + 1]
+                        s2 += cf * f[base + 2]
+                if node < n_el:
+                    for k in range(n_k):
+                        p = node * n_k + k
+                        cf = coef[p, slot]
+                        base = 3 * (c * n_points + p)
+                        s0 += cf * f[base]
+                        s1 += cf * f[base + 1]
+                        s2 += cf * f[base + 2]
+                o = c * n1 + 6 * node + 3 * slot
+                out[o] = s0
+                out[o + 1] = s1
+                out[o + 2] = s2
 
 
 @njit(**_JIT)
@@ -545,12 +558,21 @@ def _add_blocks(index, jac, m, n_points, n_k, n_nodes, row_coef, col_coef, scale
     ``acc[row node, column cable, column node - row node's index + W]`` (node indices within each
     cable), ``used`` marks them.
     """
+    cab = np.empty(3, dtype=np.int64)
+    pt = np.empty(3, dtype=np.int64)
+    el = np.empty(3, dtype=np.int64)
     for c in range(m):
+        # each point's cable, its index on it and its element once per contact: the integer
+        # divisions were the pass's largest cost when done in the column loop (72 per contact)
         for al in range(3):
             ga = index[c, al]
-            cab_a = ga // n_points
-            pa = ga - cab_a * n_points
-            ea = pa // n_k
+            cab[al] = ga // n_points
+            pt[al] = ga - cab[al] * n_points
+            el[al] = pt[al] // n_k
+        for al in range(3):
+            cab_a = cab[al]
+            pa = pt[al]
+            ea = el[al]
             for a in range(4):
                 ca = row_coef[pa, a]
                 if ca == 0.0:
@@ -559,10 +581,9 @@ def _add_blocks(index, jac, m, n_points, n_k, n_nodes, row_coef, col_coef, scale
                 rs = 3 * (a % 2)
                 rnode = cab_a * n_nodes + na
                 for be in range(3):
-                    gb = index[c, be]
-                    cab_b = gb // n_points
-                    pb = gb - cab_b * n_points
-                    eb = pb // n_k
+                    cab_b = cab[be]
+                    pb = pt[be]
+                    eb = el[be]
                     for b in range(4):
                         cb = col_coef[pb, b]
                         if cb == 0.0:
