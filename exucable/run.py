@@ -525,11 +525,19 @@ def _solve_bundle(sc, quiet: bool, steady_stop, refine: float, check_points_per_
     t_cpu = time.process_time()
     progress = _budgeted(Progress(1.0, label=sc.name, enabled=not quiet), cpu_budget_s)
     start, attempts = settings.bundle_starts[0], []
+    current = {"start": start, "model": model}
+
+    def on_start(name, start_model):
+        current.update(start=name, model=start_model)
+
     try:
         # the starts in turn, each but the last given up where its relaxation stalls (solve.bundle_starts)
-        solved = solve_bundle_starts(sc, model, refine=refine, settings=settings, progress=progress)
+        solved = solve_bundle_starts(sc, model, refine=refine, settings=settings, progress=progress,
+                                     on_start=on_start)
         model, out, start, attempts = solved.model, solved.outcome, solved.start, solved.attempts
     except _OverBudget:
+        # the budget may stop a later start: report the state that was being solved
+        model, start = current["model"], current["start"]
         from .model.recorder import History
         from .solve.dynamic import SolveOutcome
 

@@ -17,7 +17,7 @@ the relaxation's steps and smallest residual [N], the smallest true residual the
 Newton iterations and the pull force [N] where it solved. The machine is shared: compare CPU.
 
     nice .venv/bin/python studies/bundle_start_masses.py [--limit 55] [--starts clearance,noroll,statics_own]
-        [--masses diagonal,frame] [--arrangement triangular]
+        [--masses diagonal,frame] [--arrangement triangular] [--scenario FILE] [--reverse]
     nice .venv/bin/python studies/bundle_start_masses.py --quick   # two cables, the 34 m route, 3 s
 """
 
@@ -45,13 +45,22 @@ def _handover():
     return mod
 
 
-def run_variant(start: str, masses: str, limit_s: float, arrangement: str, quick: bool) -> dict:
-    """One pair in this process: the row's fields."""
+def run_variant(start: str, masses: str, limit_s: float, arrangement: str, quick: bool,
+                scenario: str | None = None, reverse: bool = False) -> dict:
+    """One pair in this process: the row's fields (``scenario``: a scenario file instead of the 100 m route,
+    ``reverse``: pulled the other way)."""
     from exucable.model import bundle as bm
     from exucable.solve import steady as st
     from exucable.solve.onset_continuation import OnsetSettings
 
-    sc = _handover().route_scenario("triangular", 2, 12.0) if quick else _handover().route_scenario(arrangement)
+    if scenario is not None:
+        from exucable.scenario.specs import load_scenario
+
+        sc = load_scenario(scenario).replace(**{"solver.mode": "steady", "cable.arrangement": arrangement})
+    else:
+        sc = _handover().route_scenario("triangular", 2, 12.0) if quick else _handover().route_scenario(arrangement)
+    if reverse:
+        sc = sc.replace(**{"pull.direction": "reverse"})
     if start == "noroll":          # the probe: the arrangement laid unrolled along the clearance path
         bm._turn_toward = lambda centreline, s, *a, **k: np.zeros_like(np.asarray(s, dtype=float))
     model = bm.build_bundle_model(sc, start_path="clearance" if start == "noroll" else start)
@@ -67,7 +76,19 @@ def run_variant(start: str, masses: str, limit_s: float, arrangement: str, quick
             "relax_steps": getattr(rel, "steps", 0), "relax_residual": getattr(rel, "residual_N", None),
             "best": float(solver.best[0]),
             "pull": float(model.pull_shares_N().sum()) if out.status == "ok" else None,
-            "message": out.message}
+            "message": out.message, "sections": _arrangements(model) if out.status == "ok" else None}
+
+
+def _arrangements(model) -> str:
+    """The arrangement found per straight and bend of a solved state, with each label's station count."""
+    from exucable.model.bundle import bundle_report, bundle_sections
+
+    rows = bundle_sections(model)["sections"]
+    report = bundle_report(model)
+    shares = 100.0 * model.pull_shares_N() / model.pull_shares_N().sum()
+    return ("; ".join(f"{r['kind']} {r['section']}: {r['arrangement']} {r['arrangements_seen']}" for r in rows)
+            + f"; weight correction {report['weight_correction_factor']:.4g}; pull shares "
+            + " / ".join(f"{x:.1f}" for x in shares) + " %")
 
 
 def main(argv=None) -> int:
@@ -76,6 +97,8 @@ def main(argv=None) -> int:
     p.add_argument("--starts", default="clearance,noroll,statics_own")
     p.add_argument("--masses", default="diagonal,frame")
     p.add_argument("--arrangement", default="triangular")
+    p.add_argument("--scenario", help="a scenario file instead of the 100 m route (e.g. the industry plan's)")
+    p.add_argument("--reverse", action="store_true", help="pull the other way (pull.direction = reverse)")
     p.add_argument("--variant", help="START:MASSES, run in this process (JSON on stdout)")
     p.add_argument("--quick", action="store_true", help="two cables through the 34 m route, 3 s, one pair (a smoke run)")
     args = p.parse_args(argv)
@@ -83,9 +106,11 @@ def main(argv=None) -> int:
         args.limit, args.starts, args.masses = 3.0, "noroll", "frame"
     if args.variant:
         start, masses = args.variant.split(":")
-        print(json.dumps(run_variant(start, masses, args.limit, args.arrangement, args.quick)))
+        print(json.dumps(run_variant(start, masses, args.limit, args.arrangement, args.quick, args.scenario,
+                                     args.reverse)))
         return 0
-    print(f"{args.arrangement}, solve CPU limit {args.limit:g} s, one fresh process per row")
+    print(f"{args.scenario or 'the 100 m route'}{' reversed' if args.reverse else ''}: "
+          f"{args.arrangement}, solve CPU limit {args.limit:g} s, one fresh process per row")
     print("| start | masses | status | solve CPU [s] | process CPU [s] | relaxation steps | its residual [N] "
           "| smallest residual [N] | Newton its | pull [N] |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
@@ -93,6 +118,7 @@ def main(argv=None) -> int:
         for masses in args.masses.split(","):
             cmd = [sys.executable, __file__, "--variant", f"{start}:{masses}", "--limit", str(args.limit),
                    "--arrangement", args.arrangement] + (["--quick"] if args.quick else [])
+            cmd += (["--scenario", args.scenario] if args.scenario else []) + (["--reverse"] if args.reverse else [])
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if proc.returncode:
                 print(f"| {start} | {masses} | error | {proc.stderr.strip().splitlines()[-1:]} |", flush=True)
@@ -104,6 +130,8 @@ def main(argv=None) -> int:
                   f"{r['relax_steps']} | {rr} | {r['best']:.3g} | {r['its']} | {pull} |", flush=True)
             if r["status"] != "ok":
                 print(f"    ({r['message'][:400]})", flush=True)
+            else:
+                print(f"    ({r['sections']})", flush=True)
     return 0
 
 

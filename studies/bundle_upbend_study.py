@@ -25,7 +25,7 @@ and CPU follow the table, with the first layer ``--onset`` [m] (the solve's defa
 ``--no-onset``, the law of one cable throughout (the stall).
 
     nice .venv/bin/python studies/bundle_upbend_study.py [--limit 60] [--quick] [--onset 5e-4 | --no-onset]
-        [--start clearance | statics | axis]
+        [--start clearance | statics | statics_own | axis]
 
 ``--start``: the bundle's start (``build_bundle_model``'s ``start_path``; the default's when not given).
 
@@ -179,7 +179,7 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true", help="the up- and down-bend only, 5 s CPU each")
     p.add_argument("--onset", type=float, default=OnsetSettings().first_m, help="the first onset layer [m]")
     p.add_argument("--no-onset", action="store_true", help="the law of one cable throughout (no onset layer)")
-    p.add_argument("--start", choices=("clearance", "statics", "axis"), help="the bundle's start (default: the model's)")
+    p.add_argument("--start", choices=("clearance", "statics", "statics_own", "axis"), help="the bundle's start (default: the model's)")
     args = p.parse_args(argv)
     onset = None if args.no_onset else OnsetSettings(first_m=args.onset)
     cases = CASES

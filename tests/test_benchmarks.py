@@ -64,6 +64,7 @@ SCRIPTS = {
     "studies/bundle_bend_study.py": "p/formula",
     "studies/bundle_jam_study.py": "F/formula",
     "studies/bundle_settle_start.py": "| start | dynamic pull CPU [s] |",
+    "studies/bundle_dynamic_judge.py": "| from | start's steady pull [N] | status |",
     "studies/bundle_physics_study.py": "| place | arrangement | D/d | μ_c |",
     "studies/checkpoint_study.py": "| case | rule's count | factor | per element |",
     "studies/wall_compliance_study.py": "| case | c [mm] | K [N/m^1.5] | δ/c [-]",

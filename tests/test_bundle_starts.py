@@ -71,8 +71,13 @@ def test_a_start_given_up_hands_over_to_the_next():
     model = build_bundle_model(sc)
     # a stall rule that stops the first start's relaxation at once: the up-bend needs it
     settings = replace(SteadySettings.from_solver(sc.solver), bundle_start_stall_steps=1, bundle_start_stall_work=1.0)
-    out = solve_bundle_starts(sc, model, settings=settings)
+    seen = []
+    out = solve_bundle_starts(sc, model, settings=settings, on_start=lambda name, m: seen.append((name, m)))
     assert out.start == "statics_own"
+    # the caller is told each start's model before its solve: the first is the one it built, the
+    # last the one the answer is in (what a budget that stops the sequence must report)
+    assert [name for name, _ in seen] == ["clearance", "statics_own"]
+    assert seen[0][1] is model and seen[-1][1] is out.model
     assert [(a.start, a.status) for a in out.attempts] == [("clearance", "failed"), ("statics_own", "ok")]
     assert "given up for the next start" in out.attempts[0].message
     assert out.outcome.status == "ok" and out.outcome.message.startswith('from the start "statics_own" ("clearance" gave up')

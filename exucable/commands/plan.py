@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import datetime
 import io
+import sys
 from pathlib import Path
 
 from exucable.plan.pull import ENGINES, load_plan_scenario, plan_pull
@@ -29,6 +30,10 @@ SECTION_COLUMNS = ("index", "kind", "plane", "slope_deg", "angle_deg", "radius_m
 MULTIBODY_SECTION_COLUMNS = ("rope_tension_in_N", "rope_tension_out_N", "rope_sidewall_pressure_N_per_m",
                              "rope_windowed_sidewall_pressure_N_per_m", "mean_sidewall_pressure_N_per_m",
                              "entry_point_load_N", "entry_s_conduit_m", "exit_point_load_N", "exit_s_conduit_m")
+#: Extra section columns of a simulated bundle's plan (several cables, ``--engine steady``): the
+#: arrangement the calculators' formula assumed, the one simulated (the rule's where the asked one did
+#: not hold, see ``exucable.plan.pull.arrangement_left``) and the one found in the section's simulated state.
+BUNDLE_SECTION_COLUMNS = ("formula_arrangement", "simulated_arrangement", "arrangement_found")
 CHECK_COLUMNS = ("direction", "name", "passed", "value", "limit", "margin", "where", "quantity")
 
 
@@ -39,8 +44,13 @@ def add_arguments(p) -> None:
     p.add_argument("--engine", choices=ENGINES, default="auto",
                    help="auto (default): steady for one cable, rope for cable.count > 1; steady (one static solve "
                         "per direction, seconds) or dynamic (a dynamic run per direction, with progress; needs "
-                        "solver.end_time): the multibody model of one cable, the rope's values beside; rope "
+                        "solver.end_time): the multibody model of the cable (or of cable.count cables in one duct), the rope's values beside; rope "
                         "(instant, any cable.count)")
+    p.add_argument("--arrangement-as-given", action="store_true",
+                   help="several cables, --engine steady: simulate cable.arrangement only, even where the "
+                        "calculators' rule gives another for the duct's D/d (three free cables are cradled at "
+                        "D/d >= 2.5); without it a direction whose asked arrangement does not reach a steady "
+                        "state is simulated in the rule's arrangement and labelled so")
     p.add_argument("--units", choices=SYSTEMS, default=None,
                    help="units of the printed tables and the report (default: the scenario's display.units); "
                         "the file's bare numbers are always read in its own display.units")
@@ -82,7 +92,8 @@ def write_plan(out_dir, plan: dict, scenario, units: str, meta: dict | None = No
     for name in ("forward", "reverse"):
         d = plan["directions"][name]
         path = out / f"sections_{name}.csv"
-        columns = SECTION_COLUMNS + (MULTIBODY_SECTION_COLUMNS if plan["engine"] != "rope" else ())
+        columns = SECTION_COLUMNS + (MULTIBODY_SECTION_COLUMNS if plan["engine"] != "rope" else ()) + (
+            BUNDLE_SECTION_COLUMNS if "bundle" in d else ())
         atomic_write_text(path, _text_csv(columns, d["sections"]))
         written.append(path)
         if "pull_in" in d:
@@ -129,8 +140,9 @@ def _print_bundle(b: dict, units: str) -> None:
     p = display_unit("force_per_length", units)
     if b["weight_correction_factor"] is None:
         return      # the solve failed: the status above says so, the sections are the calculators'
-    print(f"  simulated {b['count']} cables: weight correction factor {fmt_number(b['weight_correction_factor'])} "
-          f"(the calculators' {fmt_number(b['formula_weight_correction_factor'])})"
+    print(f"  simulated {b['count']} cables, {b['arrangement']}: weight correction factor "
+          f"{fmt_number(b['weight_correction_factor'])} (the calculators' for {b['arrangement']} "
+          f"{fmt_number(b['formula_weight_correction_factor'])})"
           + (f"; JAM at s = {b['jam_s_conduit_m']:.4g} m" if b.get("jam") else ""))
     for row in b.get("sections") or []:
         print(f"  {row['kind']} {row['section']}: {row['arrangement']}")
@@ -156,7 +168,9 @@ def main(args) -> int:
         from .compile import announce_compiling
 
         announce_compiling()
-    plan = plan_pull(scenario, spec, engine=args.engine, progress=True)
+    plan = plan_pull(scenario, spec, engine=args.engine, progress=True,
+                     arrangement_as_given=args.arrangement_as_given,
+                     notify=lambda line: print(f"{scenario.name}: {line}", file=sys.stderr, flush=True))
     units = spec.units
     f = display_unit("force", units)
     def force(v):
@@ -175,8 +189,11 @@ def main(args) -> int:
             u = d.get("pull_force_uncertainty_N")
             if u is not None:
                 print(f"  pull force uncertainty ± {from_si(u, 'force', units):.2g} {f}")
+            # a bundle's rope is the calculators' formula (the weight correction of the plan's arrangement)
+            rope = (f"the calculators' formula ({plan['arrangement']}, weight correction "
+                    f"{fmt_number(plan['weight_correction_factor'])})" if "bundle" in d else "rope")
             print(f"  {plan['engine']} engine, {d['elements']} elements: status {d['status']}"
-                  f"{'; ' + d['message'] if d['message'] else ''}; rope: pull force "
+                  f"{'; ' + d['message'] if d['message'] else ''}; {rope}: pull force "
                   f"{force(d['rope_pull_force_N'])}, max tension {force(d['rope_max_tension_N'])}")
         _print_table(*section_rows(d, units))
         if "bundle" in d:

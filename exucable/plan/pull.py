@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -41,6 +42,7 @@ from exucable.scenario.units import SYSTEMS
 from exucable.output.versions import versions
 
 __all__ = ["PlanLimits", "PlanSpec", "plan_spec", "parse_plan_scenario", "load_plan_scenario", "plan_pull", "pull_in_rope",
+           "arrangement_left", "run_headline", "BUNDLE_CPU_BUDGET_S",
            "ENGINES", "CHECKS", "point_names"]
 
 ENGINES = ("auto", "rope", "steady", "dynamic")
@@ -441,7 +443,138 @@ def _simulated_sections(rope_entry: dict, s_c, T_c, length_m: float, name: str, 
     return s_c, T_c, rows, to_conduit
 
 
-def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry: dict, progress: bool) -> dict:
+#: Sampling step along the route [m] at which a failed bundle's last state is classified
+#: (:func:`arrangement_left`): finer than a bend's length on the industry routes (R 3 m, 45°: 2.4 m).
+LEFT_STATION_STEP_M = 0.5
+
+
+def arrangement_left(model, asked: str, names: list[str], step_m: float = LEFT_STATION_STEP_M) -> list[dict]:
+    """Where the cables of a bundle model's current state are not in the ``asked`` arrangement.
+
+    Cross-sections every ``step_m`` along each piece of the scenario's route (inside the cables'
+    extent) are classified (:func:`exucable.post.bundle.classify_cross_section`); consecutive
+    stations classified otherwise form one stretch.
+
+    Parameters
+    ----------
+    model : exucable.model.bundle.BundleModel
+        Read at its current coordinates (after a failed solve: its last state).
+    asked : str
+        The arrangement the scenario asked for.
+    names : list of str
+        The route's point names in route order (:func:`point_names`).
+    step_m : float
+        Station spacing [m].
+
+    Returns
+    -------
+    list of dict
+        Per stretch, in route order: ``s_start_m``, ``s_end_m`` (the first and last station, along
+        the scenario's route from its first point [m]), ``arrangement`` (the most frequent label
+        there), ``pieces`` (the pieces it touches, e.g. ``"bend B–C"``).
+    """
+    from exucable.model.bundle import bundle_cross_sections
+    from exucable.post.bundle import classify_cross_section
+
+    sc = model.scenario
+    pieces = sc.build_conduit().centreline.pieces      # route order, as the places are given
+    stations = []
+    for k, piece in enumerate(pieces):
+        n = max(3, int(math.ceil(piece.length_m / step_m)))
+        s = piece.s_start_m + piece.length_m * (np.arange(n) + 0.5) / n
+        stations += [(float(x), k) for x in s]
+    s_all = np.array([x for x, _ in stations])
+    offsets = bundle_cross_sections(model, s_all)
+    labels = []
+    for offs in offsets:
+        labels.append(None if np.isnan(offs).any() else
+                      classify_cross_section(offs, sc.conduit.inner_radius_m, sc.cable.radius_m)["arrangement"])
+    stretches, run = [], []
+    for (x, k), lab in zip(stations + [(math.nan, -1)], labels + [None]):
+        if lab is not None and lab != asked:
+            run.append((x, k, lab))
+            continue
+        if run:
+            found = [r[2] for r in run]
+            touched = sorted({r[1] for r in run})
+            stretches.append({"s_start_m": run[0][0], "s_end_m": run[-1][0],
+                              "arrangement": max(set(found), key=found.count),
+                              "pieces": [f"{'bend' if pieces[j].is_curved else 'straight'} {names[j]}–{names[j + 1]}"
+                                         for j in touched]})
+            run = []
+    return stretches
+
+
+def _left_phrase(asked: str, stretches: list[dict], max_shown: int = 4) -> str:
+    """``stretches`` (:func:`arrangement_left`) in words, e.g. "the cables left the triangle at 57–63 m
+    (bend B–C: cradled)"."""
+    word = "the triangle" if asked == "triangular" else f"the {asked} arrangement"
+    if not stretches:
+        return f"in its last state the cables were still in {word} everywhere"
+    shown = [f"{st['s_start_m']:.1f}–{st['s_end_m']:.1f} m ({', '.join(st['pieces'])}: {st['arrangement']})"
+             for st in stretches[:max_shown]]
+    more = f" and {len(stretches) - max_shown} more" if len(stretches) > max_shown else ""
+    return f"in its last state the cables had left {word} at {'; '.join(shown)}{more} (along the route from its start)"
+
+
+def _bundle_fallback(name: str, engine: str, rope_entry: dict, progress: bool, names: list[str], first, first_cpu_s: float, as_given: bool, notify) -> dict:
+    """A bundle's direction whose asked arrangement (``first``: its failed run) is not the one the
+    calculators' rule gives for its D/d (:func:`exucable.quasistatic.engineering.auto_arrangement`).
+
+    Says where the asked arrangement broke in the failed run's last state (:func:`arrangement_left`);
+    then, unless ``as_given``, simulates the rule's arrangement and returns that entry labelled
+    "simulated as <rule> (the <asked> did not hold: …)", the calculators' values for the asked one
+    (``rope_*``) beside. With ``as_given`` the failed entry is returned, the reason and place in its
+    message. Either way ``arrangement_fallback`` holds ``asked``, ``simulated`` (None: not simulated),
+    ``rule``, ``reason``, ``left`` (the stretches), ``attempt_status``, ``attempt_message`` and
+    ``attempt_cpu_s``.
+    """
+    from exucable.run import run_scenario
+
+    sc = first.model.scenario
+    asked = first.model.arrangement
+    n = sc.cable.count
+    D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
+    rule = eng.auto_arrangement(n, D, d)
+    left = arrangement_left(first.model, asked, names)
+    word = "triangle" if asked == "triangular" else f"{asked} arrangement"
+    reason = (f"its steady solve found no steady state in {first_cpu_s:.3g} s CPU; D/d {D / d:.3g}, where the "
+              f"calculators' rule gives {n} free cables {rule}; {_left_phrase(asked, left)}")
+    info = {"asked": asked, "simulated": None if as_given else rule, "rule": rule, "reason": reason, "left": left,
+            "attempt_status": first.summary["status"], "attempt_message": first.summary["message"],
+            "attempt_cpu_s": first_cpu_s}
+    if as_given:
+        entry = _bundle_direction(first, name, rope_entry)
+        entry["message"] = (f"the {word} did not hold ({reason}); {entry['message']}; fix: plan without "
+                            f"--arrangement-as-given to simulate it as {rule}, the rule's arrangement")
+        return dict(entry, arrangement_fallback=info, simulated_arrangement=asked)
+    if notify is not None:
+        notify(f"{name}: the {word} did not hold ({reason}); simulating as {rule}")
+    second = run_scenario(sc.replace(**{"cable.arrangement": rule}), None, quiet=not progress, plots=False,
+                          mode=engine, cpu_budget_s=BUNDLE_CPU_BUDGET_S)
+    entry = _bundle_direction(second, name, rope_entry)
+    note = f"simulated as {rule} (the {word} did not hold: {reason})"
+    entry["message"] = note + (f"; {entry['message']}" if entry["message"] else "")
+    return dict(entry, arrangement_fallback=info, simulated_arrangement=rule)
+
+
+def run_headline(entry: dict) -> str:
+    """The run's message for the ``multibody_run`` check: whole where the run is not trusted (its
+    reason and fix), else its first clause (what was simulated), the solve's details, which the
+    direction's status line prints in full, left out."""
+    message = entry["message"]
+    if entry["status"] not in TRUSTED_STATUSES:
+        return message
+    depth = 0
+    for i, ch in enumerate(message):
+        depth += {"(": 1, ")": -1}.get(ch, 0)
+        if depth == 0 and message.startswith("; ", i):
+            return message[:i]
+    return message
+
+
+def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry: dict, progress: bool,
+                         names: list[str] | None = None, as_given: bool = False, notify=None) -> dict:
     """One direction's plan entry from the multibody model, the rope's values kept beside.
 
     The scenario is run in ``engine``'s solver mode with ``pull.direction = name`` (the reverse pull is
@@ -456,11 +589,19 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
 
     sc = dataclasses.replace(scenario, pull=dataclasses.replace(scenario.pull, direction=name))
     budget = {"cpu_budget_s": BUNDLE_CPU_BUDGET_S} if sc.cable.count > 1 else {}
+    cpu0 = time.process_time()
     result = run_scenario(sc, None, quiet=not progress, plots=False, mode=engine, **budget)
     summary = result.summary
     bundle = summary.get("bundle")
     if bundle is not None:
-        return _bundle_direction(result, name, rope_entry)
+        model = result.model
+        D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
+        if summary["status"] == "failed" and model.arrangement != eng.auto_arrangement(sc.cable.count, D, d):
+            return _bundle_fallback(name, engine, rope_entry, progress,
+                                    names or point_names(sc, len(model.conduit.centreline.pieces)), result,
+                                    time.process_time() - cpu0, as_given, notify)
+        return dict(_bundle_direction(result, name, rope_entry), arrangement_fallback=None,
+                    simulated_arrangement=model.arrangement)
     L = scenario.build_conduit().centreline.length_m
     s_c, T_c, rows, to_conduit = _simulated_sections(
         rope_entry, *cable_tension_along_conduit(result.model), L, name, summary["bends"],
@@ -547,7 +688,18 @@ def _bundle_direction(result, name: str, rope_entry: dict) -> dict:
     }
 
 
-def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress: bool = False) -> dict:
+def _label_bundle_sections(entry: dict, formula_arrangement: str) -> None:
+    """Put on each section row of a simulated bundle's direction the arrangement the formula assumed,
+    the one simulated, and the one found there in the simulated state (None when nothing solved)."""
+    found = {row["section"]: row["arrangement"] for row in (entry["bundle"].get("sections") or [])}
+    solved = entry["bundle"].get("weight_correction_factor") is not None
+    for r in entry["sections"]:
+        r.update(formula_arrangement=formula_arrangement, simulated_arrangement=entry["simulated_arrangement"],
+                 arrangement_found=found.get(r["route_index"]) if solved else None)
+
+
+def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress: bool = False,
+              arrangement_as_given: bool = False, notify=None) -> dict:
     """Plan a pull in both directions.
 
     Parameters
@@ -564,6 +716,16 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
         bundle (:func:`_bundle_direction`, the calculators' values beside).
     progress : bool
         Show the multibody runs' progress bars on a terminal (stderr).
+    arrangement_as_given : bool
+        Several cables, ``"steady"``: when the asked arrangement is not the one the calculators' rule
+        gives for the duct's D/d (:func:`exucable.quasistatic.engineering.auto_arrangement`: three free
+        cables are cradled at D/d ≥ 2.5) and its solve fails, report it failed, with where it broke
+        (:func:`arrangement_left`), rather than simulate the rule's arrangement (the default; the
+        direction's ``arrangement_fallback`` and ``simulated_arrangement`` say which was simulated
+        and why, the calculators' values for the asked arrangement beside).
+    notify : callable, optional
+        Called with a line of text when a direction falls back to the rule's arrangement (the
+        command prints it; another solve of up to :data:`BUNDLE_CPU_BUDGET_S` follows).
 
     Returns
     -------
@@ -574,7 +736,9 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
         ``jam_ratio``, ``jam_risk``, ``clearance_m``, ``arrangement``, ``count``, ``checks`` and
         ``not_checked`` (those of the recommended direction; every direction has its own), ``passed``,
         ``fill_percent``, ``point_names`` (route order), ``inputs``, ``versions``. Each section row has
-        ``route_index``, ``name`` ("B–C" in pull direction) and ``bend_number`` (route order).
+        ``route_index``, ``name`` ("B–C" in pull direction) and ``bend_number`` (route order); a simulated
+        bundle's rows also ``formula_arrangement`` (the calculators'), ``simulated_arrangement`` and
+        ``arrangement_found`` (in that section of the simulated state; None without one).
 
     Raises
     ------
@@ -624,14 +788,17 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
             "profile": {"s_m": (rope.s_cable_m).tolist(), "tension_N": rope.tension_N.tolist()},
         }
         if engine != "rope":
-            entry = _multibody_direction(scenario, name, engine, entry, progress)
+            entry = _multibody_direction(scenario, name, engine, entry, progress, names, arrangement_as_given,
+                                         notify)
+            if "bundle" in entry:
+                _label_bundle_sections(entry, arrangement)
         entry["checks"] = _checks(entry, spec, scenario, clearance, jam)
         entry["not_checked"] = _not_checked(entry["checks"], spec, any(r["bend_number"] for r in rows))
         if engine != "rope":
             # a run that failed or is flagged (exucable.post.trust) gives numbers no check should pass on
             entry["checks"].append({"name": "multibody_run", "passed": entry["status"] in TRUSTED_STATUSES,
                                     "value": None, "limit": None, "margin": None, "quantity": None,
-                                    "where": f"status {entry['status']}" + (f": {entry['message']}" if entry["message"] else "")})
+                                    "where": f"status {entry['status']}" + (f": {run_headline(entry)}" if entry["message"] else "")})
         entry["passed"] = all(c["passed"] for c in entry["checks"])
         if spec.feed_from_reel:
             entry["pull_in"] = _pull_in_history(curve, rope)
@@ -654,6 +821,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
         "jam_risk": jam.risk,
         "clearance_m": clearance,
         "arrangement": arrangement,
+        "arrangement_as_given": arrangement_as_given,
         "count": spec.count,
         "checks": directions[recommended]["checks"],
         "not_checked": directions[recommended]["not_checked"],

@@ -30,8 +30,8 @@ from exucable.errors import ExucableError
 from exucable.io import atomic_write_text, new_figure
 from exucable.scenario.units import display_unit, from_si
 
-__all__ = ["plan_report_html", "section_rows", "check_in_units", "fmt_number", "direction_label", "report_pdf",
-           "find_browser"]
+__all__ = ["plan_report_html", "section_rows", "engine_note", "bundle_note", "simulated_arrangement_phrase", "check_in_units",
+           "fmt_number", "direction_label", "report_pdf", "find_browser"]
 
 # Screen: a readable column. Print: 182 mm of text (A4 210 mm and Letter 216 mm, less 14 mm margins), no
 # heading left at a page foot, no figure, check table or title block split across pages.
@@ -266,6 +266,36 @@ def _swbp_figure(plan: dict, units: str, limit_N_per_m) -> str | None:
     return _png(fig)
 
 
+def simulated_arrangement_phrase(plan: dict) -> str:
+    """"; simulated as cradled forward and reverse" where a simulated bundle's arrangement differs from
+    the plan's (the calculators'), else ""."""
+    simulated = {n: plan["directions"][n].get("simulated_arrangement") for n in ("forward", "reverse")}
+    other = {n: a for n, a in simulated.items() if a is not None and a != plan["arrangement"]}
+    if not other:
+        return ""
+    return "; " + "; ".join(f"simulated as {a} {direction_label(plan, n)}" for n, a in other.items())
+
+
+def bundle_note(direction: dict, plan: dict) -> str | None:
+    """One sentence on what a simulated bundle's direction simulated, beside the formula's arrangement:
+    "Simulated as cradled (the triangle did not hold: …); …" (None: not a simulated bundle)."""
+    if "bundle" not in direction:
+        return None
+    fb = direction.get("arrangement_fallback")
+    formula = (f"the calculators' formula values (rope columns) are for {plan['arrangement']}, weight correction "
+               f"factor {fmt_number(plan['weight_correction_factor'])}")
+    if fb is None:
+        return f"Simulated {plan['count']} cables, {direction.get('simulated_arrangement')}; {formula}."
+    if fb["simulated"] is None:
+        return (f"Not simulated: the {fb['asked']} arrangement was asked as given and did not hold ({fb['reason']}); "
+                f"the sections are the calculators' ({plan['arrangement']}).")
+    word = "triangle" if fb["asked"] == "triangular" else f"{fb['asked']} arrangement"
+    if direction["status"] == "failed":
+        return (f"Not simulated: the {word} did not hold ({fb['reason']}), and the rule's {fb['simulated']} did not "
+                f"solve either; the sections are the calculators' ({plan['arrangement']}).")
+    return f"Simulated as {fb['simulated']} (the {word} did not hold: {fb['reason']}); {formula}."
+
+
 def _input_rows(plan: dict, units: str) -> list[list]:
     """Rows (input, value in ``units``, SI) of the plan's inputs and limits, named in words."""
     inp = plan["inputs"]
@@ -281,7 +311,8 @@ def _input_rows(plan: dict, units: str) -> list[list]:
     rows = [["cable outer diameter d", *q(inp["cable_diameter_m"], *length_small)],
             ["duct inner diameter D", *q(inp["duct_inner_diameter_m"], *length_small)],
             ["cables in the duct", str(inp.get("count", plan["count"])), ""],
-            ["arrangement", f"{plan['arrangement']} (given: {inp.get('arrangement', plan['arrangement'])})", ""],
+            ["arrangement", f"{plan['arrangement']} (given: {inp.get('arrangement', plan['arrangement'])})"
+             + simulated_arrangement_phrase(plan), ""],
             ["weight per length, one cable", *q(inp["weight_per_length_one_cable_N_per_m"], "force_per_length")],
             ["friction coefficient μ", fmt_number(inp["friction"]), ""],
             ["back tension at the tail", *q(inp["back_tension_N"], "force")],
@@ -314,6 +345,19 @@ _ENGINE_NOTE = {
     "dynamic": "multibody model of one cable, a dynamic run per direction (tensions of its last state, pull force "
                "averaged over its steady window); the rope's values beside; SWBP: peak windowed pressure in each bend",
 }
+
+
+def engine_note(plan: dict) -> str:
+    """What the plan's engine simulated, in words: the note of ``_ENGINE_NOTE``, with "one cable" made
+    the bundle's cables where ``cable.count`` > 1 (each cable its own ANCF cable, the cable–cable
+    contact between them; the calculators' weight-corrected rope beside)."""
+    note = _ENGINE_NOTE[plan["engine"]]
+    count = int(plan.get("count") or plan.get("inputs", {}).get("count") or 1)
+    if count > 1 and plan["engine"] != "rope":
+        note = note.replace("multibody model of one cable", f"multibody model of {count} cables in one duct "
+                            "(one ANCF cable each, cable–cable contact)").replace(
+            "the rope's values beside", "the calculators' formula values beside")
+    return note
 
 
 def _check_phrase(c: dict, units: str) -> str:
@@ -366,7 +410,7 @@ def _meta_rows(plan: dict, meta: dict) -> list[tuple[str, str]]:
             ("Revision", meta.get("revision") or blank), ("Date", meta.get("date") or blank),
             ("Scenario", f"{inp['scenario']}" + (f": {inp['description']}" if inp.get("description") else "")),
             ("Scenario file", meta.get("scenario_file") or inp.get("scenario_file") or "–"),
-            ("Engine", f"{plan['engine']}: {_ENGINE_NOTE[plan['engine']]}"),
+            ("Engine", f"{plan['engine']}: {engine_note(plan)}"),
             ("Software", f"exucable {v.get('exucable', '?')} (Exudyn {v.get('exudyn', '?')}, numpy "
                          f"{v.get('numpy', '?')}, Python {v.get('python', '?')})")]
     return rows
@@ -414,7 +458,8 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
                  f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in _meta_rows(plan, meta))
              + "</table>",
              f"<div class='verdict {css}' id='verdict'>{verdict}</div>",
-             f"<p class='note'>{plan['count']} cable(s), arrangement {html.escape(plan['arrangement'])}, weight "
+             f"<p class='note'>{plan['count']} cable(s), arrangement {html.escape(plan['arrangement'])}"
+             f"{html.escape(simulated_arrangement_phrase(plan))}, weight "
              f"correction factor {fmt_number(plan['weight_correction_factor'])}, jam ratio "
              f"{fmt_number(plan['jam_ratio'])} (risk: {html.escape(plan['jam_risk'])}), clearance "
              f"{fmt_number(from_si(plan['clearance_m'], 'length', units, small=True))} "
@@ -453,6 +498,8 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
                   f"{'every given limit is met' if d['passed'] else 'a check fails'}"
                   f"{'; the cable runs slack somewhere (a downhill stretch steeper than the friction angle)' if d['slack'] else ''}"
                   ". Sections in pull order, numbered and named in route order.</p>",
+                  "" if bundle_note(d, plan) is None else
+                  f"<p class='note' id='simulated-{name}'>{html.escape(bundle_note(d, plan))}</p>",
                   f"<div id='sections-{name}'>" + _table(header, rows, left=(1, 3), table_id=f"sections-table-{name}")
                   + "</div>" + loads + "</div>"]
     if plan["directions"]["forward"].get("pull_in", {}).get("engine") == "steady":

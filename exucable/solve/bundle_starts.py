@@ -52,7 +52,7 @@ class BundleStartsOutcome:
 
 
 def solve_bundle_starts(scenario, model, refine: float = 1.0, settings: SteadySettings | None = None,
-                        progress: Progress | None = None) -> BundleStartsOutcome:
+                        progress: Progress | None = None, on_start=None) -> BundleStartsOutcome:
     """Solve a bundle's steady state from ``settings.bundle_starts`` in turn (the module's notes).
 
     Parameters
@@ -69,6 +69,10 @@ def solve_bundle_starts(scenario, model, refine: float = 1.0, settings: SteadySe
         builds after the first included.
     progress : Progress, optional
         Told each solve's progress.
+    on_start : callable, optional
+        Called as ``on_start(start, model)`` before each start's solve, so that a caller whose own
+        budget stops the sequence by an exception (the plan's CPU budget) still holds the state
+        that was being solved, not the first start's.
 
     Returns
     -------
@@ -88,6 +92,8 @@ def solve_bundle_starts(scenario, model, refine: float = 1.0, settings: SteadySe
         last = k == len(starts) - 1
         if k:
             model = build_bundle_model(scenario, refine=refine, start_path=start)
+        if on_start is not None:
+            on_start(start, model)
         left = settings.time_limit_s - (time.process_time() - t0)
         solver = SteadySolver(model, replace(settings, time_limit_s=max(left, 1e-3)), progress,
                               onset=OnsetSettings(), fallback=not last)
