@@ -217,3 +217,32 @@ def test_without_cable_friction_the_rates_sweep_is_left_out_bit_for_bit():
     np.testing.assert_array_equal(U.reshape(-1), k.speed_m_per_s * (k.dS @ q))
     np.testing.assert_array_equal(res.generalized_force, k.St @ (np.bincount(
         (3 * c["index"][:, :, None] + np.arange(3)).reshape(-1), weights=c["force"].reshape(-1), minlength=X.size)))
+
+
+@pytest.mark.parametrize("window", [None, 400])
+def test_search_from_the_guess_to_the_layer_edge_equals_the_numpy_scan(window):
+    """The compiled search starts from the last point's segment and its neighbours (kept, not
+    evaluated again) and reaches no farther than the onset layer's edge (gap + s): on the bent
+    trefoil with its third cable lifted off the other two along the cable (points in contact, in the
+    layer and beyond it, so that both bounds bite), with a layer, it finds the numpy scan's segments
+    over the whole window and the same forces and Jacobian (round-off only)."""
+    n_el, Le, bend_R, layer = 40, 0.02, 0.3, 3e-4
+    q = bundle_q(np.random.default_rng(5), n_el=n_el, Le=Le, wobble=1e-4).reshape(3, -1, 6)
+    q[2, :, 2] += np.linspace(-2e-4, 1.5e-3, n_el + 1)      # from pressed in to 1.5 mm off
+    q = q.reshape(-1, 6)
+    x, y = q[:, 0].copy(), q[:, 1].copy()
+    q[:, 0], q[:, 1] = (bend_R + y) * np.sin(x / bend_R), bend_R - (bend_R + y) * np.cos(x / bend_R)
+    q = q.reshape(-1)
+    ka, kb = (kernel(b, n_el=n_el, Le=Le, n_k=12, window=window) for b in ("numpy", "numba"))
+    for k in (ka, kb):
+        k.set_onset_layer(layer)
+    a, b = ka.contacts(q, jacobian=True), kb.contacts(q, jacobian=True)
+    inside = a["penetration_m"] > 0.0
+    assert inside.sum() > 100 and (~inside).sum() > 20          # contacts in the layer too
+    assert len(a["t"]) < 3 * 40 * 12                              # and points beyond it
+    np.testing.assert_array_equal(b["index"], a["index"])
+    np.testing.assert_array_equal(b["edge"], a["edge"])
+    np.testing.assert_allclose(b["t"], a["t"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(b["penetration_m"], a["penetration_m"], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(b["force"], a["force"], rtol=0, atol=1e-11 * np.abs(a["force"]).max())
+    np.testing.assert_allclose(b["jac_x"], a["jac_x"], rtol=0, atol=1e-11 * np.abs(a["jac_x"]).max())
