@@ -91,3 +91,14 @@ def test_one_start_given_is_the_only_one_tried():
     assert res.status == "ok", res.message
     assert res.summary.bundle["start"] == "statics_own"
     assert [a["start"] for a in res.summary.bundle["starts_tried"]] == ["statics_own"]
+
+
+def test_the_dynamic_runs_steady_start_takes_the_same_sequence():
+    """A dynamic bundle run's steady start (``solver.start_from = "steady"``) is the state a steady
+    run of the same scenario reports: from the first start that solves, here the one start given."""
+    from exucable.solve.start import bundle_steady_start
+
+    sc = scenario(["statics_own"])
+    first = bundle_steady_start(sc)
+    assert first.layouts is not None, first.message
+    assert first.pull_force_N == pytest.approx(alone(sc, "statics_own"), rel=1e-12)

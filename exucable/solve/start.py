@@ -215,17 +215,24 @@ def bundle_steady_start(scenario, refine: float = 1.0, solve: bool = True) -> Bu
     start's gap onto each other."""
     from ..model.bundle import build_bundle_model
     from ..model.bundle_rig import solved_bundle_layouts
-    from .steady import SteadySettings, solve_steady
+    from .bundle_starts import solve_bundle_starts
+    from .steady import SteadySettings
 
     t0 = time.perf_counter()
     # steady sliding has no static friction and no stop: the start leaves them out
-    model = build_bundle_model(scenario.replace(**{"solver.mode": "steady", "contact.static_friction": None,
-                                                   "pull.stop_time": None, "pull.hold_time": None}), refine=refine)
+    steady = scenario.replace(**{"solver.mode": "steady", "contact.static_friction": None,
+                                 "pull.stop_time": None, "pull.hold_time": None})
+    settings = SteadySettings.from_solver(steady.solver)
+    model = build_bundle_model(steady, refine=refine, start_path=settings.bundle_starts[0])
     if not solve:
         return BundleSteadyStart(model, None, float("nan"), "", time.perf_counter() - t0)
-    out = solve_steady(model, settings=SteadySettings.from_solver(model.scenario.solver))
+    # the steady mode's own sequence of starts (solve.bundle_starts), so that the dynamic run starts
+    # from the state a steady run of the same scenario reports
+    solved = solve_bundle_starts(steady, model, refine=refine, settings=settings)
+    out = solved.outcome
     if out.status == "failed":
         # the model's start (model.layout, data) is untouched by the solve: the run starts from it
         return BundleSteadyStart(model, None, float("nan"), out.message, time.perf_counter() - t0)
+    model = solved.model
     return BundleSteadyStart(model, solved_bundle_layouts(model), float(np.sum(model.pull_shares_N())), out.message,
                              time.perf_counter() - t0)
