@@ -130,10 +130,13 @@ def _print_bundle(count: int, name: str, row: dict, t1: float, c1: float) -> Non
           f"{_num(b.get('formula_weight_correction_factor'), '.5g')}); per straight: "
           + ", ".join(_num(st.get("weight_correction_factor"), ".4g") for st in b.get("straights") or []))
     u = sn.get("pull_force_uncertainty") or {}
-    print(f"    error bar ± {_num(sn.get('pull_force_uncertainty_N'), '.3g')} N (mesh {_num(u.get('mesh_N'), '.3g')} N, "
-          f"solve {_num(u.get('solve_N'), '.2g')} N, onset layer {_num(u.get('layer_N'), '.2g')} N; coarse "
-          f"{_num(u.get('coarse_value_N'), '.6g')} N on {u.get('coarse_elements')} elements, "
-          f"{_num(u.get('cpu_time_s'), '.3g')} s CPU): {(sn.get('pull_force_uncertainty_method') or '')[:200]}")
+    coarse = (f"coarse {_num(u.get('coarse_value_N'), '.6g')} N on {u.get('coarse_elements')} elements, "
+              f"{_num(u.get('cpu_time_s'), '.3g')} s CPU" if u.get("coarse_value_N") is not None
+              else "no coarse solve")
+    mesh = f"mesh {_num(u.get('mesh_N'), '.3g')} N" if u.get("mesh_N") is not None else "mesh not measured"
+    print(f"    error bar ± {_num(sn.get('pull_force_uncertainty_N'), '.3g')} N ({mesh}, "
+          f"solve {_num(u.get('solve_N'), '.2g')} N, onset layer {_num(u.get('layer_N'), '.2g')} N; {coarse}): "
+          f"{(sn.get('pull_force_uncertainty_method') or '')[:200]}")
     print("    pull shares: " + ", ".join(_num(None if c.get("pull_share") is None else 100 * c["pull_share"], ".1f", " %")
                                          for c in b.get("cables") or []))
 
