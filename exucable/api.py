@@ -268,6 +268,9 @@ class Result:
     scenario : Scenario
     out_dir : Path or None
         Where the files went, if anywhere.
+    cable_tensions : tuple of TensionProfile or None
+        Several cables (``cable.count`` > 1): each cable's tension along it [N], cable 1 first, as
+        ``cable_tensions.csv`` (``tension_profile`` is then their sum, the bundle's); None for one cable.
     """
 
     summary: RunSummary
@@ -276,6 +279,7 @@ class Result:
     model: Model
     scenario: Scenario
     out_dir: Path | None
+    cable_tensions: tuple[TensionProfile, ...] | None = None
 
     def __repr__(self) -> str:
         s = self.summary
@@ -372,7 +376,19 @@ def run(scenario: Scenario | str | Path, out_dir=None, progress: bool = False, m
         model=raw.model,
         scenario=raw.model.scenario,
         out_dir=Path(out_dir) if out_dir is not None else None,
+        cable_tensions=_cable_profiles(raw.cable_tensions),
     )
+
+
+def _cable_profiles(cables: dict | None) -> tuple[TensionProfile, ...] | None:
+    """Each cable's :class:`TensionProfile` from a run's ``cable_tensions`` (``x_m`` and
+    ``cable_<k>_tension_N``, k from 1), in cable order; None for one cable."""
+    if cables is None:
+        return None
+    x = np.asarray(cables["x_m"], dtype=float)
+    count = sum(1 for k in cables if k != "x_m")
+    return tuple(TensionProfile(x_m=x, tension_N=np.asarray(cables[f"cable_{k}_tension_N"], dtype=float))
+                 for k in range(1, count + 1))
 
 
 def vary(scenario: Scenario, values: dict[str, Sequence], progress: bool = False,

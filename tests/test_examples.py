@@ -63,3 +63,13 @@ def test_three_cables_give_the_rigid_circle_factor():
     assert b["formula_weight_correction_factor"] == pytest.approx(1 + 4 / 3 * x * x, rel=1e-12)
     assert b["straights"][0]["weight_correction_factor"] == pytest.approx(1 + 4 / 3 * x * x, rel=2e-3)
     assert b["sections"][0]["arrangement"] == "cradled" and b["jam"] is False
+    # each cable's tension profile, cable 1 first; the bundle's profile is their sum, and each cable's
+    # leading-end tension is its pull share (the profile's end from the cable's loads, the share from the
+    # eye's reaction: equal to the solve's residual, 6e-6 here; 1e-4 the steady error bar's floor)
+    cables = res.cable_tensions
+    assert len(cables) == 3
+    total = sum(c.tension_N for c in cables)
+    assert total == pytest.approx(res.tension_profile.tension_N, rel=1e-12)
+    for c, share in zip(cables, b["cables"]):
+        assert c.x_m == pytest.approx(res.tension_profile.x_m)
+        assert c.tension_N[-1] / total[-1] == pytest.approx(share["pull_share"], rel=1e-4)

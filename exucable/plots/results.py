@@ -237,8 +237,19 @@ def tension_profile_figure(result, frame=None):
     one). Returns the figure."""
     p = result.tension_profile
     fig, ax = frame or tension_profile_frame()
-    title = fit_frame(fig, TENSION_AXES_IN, f"{result.summary.get('name', '')}: tension along the cable", 12)
-    ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N from the equilibrium of its loads)")
+    cables = getattr(result, "cable_tensions", None)
+    what = "tension along the cable" if cables is None else "tension along the cables"
+    title = fit_frame(fig, TENSION_AXES_IN, f"{result.summary.get('name', '')}: {what}", 12)
+    if cables is None:
+        ax.plot(p["x_m"], p["tension_N"], ".-", ms=3, label="exucable (N from the equilibrium of its loads)")
+    else:
+        # several cables: the bundle's (their sum, the pull at the eye) and each cable's share beside it
+        names = [k for k in cables if k != "x_m"]
+        ax.plot(p["x_m"], p["tension_N"], ".-", ms=3,
+                label=f"bundle: sum of the {len(names)} cables (N from the equilibrium of their loads)")
+        for k in names:
+            ax.plot(cables["x_m"], cables[k], "-", lw=1, alpha=0.8,
+                    label=k.replace("_tension_N", "").replace("_", " "))
     rp = result.rope_profile
     if rp is not None and "x_m" in result.extras:
         ax.plot(result.extras["x_m"], rp["tension_N"], "k--", lw=1, label="rope reference")
@@ -246,7 +257,7 @@ def tension_profile_figure(result, frame=None):
     ax.set_ylabel("tension [N]")
     ax.set_title(title, fontsize=12, y=TITLE_Y)
     ax.grid(alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    ax.legend(loc="best", fontsize=8 if cables is None else 7)
     return fig
 
 
