@@ -61,6 +61,22 @@ def test_a_coarse_solve_out_of_time_leaves_the_solve_parts_and_says_why():
     assert "failed" in bar.method or "no CPU time left" in bar.method
 
 
+def test_without_a_cpu_limit_the_coarse_solve_has_the_fine_solves(down_bend):
+    # the default limit: the solver's settings refuse an unlimited time, so it is the fine solve's own
+    from exucable.solve.error_bar import bundle_error_bar
+    from exucable.solve.steady import SteadySettings
+
+    sc = scenario("down", "triangular", 0.0, 60.0)
+    r = run_scenario(sc, error_bar=False)
+    s = r.summary
+    bar = bundle_error_bar(sc, r.model, s["pull_force_N"], s["bundle"]["onset_layer"],
+                           SteadySettings.from_solver(sc.solver), s["bundle"]["start"],
+                           weight_correction=s["bundle"]["weight_correction_factor"])
+    assert bar.mesh_N is not None
+    assert bar.coarse_value_N == pytest.approx(down_bend["pull_force_uncertainty"]["coarse_value_N"], rel=1e-9)
+    assert bar.uncertainty_N == pytest.approx(down_bend["pull_force_uncertainty_N"], rel=1e-9)
+
+
 @pytest.mark.parametrize("left_s, fine_s, skipped", [(10.0, 40.0, True), (39.0, 40.0, True), (45.0, 40.0, False), (5.0, 4.0, False)])
 def test_the_coarse_solve_waits_for_its_budget(left_s, fine_s, skipped):
     why = coarse_solve_skipped(True, left_s, fine_s)

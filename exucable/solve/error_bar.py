@@ -322,7 +322,7 @@ def coarse_solve_skipped(error_bar: bool, cpu_left_s: float, fine_cpu_s: float) 
 
 
 def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settings, start: str,
-                     refine: float = 1.0, cpu_left_s: float = float("inf"), skip: str | None = None,
+                     refine: float = 1.0, cpu_left_s: float | None = None, skip: str | None = None,
                      weight_correction: float | None = None) -> SteadyErrorBar:
     """The uncertainty of several cables' steady pull ``value_N`` [N] (module notes): u_solve + u_layer,
     plus u_mesh from a second solve on a mesh ``COARSE_RATIO`` coarser unless ``skip`` says why not.
@@ -343,8 +343,9 @@ def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settin
         The start that gave the answer (``bundle_starts``' entry): the coarse solve's only start.
     refine : float
         The fine model's ``refine``; the coarse one is built at ``refine / COARSE_RATIO``.
-    cpu_left_s : float
-        The coarse solve's CPU limit [s] (what is left of the budget).
+    cpu_left_s : float, optional
+        The coarse solve's CPU limit [s] (what is left of the budget); default the fine solve's
+        ``settings.time_limit_s``.
     skip : str, optional
         Why the coarse solve is not made (:func:`coarse_solve_skipped`).
     weight_correction : float, optional
@@ -385,7 +386,9 @@ def bundle_error_bar(scenario, model, value_N: float, onset: dict | None, settin
     m = coarse.mesh.elements
     if m >= n:
         return parts_only(f"{head} not possible: {n} elements cannot be coarsened")
-    left = cpu_left_s - (time.process_time() - c0)
+    # the solver's settings refuse an unlimited time, so no limit given means the fine solve's own
+    limit_s = settings.time_limit_s if cpu_left_s is None else cpu_left_s
+    left = limit_s - (time.process_time() - c0)
     if left <= 0.0:
         return parts_only(f"{head}: no CPU time left after its build", m)
     out = solve_bundle_starts(scenario, coarse, refine=refine / COARSE_RATIO,
