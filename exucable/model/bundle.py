@@ -41,7 +41,7 @@ from .generic import add_user_force_object
 from .layout import CableLayout, lay_cable, plan_cable_mesh, steady_lead_out_m
 from .rig import Drive, add_drive, add_end_force
 
-__all__ = ["BUNDLE_STARTS", "BundleModel", "arrangement_offsets", "load_turn_rad", "start_tensions", "build_bundle_model", "statics_start", "check_bundle_supported",
+__all__ = ["BUNDLE_STARTS", "BundleModel", "arrangement_offsets", "bundle_offsets", "load_turn_rad", "start_tensions", "build_bundle_model", "statics_start", "check_bundle_supported",
            "bundle_arrangement", "bundle_report", "bundle_tension_profile", "straight_weight_correction",
            "bundle_sections", "bundle_cross_sections", "bundle_tension_along_conduit"]
 
@@ -58,6 +58,16 @@ def bundle_arrangement(scenario) -> str:
     c = scenario.cable
     D, d = 2.0 * scenario.conduit.inner_radius_m, 2.0 * c.radius_m
     return eng.auto_arrangement(c.count, D, d) if c.arrangement == "auto" else c.arrangement
+
+
+def bundle_offsets(scenario) -> np.ndarray:
+    """The scenario's cable axes in the duct's cross-section at the start [m], shape (count, 2),
+    (horizontal, up) from the duct's axis: ``cable.positions`` where given (checked to fit by the
+    scenario), else :func:`arrangement_offsets` of :func:`bundle_arrangement`."""
+    c = scenario.cable
+    if c.positions_m is not None:
+        return np.asarray(c.positions_m, dtype=float)
+    return arrangement_offsets(c.count, bundle_arrangement(scenario), scenario.conduit.inner_radius_m, c.radius_m)
 
 
 def arrangement_offsets(count: int, arrangement: str, inner_radius_m: float, cable_radius_m: float) -> np.ndarray:
@@ -747,7 +757,7 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
     n = sc.cable.count
     c = sc.cable
     arrangement = bundle_arrangement(sc)
-    offsets = arrangement_offsets(n, arrangement, sc.conduit.inner_radius_m, c.radius_m)
+    offsets = bundle_offsets(sc)
     conduit = sc.build_conduit()
     if sc.pull.direction == "reverse":
         conduit = conduit.reversed()
@@ -809,11 +819,14 @@ def build_bundle_model(scenario, refine: float = 1.0, start_path: str = "clearan
             return np.stack([np.interp(s, s_grid, P[:, j]) for j in range(3)], axis=1)
     # laid as circles START_GAP·r larger: the cables start that far off the wall and apart, so what
     # the fit and the roll leave over is a gap the first steps close, not an overlap they must undo
-    try:
-        laid_r = (1.0 + START_GAP) * c.radius_m
-        laid = arrangement_offsets(n, arrangement, sc.conduit.inner_radius_m, laid_r)
-    except ModelError:
-        laid, laid_r = offsets, c.radius_m
+    # (cable.positions are laid where the user put them: they have no larger circles to take)
+    laid, laid_r = offsets, c.radius_m
+    if c.positions_m is None:
+        try:
+            laid = arrangement_offsets(n, arrangement, sc.conduit.inner_radius_m, (1.0 + START_GAP) * c.radius_m)
+            laid_r = (1.0 + START_GAP) * c.radius_m
+        except ModelError:
+            pass
 
     # ...except in the last element before the exit and beyond: the eye holds the leading ends where
     # they are laid, and there they are the rigid circles (a gap held open at the eye is not the pull's)
@@ -1022,6 +1035,7 @@ def bundle_report(model: BundleModel) -> dict:
     return {
         "count": n,
         "arrangement": model.arrangement,
+        "positions_given": sc.cable.positions_m is not None,
         "pull_force_N": F,
         "trailing_tension_N": Tb,
         "max_tension_N": max(c["max_tension_N"] for c in cables),

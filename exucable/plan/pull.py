@@ -596,7 +596,9 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
     if bundle is not None:
         model = result.model
         D, d = 2.0 * sc.conduit.inner_radius_m, 2.0 * sc.cable.radius_m
-        if summary["status"] == "failed" and model.arrangement != eng.auto_arrangement(sc.cable.count, D, d):
+        # cables laid at cable.positions are the user's lay, kept as --arrangement-as-given keeps one
+        if (summary["status"] == "failed" and sc.cable.positions_m is None
+                and model.arrangement != eng.auto_arrangement(sc.cable.count, D, d)):
             return _bundle_fallback(name, engine, rope_entry, progress,
                                     names or point_names(sc, len(model.conduit.centreline.pieces)), result,
                                     time.process_time() - cpu0, as_given, notify)

@@ -182,6 +182,15 @@ FIELDS: tuple[Field, ...] = (
       choices=("auto", "single", "triangular", "cradled", "diamond"), ours=True,
       rule="`single` (1), `triangular` (2, 3), `cradled` (3, 4), `diamond` (4); `auto`: 3 cables triangular for "
            "D/d < 2.5 else cradled, 4 diamond for D/d < 3.0 else cradled (Cableizer CR_pull)"),
+    F("cable.positions", "positions_m", "custom", "m", None, ours=True,
+      default_doc="the arrangement's rigid circles at rest",
+      rule="array of `cable.count` pairs [horizontal, up] [m]: the cables' axes in the duct's cross-section, from "
+           "its axis (horizontal to the right looking along the pull, up against gravity), where the simulation "
+           "lays them at the start instead of `cable.arrangement`'s rest (turned with the load into bends as an "
+           "arrangement is) and where the pulling eye holds their leading ends; inside the duct and apart (each "
+           "at most `conduit.inner_radius` − `cable.radius` from the axis, any two at least 2 `cable.radius` "
+           "apart). The calculators' formula values stay `cable.arrangement`'s, and `exucable plan` keeps the "
+           "lay (no fallback to the rule's arrangement)"),
     F("cable.weight_correction_in_bends", "weight_correction_in_bends", "bool", "", True, ours=True,
       rule="`exucable plan`, several cables: `true` (IEEE 1185, AEIC CG5, Polywater): the weight correction factor "
            "w_c multiplies the friction in bends too, T_out = T_in e^(w_c μ θ); `false`: on straights only, "

@@ -143,6 +143,40 @@ def coerce_value(f: Field, value):
     return value  # "custom": checked by the section's own code
 
 
+def _parse_positions(raw, count: int) -> tuple:
+    """``cable.positions`` as ``count`` pairs of finite floats [m] (the fit is the scenario's check)."""
+    if count < 2:
+        raise ScenarioError("cable.positions", f"places several cables; cable.count is {count}: remove it or set "
+                                               "cable.count to 2…4")
+    if not isinstance(raw, (list, tuple)) or len(raw) != count:
+        raise ScenarioError("cable.positions", f"must be an array of cable.count = {count} pairs [horizontal, up] [m], "
+                                               f"one per cable, got {_describe(raw)}")
+    pairs = []
+    for i, pair in enumerate(raw):
+        key = f"cable.positions[{i}]"
+        if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+            raise ScenarioError(key, f"must be a pair [horizontal, up] [m] from the duct's axis, got {_describe(pair)}")
+        pairs.append((_as_float(key, pair[0], "m"), _as_float(key, pair[1], "m")))
+    return tuple(pairs)
+
+
+def _check_positions_fit(positions_m, inner_radius_m: float, cable_radius_m: float) -> None:
+    """Refuse ``cable.positions`` that put a cable into the duct's wall or two cables into each other
+    (a relative 1e-9 for round-off: touching is allowed, as in the arrangements' rigid circles)."""
+    room = inner_radius_m - cable_radius_m
+    for i, (h, v) in enumerate(positions_m):
+        if math.hypot(h, v) > room * (1.0 + 1e-9):
+            raise ScenarioError(f"cable.positions[{i}]", f"[{h!r}, {v!r}] m is {math.hypot(h, v):.6g} m from the duct's axis: "
+                                f"the cable would cut into the wall; at most conduit.inner_radius − cable.radius = "
+                                f"{room:.6g} m")
+    for i in range(len(positions_m)):
+        for j in range(i + 1, len(positions_m)):
+            gap = math.dist(positions_m[i], positions_m[j])
+            if gap < 2.0 * cable_radius_m * (1.0 - 1e-9):
+                raise ScenarioError(f"cable.positions[{j}]", f"is {gap:.6g} m from cable.positions[{i}]: the cables "
+                                    f"would overlap; place them at least 2 cable.radius = {2.0 * cable_radius_m:.6g} m apart")
+
+
 def _toml_value(value):
     """A dataclass value in TOML form (tuples as lists)."""
     if isinstance(value, tuple):
@@ -269,6 +303,10 @@ class CableSpec(_Spec):
     weight_correction_in_bends : bool
         ``exucable plan``: apply the weight correction factor to the friction in bends too (default) or
         on straights only.
+    positions_m : tuple of (float, float) or None
+        Several cables: their axes at the start, (horizontal, up) from the duct's axis [m], one pair per
+        cable (``cable.positions``); None lays them in ``arrangement``'s rest. Inside the duct and apart
+        (checked by the scenario).
     """
 
     _SECTION: ClassVar[str] = "cable"
@@ -286,8 +324,11 @@ class CableSpec(_Spec):
     count: int = _default("cable.count")
     arrangement: str = _default("cable.arrangement")
     weight_correction_in_bends: bool = _default("cable.weight_correction_in_bends")
+    positions_m: tuple | None = None
 
     def _check(self) -> None:
+        if self.positions_m is not None:
+            object.__setattr__(self, "positions_m", _parse_positions(self.positions_m, self.count))
         if self.elements is not None and self.element_length_m is not None:
             raise ScenarioError("cable.element_length", "give either elements or element_length, not both "
                                 "(or neither: the mesh rule then chooses, see scenarios/README.md)")
@@ -1043,6 +1084,8 @@ class Scenario:
             )
         if self.cable.count > 1:
             _eng.check_fit(self.cable.count, 2.0 * self.conduit.inner_radius_m, 2.0 * self.cable.radius_m)
+        if self.cable.positions_m is not None:
+            _check_positions_fit(self.cable.positions_m, self.conduit.inner_radius_m, self.cable.radius_m)
         _check_sizes(self)
         conduit = self.build_conduit()  # route errors surface here, keyed
         _check_friction_turning(self, conduit)
