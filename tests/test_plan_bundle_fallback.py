@@ -14,6 +14,7 @@ from __future__ import annotations
 import csv
 import importlib
 import json
+import math
 
 import pytest
 
@@ -143,3 +144,26 @@ def test_where_the_cables_are_not_in_the_asked_arrangement():
     # stations every 0.5 m at the middles of the 8 intervals of the 4 m straight
     assert (stretch["s_start_m"], stretch["s_end_m"]) == pytest.approx((0.25, 3.75))
     assert arrangement_left(res.model, "cradled", ["A", "B"]) == []
+
+
+def test_cables_laid_at_positions_are_not_replaced_by_the_rule(runs):
+    # cable.positions is the user's lay: a triangle laid there that fails stays failed (as
+    # --arrangement-as-given keeps an arrangement), and a lay that solves is labelled as positions
+    rho = 3.3 * R_CABLE - R_CABLE
+    a = [-R_CABLE, -(rho**2 - R_CABLE**2) ** 0.5]
+    b = [R_CABLE, a[1]]
+    top = [0.0, a[1] + (4.0 * R_CABLE**2 - R_CABLE**2) ** 0.5]
+    sc = straight_duct("triangular", 3.3).replace(**{"cable.positions": [a, b, top]})
+    plan = plan_pull(sc, plan_spec(sc), engine="steady")
+    assert runs == ["triangular"] * 2
+    assert all(plan["directions"][n]["status"] == "failed" and plan["directions"][n]["arrangement_fallback"] is None
+               for n in ("forward", "reverse"))
+    runs.clear()
+    cradled = straight_duct("cradled", 3.3)
+    alpha = 2.0 * math.asin(R_CABLE / rho)      # two touching cables on the wall, seen from the axis
+    sc = cradled.replace(**{"cable.positions": [[rho * math.sin(k * alpha), -rho * math.cos(k * alpha)]
+                                                for k in (-1, 0, 1)]})
+    plan = plan_pull(sc, plan_spec(sc), engine="steady")
+    assert runs == ["cradled"] * 2
+    assert plan["directions"]["forward"]["status"] == "ok"
+    assert plan["directions"]["forward"]["simulated_arrangement"] == "laid at cable.positions"
