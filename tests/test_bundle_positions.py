@@ -144,3 +144,17 @@ def test_dynamic_pull_from_the_positions_keeps_the_lay(capsys):
     assert straight["weight_correction_factor"] == pytest.approx(tri, rel=3e-3)
     _print_bundle(s, Path("out"))
     assert "3 cables laid at cable.positions (formulas: cradled)" in capsys.readouterr().out
+
+
+def test_positions_typed_to_a_few_digits_are_taken():
+    # the D/d 3.3 triangle's exact bottom cables sit at (±0.015, −0.0310689…) m: typed as −0.031069 they
+    # overlap the wall by 0.5 µm, inside the allowed 1e-3 r = 15 µm; 30 µm into the wall is refused
+    from exucable.scenario.specs import POSITIONS_OVERLAP
+
+    typed = [[-0.015, -0.031069], [0.015, -0.031069], [0.0, -0.005087]]
+    sc = straight_duct(3, "triangular", 3.3, cable=dict(positions=typed))
+    assert sc.cable.positions_m[0] == (-0.015, -0.031069)
+    assert POSITIONS_OVERLAP * R_CABLE == pytest.approx(15e-6)
+    rho = 3.3 * R_CABLE - R_CABLE
+    with pytest.raises(ScenarioError, match=r"cable.positions\[0\].*wall"):
+        straight_duct(3, "cradled", 3.3, cable=dict(positions=[[0.0, -(rho + 30e-6)], [0.03, -0.02], [-0.03, -0.02]]))

@@ -160,19 +160,28 @@ def _parse_positions(raw, count: int) -> tuple:
     return tuple(pairs)
 
 
+#: Overlap allowed in ``cable.positions`` [fraction of cable.radius]: positions typed to a few digits
+#: (a triangle's 0.031069 for 0.0310689…) overlap by a fraction of a micrometre; the Hertz law takes an
+#: overlap of this size (15 µm at r = 15 mm, of the order of a solved contact's few µm) as a small force.
+POSITIONS_OVERLAP = 1e-3
+
+
 def _check_positions_fit(positions_m, inner_radius_m: float, cable_radius_m: float) -> None:
     """Refuse ``cable.positions`` that put a cable into the duct's wall or two cables into each other
-    (a relative 1e-9 for round-off: touching is allowed, as in the arrangements' rigid circles)."""
+    by more than ``POSITIONS_OVERLAP`` × the cable radius (touching is allowed, as in the
+    arrangements' rigid circles)."""
     room = inner_radius_m - cable_radius_m
+    slack = POSITIONS_OVERLAP * cable_radius_m
     for i, (h, v) in enumerate(positions_m):
-        if math.hypot(h, v) > room * (1.0 + 1e-9):
+        if math.hypot(h, v) > room + slack:
+            on_wall = room / math.hypot(h, v)
             raise ScenarioError(f"cable.positions[{i}]", f"[{h!r}, {v!r}] m is {math.hypot(h, v):.6g} m from the duct's axis: "
                                 f"the cable would cut into the wall; at most conduit.inner_radius − cable.radius = "
-                                f"{room:.6g} m")
+                                f"{room:.6g} m (at the wall in that direction: [{h * on_wall:.6g}, {v * on_wall:.6g}])")
     for i in range(len(positions_m)):
         for j in range(i + 1, len(positions_m)):
             gap = math.dist(positions_m[i], positions_m[j])
-            if gap < 2.0 * cable_radius_m * (1.0 - 1e-9):
+            if gap < 2.0 * cable_radius_m - slack:
                 raise ScenarioError(f"cable.positions[{j}]", f"is {gap:.6g} m from cable.positions[{i}]: the cables "
                                     f"would overlap; place them at least 2 cable.radius = {2.0 * cable_radius_m:.6g} m apart")
 
