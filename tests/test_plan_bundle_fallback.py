@@ -167,3 +167,10 @@ def test_cables_laid_at_positions_are_not_replaced_by_the_rule(runs):
     assert runs == ["cradled"] * 2
     assert plan["directions"]["forward"]["status"] == "ok"
     assert plan["directions"]["forward"]["simulated_arrangement"] == "laid at cable.positions"
+    # the report's inputs list the places; its engine text says the lay, not "simulated as"
+    from exucable.plan.report import plan_report_html
+
+    assert plan["inputs"]["positions_m"] == [list(p) for p in sc.cable.positions_m]
+    page = plan_report_html(plan, "t")
+    assert "cables laid at (horizontal, up) from the duct&#x27;s axis (cable.positions)" in page
+    assert "simulated laid at cable.positions forward" in page and "simulated as laid" not in page

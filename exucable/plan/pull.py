@@ -665,7 +665,7 @@ def _bundle_direction(result, name: str, rope_entry: dict) -> dict:
         "pull_force_uncertainty_N": summary.get("pull_force_uncertainty_N"),
         "pull_force_uncertainty_method": summary.get("pull_force_uncertainty_method"),
         "elements": int(result.model.layout.element_length_m.size), "wall_time_s": summary["wall_time_s"],
-        "bundle": {k: bundle.get(k) for k in ("count", "arrangement", "weight_correction_factor",
+        "bundle": {k: bundle.get(k) for k in ("count", "arrangement", "positions_given", "weight_correction_factor",
                                               "formula_weight_correction_factor", "straights", "sections", "bends",
                                               "jam", "jam_s_conduit_m", "cables")},
     }
@@ -843,6 +843,7 @@ def plan_pull(scenario: Scenario, spec: PlanSpec, engine: str = "auto", progress
             "duct_inner_diameter_m": D,
             "count": spec.count,
             "arrangement": spec.arrangement,
+            "positions_m": None if scenario.cable.positions_m is None else [list(p) for p in scenario.cable.positions_m],
             "weight_per_length_one_cable_N_per_m": scenario.cable.mass_per_length_kg_per_m * g,
             "gravity_m_per_s2": g,
             "friction": scenario.contact.friction,

@@ -44,7 +44,7 @@ th{background:#f3f3f3} td.l,th.l{text-align:left} .pass{color:#11751b;font-weigh
 .unchecked{color:#8a5a00;font-weight:600}
 .verdict{font-size:1.05em;padding:.6em 1em;border-radius:6px;border:1px solid #999}
 .ok{background:#e6f4ea} .bad{background:#fde7e9} img{max-width:100%} .note{color:#555;font-size:.88em}
-table.meta td{text-align:left} table.meta th{text-align:left;width:11em} .sign td{height:2.2em;min-width:12em}
+table.meta td{text-align:left;white-space:normal} table.meta th{text-align:left;width:11em} .sign td{height:2.2em;min-width:12em}
 figure{margin:.4em 0} figcaption{font-size:.85em;color:#555}
 @page{margin:14mm}
 @media print{
@@ -273,7 +273,9 @@ def simulated_arrangement_phrase(plan: dict) -> str:
     other = {n: a for n, a in simulated.items() if a is not None and a != plan["arrangement"]}
     if not other:
         return ""
-    return "; " + "; ".join(f"simulated as {a} {direction_label(plan, n)}" for n, a in other.items())
+    # "laid at cable.positions" is a lay, not an arrangement's name: no "as" before it
+    return "; " + "; ".join(f"simulated {'' if a.startswith('laid') else 'as '}{a} {direction_label(plan, n)}"
+                            for n, a in other.items())
 
 
 def bundle_note(direction: dict, plan: dict) -> str | None:
@@ -313,6 +315,10 @@ def _input_rows(plan: dict, units: str) -> list[list]:
             ["cables in the duct", str(inp.get("count", plan["count"])), ""],
             ["arrangement", f"{plan['arrangement']} (given: {inp.get('arrangement', plan['arrangement'])})"
              + simulated_arrangement_phrase(plan), ""],
+            *([["cables laid at (horizontal, up) from the duct's axis (cable.positions)",
+                 "; ".join(f"({', '.join(q(x, *length_small)[0] for x in pair)})" for pair in inp["positions_m"]),
+                 "; ".join(f"({', '.join(q(x, *length_small)[1] for x in pair)})" for pair in inp["positions_m"])]]
+              if inp.get("positions_m") else []),
             ["weight per length, one cable", *q(inp["weight_per_length_one_cable_N_per_m"], "force_per_length")],
             ["friction coefficient μ", fmt_number(inp["friction"]), ""],
             ["back tension at the tail", *q(inp["back_tension_N"], "force")],
@@ -531,7 +537,7 @@ def plan_report_html(plan: dict, title: str, route_png: bytes | None = None, uni
                            "the data sheet.")
     parts += ["<div class='block'><h2>Inputs and assumptions</h2>",
               _table(["input", f"value ({units})", "SI"], _input_rows(plan, units), left=(0, 1, 2), table_id="inputs",
-                     wrap=(0,)),
+                     wrap=(0, 1, 2)),
               "<ul class='note'>" + "".join(f"<li>{html.escape(a)}</li>" for a in assumptions) + "</ul></div>",
               "<div class='block'><h2>Sign-off</h2><table class='sign' id='sign-off'><tr><th class='l'>role</th>"
               "<th class='l'>name</th><th class='l'>signature</th><th class='l'>date</th></tr>"
