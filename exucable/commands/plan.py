@@ -135,13 +135,13 @@ def _print_table(header, rows) -> None:
 def _print_bundle(b: dict, units: str) -> None:
     """A simulated bundle's values beside the calculators' (``--engine steady``, several cables)."""
     from exucable.plan.report import fmt_number
+    from exucable.post.bundle import laid_phrase
     from exucable.scenario.units import display_unit, from_si
 
     p = display_unit("force_per_length", units)
     if b["weight_correction_factor"] is None:
         return      # the solve failed: the status above says so, the sections are the calculators'
-    laid = "laid at cable.positions" if b.get("positions_given") else b["arrangement"]
-    print(f"  simulated {b['count']} cables, {laid}: weight correction factor "
+    print(f"  simulated {b['count']} cables, {laid_phrase(b)}: weight correction factor "
           f"{fmt_number(b['weight_correction_factor'])} (the calculators' for {b['arrangement']} "
           f"{fmt_number(b['formula_weight_correction_factor'])})"
           + (f"; JAM at s = {b['jam_s_conduit_m']:.4g} m" if b.get("jam") else ""))

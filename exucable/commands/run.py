@@ -131,8 +131,9 @@ def _print_bundle(s: dict, out_dir: Path) -> int:
                   else f" (± {_f(u, '.2g')} N: solve tolerance only, mesh part not measured)")
     else:
         spread = ""
-    laid = (f"laid at cable.positions (formulas: {b['arrangement']})" if b.get("positions_given")
-            else b["arrangement"])
+    from ..post.bundle import laid_phrase
+
+    laid = laid_phrase(b) + (f" (formulas: {b['arrangement']})" if b.get("positions_given") else "")
     print(f"{s['name']}: status {s['status']}, {b['count']} cables {laid}, pulling force "
           f"{_f(s['pull_force_N'])} N{spread}, back tension {_f(s['trailing_tension_N'])} N, max tension {_f(s['max_tension_N'])} N")
     print(f"  weight correction factor {_f(wcf, '.5g')} (the calculators' {b['formula_weight_correction_factor']:.5g})")

@@ -602,9 +602,10 @@ def _multibody_direction(scenario: Scenario, name: str, engine: str, rope_entry:
             return _bundle_fallback(name, engine, rope_entry, progress,
                                     names or point_names(sc, len(model.conduit.centreline.pieces)), result,
                                     time.process_time() - cpu0, as_given, notify)
-        laid = "laid at cable.positions" if sc.cable.positions_m is not None else model.arrangement
+        from exucable.post.bundle import laid_phrase
+
         return dict(_bundle_direction(result, name, rope_entry), arrangement_fallback=None,
-                    simulated_arrangement=laid)
+                    simulated_arrangement=laid_phrase(bundle))
     L = scenario.build_conduit().centreline.length_m
     s_c, T_c, rows, to_conduit = _simulated_sections(
         rope_entry, *cable_tension_along_conduit(result.model), L, name, summary["bends"],

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 from exucable.errors import ExucableError
 from exucable.io import atomic_write_text, new_figure
+from exucable.post.bundle import LAID_AT_POSITIONS
 from exucable.scenario.units import display_unit, from_si
 
 __all__ = ["plan_report_html", "section_rows", "engine_note", "bundle_note", "simulated_arrangement_phrase", "check_in_units",
@@ -273,8 +274,8 @@ def simulated_arrangement_phrase(plan: dict) -> str:
     other = {n: a for n, a in simulated.items() if a is not None and a != plan["arrangement"]}
     if not other:
         return ""
-    # "laid at cable.positions" is a lay, not an arrangement's name: no "as" before it
-    return "; " + "; ".join(f"simulated {'' if a.startswith('laid') else 'as '}{a} {direction_label(plan, n)}"
+    # cables laid at their positions are a lay, not an arrangement's name: no "as" before it
+    return "; " + "; ".join(f"simulated {'' if a == LAID_AT_POSITIONS else 'as '}{a} {direction_label(plan, n)}"
                             for n, a in other.items())
 
 

@@ -42,7 +42,8 @@ import numpy as np
 from .pressure import windowed_load
 
 __all__ = ["ACROSS_DEG", "CONTACT_TOLERANCE", "cross_section_frame", "frame_across", "cable_points", "cross_section_offsets",
-           "classify_cross_section", "arrangement_sections", "bend_pressures", "jam_band_warning"]
+           "classify_cross_section", "arrangement_sections", "bend_pressures", "jam_band_warning", "LAID_AT_POSITIONS",
+           "laid_phrase"]
 
 #: Gap, as a fraction of the cable radius, below which two surfaces count as touching [-]. Contact
 #: acts at check points, not in every plane, and the kernel sees the other cable as the polyline of
@@ -53,6 +54,14 @@ CONTACT_TOLERANCE = 0.05
 #: the duct (on nearly opposite sides) [deg]; the cradle of three at D/d = 3 spans 120°, a wedged
 #: line 180° less the chain's sag.
 ACROSS_DEG = 150.0
+#: What a bundle laid at ``cable.positions`` is called where an arrangement's name would stand.
+LAID_AT_POSITIONS = "laid at cable.positions"
+
+
+def laid_phrase(bundle: dict) -> str:
+    """How a bundle's cables were laid, from its summary (``summary["bundle"]``): the arrangement's
+    name, or :data:`LAID_AT_POSITIONS` where ``positions_given``."""
+    return LAID_AT_POSITIONS if bundle.get("positions_given") else bundle["arrangement"]
 
 
 def cross_section_frame(centreline, s_m) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -189,8 +189,8 @@ FIELDS: tuple[Field, ...] = (
            "lays them at the start instead of `cable.arrangement`'s rest (turned with the load into bends as an "
            "arrangement is) and where the pulling eye holds their leading ends; inside the duct and apart (each "
            "at most `conduit.inner_radius` − `cable.radius` from the axis, any two at least 2 `cable.radius` "
-           "apart, to 1e-3 `cable.radius` for digits typed). The calculators' formula values stay `cable.arrangement`'s, and `exucable plan` keeps the "
-           "lay (no fallback to the rule's arrangement)"),
+           "apart, to 1e-3 `cable.radius` for digits typed). The calculators' formula values stay "
+           "`cable.arrangement`'s, and `exucable plan` keeps the lay (no fallback to the rule's arrangement)"),
     F("cable.weight_correction_in_bends", "weight_correction_in_bends", "bool", "", True, ours=True,
       rule="`exucable plan`, several cables: `true` (IEEE 1185, AEIC CG5, Polywater): the weight correction factor "
            "w_c multiplies the friction in bends too, T_out = T_in e^(w_c μ θ); `false`: on straights only, "
